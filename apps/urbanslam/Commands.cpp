@@ -1,0 +1,14 @@
+#include "Commands.h"
+
+namespace urbanslam::cli {
+
+const std::vector<Command>& commands() {
+  static const std::vector<Command> all = {
+      {"run", "build a map and trajectory from a log (the main job)", runCommand},
+      {"convert", "write any supported log as an MRPT rawlog", convertCommand},
+      {"check-ini", "validate an ini file and print the resolved configuration", checkIniCommand},
+  };
+  return all;
+}
+
+}  // namespace urbanslam::cli

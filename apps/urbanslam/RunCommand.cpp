@@ -1,0 +1,74 @@
+// `urbanslam run`: the main job, as icp-slam/rbpf-slam do it (a log in, a folder of outputs out).
+#include <filesystem>
+#include <iostream>
+
+#include "ArgParser.h"
+#include "Commands.h"
+#include "DefaultPaths.h"
+#include "urbanslam/common/Progress.h"
+#include "urbanslam/slam/Pipeline.h"
+#include "urbanslam/slam/RunOutputs.h"
+
+namespace urbanslam::cli {
+
+namespace {
+
+class ProgressObserver : public slam::PipelineObserver {
+ public:
+  explicit ProgressObserver(common::ProgressBar& bar) : bar_(bar) {}
+  void onStep(const slam::StepEvent& e) override {
+    bar_.update(static_cast<uint64_t>(e.progress * 1000),
+                std::to_string(e.scans) + " scans, " + std::to_string(e.keyframes) + " keyframes");
+  }
+
+ private:
+  common::ProgressBar& bar_;
+};
+
+}  // namespace
+
+int runCommand(const Argv& args) {
+  ArgParser ap("urbanslam run [--ini FILE] [--out DIR] [--quiet] [--json] [LOG]",
+               "Builds a map and trajectory from a log: MRPT rawlog (either layout, gzipped or not),\n"
+               "CARMEN log (raw or Freiburg-corrected) or Victoria Park (folder or zip).");
+  ap.addPositional("LOG", "input log; default: the shipped rawlogs/intel.rawlog", false);
+  ap.addOption("ini", "FILE", "configuration (see ini/default.ini for every key)", "ini/default.ini");
+  ap.addOption("out", "DIR", "output folder (created if needed)", "out");
+  ap.addFlag("quiet", "no progress bar and no summary on stderr");
+  ap.addFlag("json", "print stats.json as one JSON object on stdout");
+  ap.addEpilog(
+      "outputs in DIR: trajectory_keyframes.tum, trajectory_odometry.tum, reference.tum (when the log\n"
+      "has one), map.ply/.pcd/.xyz, map.simplemap, grid.png + grid.yaml, config.ini, stats.json\n"
+      "(written last: its presence marks a complete run).");
+  if (!ap.parse(args)) return 0;
+
+  const std::string log = ap.positional("LOG").empty() ? defaultRawlog() : ap.positional("LOG");
+  const std::string ini = ap.has("ini") ? ap.option("ini") : defaultIni();
+  const bool quiet = ap.flag("quiet");
+  std::string resolved;
+  const slam::PipelineOptions options = slam::loadPipelineOptions(ini, &resolved);
+
+  auto source = io::openDataSource(log);
+  slam::Pipeline pipeline(options);
+  common::ProgressBar bar("run", 1000, !quiet);
+  ProgressObserver progress(bar);
+  pipeline.addObserver(&progress);
+  pipeline.run(*source);
+  bar.finish();
+
+  const std::string out = ap.option("out");
+  const common::Json stats = slam::writeRunOutputs(pipeline, out, {log, source->format(), ini, resolved});
+  if (ap.flag("json")) std::cout << stats.dump() << "\n";
+  if (!quiet) {
+    const auto& t = stats.at("timing");
+    std::cerr << "urbanslam run: " << pipeline.stats().scans_used << " scans, " << pipeline.keyframes().size()
+              << " keyframes, " << stats.at("counts").at("map_points").asNumber() << " map points in "
+              << t.at("wall_s").asNumber() << " s (" << t.at("real_time_factor").asNumber()
+              << "x real time)\n"
+              << "outputs in " << std::filesystem::absolute(out).string() << "/ (grid.png, map.ply, "
+              << "trajectory_keyframes.tum, stats.json, ...)\n";
+  }
+  return 0;
+}
+
+}  // namespace urbanslam::cli

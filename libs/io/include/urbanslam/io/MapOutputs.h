@@ -1,0 +1,54 @@
+#pragma once
+// The map products of a run, all built from scans placed at (estimated) vehicle poses:
+// trajectory (TUM), point cloud (PLY binary/ASCII, PCD, XYZ), MRPT .simplemap, and an occupancy
+// grid as PNG + YAML (ROS map_server convention). Every writer writes atomically.
+#include <string>
+#include <vector>
+
+#include "urbanslam/common/Pose2.h"
+#include "urbanslam/io/LaserScan.h"
+
+namespace urbanslam::io {
+
+struct StampedPose {
+  double timestamp = 0;
+  common::Pose2 pose;
+};
+
+// A scan and the vehicle pose it was taken from.
+struct PosedScan {
+  common::Pose2 pose;
+  const LaserScan* scan = nullptr;
+};
+
+struct MapPoint {
+  float x = 0, y = 0, z = 0;
+};
+
+// TUM RGB-D format: "timestamp x y z qx qy qz qw", one pose per line (z = 0, yaw-only quaternion).
+void writeTum(const std::string& path, const std::vector<StampedPose>& poses);
+// Reads a TUM trajectory (2D part). Throws common::InputError naming file and line.
+std::vector<StampedPose> readTum(const std::string& path);
+
+// World-frame points of all valid beams, optionally keeping every `decimation`-th point.
+std::vector<MapPoint> mapPoints(const std::vector<PosedScan>& scans, int decimation = 1);
+
+enum class PlyEncoding { Ascii, BinaryLittleEndian };
+void writePly(const std::string& path, const std::vector<MapPoint>& pts, PlyEncoding encoding);
+void writePcd(const std::string& path, const std::vector<MapPoint>& pts);  // PCD v0.7, ASCII
+void writeXyz(const std::string& path, const std::vector<MapPoint>& pts);  // "x y z" per line
+
+// MRPT CSimpleMap: one (pose, sensory frame with the scan) per keyframe.
+void writeSimpleMap(const std::string& path, const std::vector<PosedScan>& scans);
+
+struct OccupancyGridOptions {
+  double resolution_m = 0.05;
+  double occupied_thresh = 0.65;  // map_server thresholds, written into the YAML
+  double free_thresh = 0.196;
+};
+
+// Writes `<prefix>.png` and `<prefix>.yaml`; returns the PNG's size in cells (width, height).
+std::pair<int, int> writeOccupancyGrid(const std::string& prefix, const std::vector<PosedScan>& scans,
+                                       const OccupancyGridOptions& options);
+
+}  // namespace urbanslam::io

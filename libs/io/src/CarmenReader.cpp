@@ -1,0 +1,257 @@
+#include "urbanslam/io/CarmenReader.h"
+
+#include <cmath>
+
+#include "TextScanner.h"
+#include "urbanslam/common/Error.h"
+
+namespace urbanslam::io {
+
+using common::InputError;
+using common::Pose2;
+using detail::parseInteger;
+using detail::parseNumber;
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+// Angular resolution of a FLASER/RLASER with n beams over the usual 180° (SICK LMS modes).
+double resolutionForBeams(long n) {
+  if (n == 180 || n == 181) return 1.0 * kDeg;
+  if (n == 360 || n == 361) return 0.5 * kDeg;
+  if (n == 720 || n == 721) return 0.25 * kDeg;
+  return n > 1 ? M_PI / static_cast<double>(n - 1) : M_PI;
+}
+
+bool samePose(const Pose2& a, const Pose2& b) {
+  return std::abs(a.x - b.x) < 1e-9 && std::abs(a.y - b.y) < 1e-9 &&
+         std::abs(common::wrapToPi(a.phi - b.phi)) < 1e-9;
+}
+
+// Fills ranges/valid; NaN, infinite and negative ranges are corrupt input, not no-returns.
+void readRanges(const std::vector<std::string>& f, size_t first, long n, double max_range,
+                const std::string& where, LaserScan& scan) {
+  scan.ranges.resize(static_cast<size_t>(n));
+  scan.valid.resize(static_cast<size_t>(n));
+  for (long i = 0; i < n; ++i) {
+    const double r = parseNumber(f[first + static_cast<size_t>(i)], where, "range");
+    if (r < 0) throw InputError(where + ": negative range " + f[first + static_cast<size_t>(i)]);
+    scan.ranges[static_cast<size_t>(i)] = static_cast<float>(r);
+    scan.valid[static_cast<size_t>(i)] = (r > 0 && r < max_range) ? 1 : 0;
+  }
+}
+
+// CARMEN beams start at start_angle and go counter-clockwise. We keep MRPT's symmetric beam
+// layout (beam 0 at -aperture/2) and put the asymmetry into the sensor's yaw, so scans convert
+// to CObservation2DRangeScan and back without loss.
+void setGeometry(LaserScan& scan, double start_angle, double resolution, const Pose2& mount) {
+  const double n = static_cast<double>(scan.ranges.size());
+  const double aperture = resolution * (n - 1);
+  scan.angle_increment_rad = resolution;
+  scan.angle_min_rad = -aperture / 2;
+  scan.sensor_pose = {mount.x, mount.y, common::wrapToPi(mount.phi + start_angle + aperture / 2)};
+}
+
+}  // namespace
+
+bool CarmenReader::sniff(const std::string& head) {
+  for (const char* tag : {"FLASER ", "ODOM ", "ROBOTLASER1 ", "RLASER ", "PARAM ", "# message formats", "RAWLASER"})
+    if (head.find(tag) != std::string::npos) return true;
+  return false;
+}
+
+CarmenReader::CarmenReader(const std::string& path) : DataSource(path) {
+  prescan();
+  text_ = std::make_unique<detail::TextScanner>(detail::openGzFile(path), path);
+}
+
+CarmenReader::~CarmenReader() = default;
+
+// Reads the head of the log once to learn what the stream cannot tell until too late: whether
+// it is a corrected log (NEFF lines, anchors that jump) and whether it has timestamps.
+void CarmenReader::prescan() {
+  detail::TextScanner t(detail::openGzFile(path_), path_);
+  std::string line;
+  std::vector<std::string> f;
+  bool after_scan = false, any_ts = false, any_scan = false;
+  Pose2 scan_pose, prev_odom;
+  bool have_prev_odom = false;
+  for (int k = 0; k < 50000 && t.nextLine(line); ++k) {
+    detail::splitFields(line, f);
+    if (f.empty()) continue;
+    const std::string where = path_ + ":" + std::to_string(t.lineNumber());
+    if (f[0] == "NEFF") info_.corrected = true;
+    if (f[0] == "PARAM" && f.size() >= 3) handleParam(f);
+    if (f[0] == "ODOM" && f.size() >= 4) {
+      any_odom_lines_ = true;
+      const Pose2 p{parseNumber(f[1], where, "x"), parseNumber(f[2], where, "y"), parseNumber(f[3], where, "theta")};
+      // An anchor that differs from the odometry just before it is a corrected pose.
+      if (after_scan && samePose(p, scan_pose) && have_prev_odom && !samePose(p, prev_odom))
+        info_.corrected = true;
+      prev_odom = p;
+      have_prev_odom = true;
+    }
+    after_scan = false;
+    if ((f[0] == "FLASER" || f[0] == "RLASER") && f.size() >= 2) {
+      const long n = parseInteger(f[1], where, "beam count");
+      if (n >= 0 && f.size() >= static_cast<size_t>(n) + 9) {
+        any_scan = true;
+        scan_pose = {parseNumber(f[static_cast<size_t>(n) + 2], where, "x"),
+                     parseNumber(f[static_cast<size_t>(n) + 3], where, "y"),
+                     parseNumber(f[static_cast<size_t>(n) + 4], where, "theta")};
+        after_scan = f[0] == "FLASER";
+        if (parseNumber(f[static_cast<size_t>(n) + 8], where, "timestamp") != 0) any_ts = true;
+      }
+    }
+  }
+  info_.has_timestamps = any_ts || !any_scan;
+}
+
+void CarmenReader::handleParam(const std::vector<std::string>& f) {
+  // Only the geometry we need; the many other PARAMs are robot/simulator settings.
+  const auto num = [&](double& dst) {
+    char* end = nullptr;
+    const double v = std::strtod(f[2].c_str(), &end);
+    if (end != f[2].c_str() && std::isfinite(v)) dst = v;
+  };
+  if (f[1] == "robot_front_laser_max") num(info_.front_max_range_m);
+  else if (f[1] == "robot_rear_laser_max") num(info_.rear_max_range_m);
+  else if (f[1] == "robot_frontlaser_offset") num(info_.front_offset_m);
+  else if (f[1] == "robot_rearlaser_offset") num(info_.rear_offset_m);
+}
+
+double CarmenReader::progress() const { return text_ ? text_->progress() : 0.0; }
+
+std::string CarmenReader::format() const {
+  std::string s = info_.corrected ? "CARMEN log (corrected: FLASER poses are the reference)" : "CARMEN log";
+  if (!info_.has_timestamps) s += ", no timestamps: scan index used as time";
+  return s;
+}
+
+// Logs without timestamps get the scan count as time: scan k at k seconds, the odometry read
+// before it at the same time, so the order of the file is kept.
+double CarmenReader::stamp(double log_ts, bool is_scan) {
+  if (info_.has_timestamps) return log_ts;
+  return static_cast<double>(scans_ + (is_scan ? 0 : 1));
+}
+
+bool CarmenReader::next(Measurement& out) {
+  while (pending_pos_ >= pending_.size()) {
+    pending_.clear();
+    pending_pos_ = 0;
+    std::string line;
+    if (!text_->nextLine(line)) return false;
+    parseLine(line);
+  }
+  out = std::move(pending_[pending_pos_++]);
+  return true;
+}
+
+bool CarmenReader::parseLine(const std::string& line) {
+  detail::splitFields(line, fields_);
+  if (fields_.empty() || fields_[0][0] == '#') return false;
+  const std::string where = path_ + ":" + std::to_string(text_->lineNumber());
+  const std::string& tag = fields_[0];
+  if (tag == "ODOM") handleOdom(fields_, where);
+  else if (tag == "FLASER") handleLaser(fields_, where, false);
+  else if (tag == "RLASER") handleLaser(fields_, where, true);
+  else if (tag == "ROBOTLASER1") handleRobotLaser(fields_, where);
+  else if (tag == "PARAM" && fields_.size() >= 3) handleParam(fields_);
+  // NEFF, SYNC, TRUEPOS, RAWLASER*, SONAR, ...: not used.
+  // Only the ODOM line right after a scan can be an anchor (handlers set/clear the flag).
+  if (tag != "ODOM" && tag != "FLASER" && tag != "RLASER" && tag != "ROBOTLASER1") last_was_scan_ = false;
+  return true;
+}
+
+void CarmenReader::handleOdom(const std::vector<std::string>& f, const std::string& where) {
+  // ODOM x y theta tv rv accel timestamp hostname logger_timestamp
+  if (f.size() < 8) throw InputError(where + ": truncated ODOM line (" + std::to_string(f.size()) + " fields, need 8)");
+  const Pose2 p{parseNumber(f[1], where, "x"), parseNumber(f[2], where, "y"),
+                common::wrapToPi(parseNumber(f[3], where, "theta"))};
+  const double ts = parseNumber(f[7], where, "timestamp");
+  const bool anchor = last_was_scan_ && samePose(p, last_scan_pose_);
+  last_was_scan_ = false;
+  if (anchor && have_odom_) {
+    // A re-anchor at the corrected pose starts a new segment; in a raw log it is a zero increment.
+    last_odom_line_ = p;
+    return;
+  }
+  if (!have_raw_) {
+    raw_ = p;
+    have_raw_ = true;
+  } else {
+    raw_ = common::compose(raw_, common::between(last_odom_line_, p));
+  }
+  last_odom_line_ = p;
+  have_odom_ = true;
+  pending_.emplace_back(OdometryReading{stamp(ts, false), raw_});
+}
+
+void CarmenReader::emitScan(LaserScan scan, const Pose2& log_pose, const Pose2& odom_pose) {
+  if (info_.corrected) {
+    pending_.emplace_back(ReferencePose{scan.timestamp, log_pose});
+  } else if (!any_odom_lines_) {
+    // Logs without ODOM lines carry the odometry only inside the laser messages.
+    pending_.emplace_back(OdometryReading{scan.timestamp, odom_pose});
+  }
+  pending_.emplace_back(std::move(scan));
+}
+
+void CarmenReader::handleLaser(const std::vector<std::string>& f, const std::string& where, bool rear) {
+  // FLASER n r1..rn x y theta odom_x odom_y odom_theta timestamp hostname logger_timestamp
+  if (f.size() < 2) throw InputError(where + ": truncated laser line");
+  const long n = parseInteger(f[1], where, "beam count");
+  if (n <= 0 || n > 100000) throw InputError(where + ": invalid beam count " + f[1]);
+  const size_t nn = static_cast<size_t>(n);
+  if (f.size() < nn + 9)
+    throw InputError(where + ": truncated laser line (" + std::to_string(f.size()) + " fields, need " +
+                     std::to_string(nn + 9) + ")");
+  LaserScan scan;
+  scan.label = rear ? "RLASER" : "FLASER";
+  scan.max_range_m = rear ? info_.rear_max_range_m : info_.front_max_range_m;
+  readRanges(f, 2, n, scan.max_range_m, where, scan);
+  const Pose2 pose{parseNumber(f[nn + 2], where, "x"), parseNumber(f[nn + 3], where, "y"),
+                   common::wrapToPi(parseNumber(f[nn + 4], where, "theta"))};
+  const Pose2 odom{parseNumber(f[nn + 5], where, "odom_x"), parseNumber(f[nn + 6], where, "odom_y"),
+                   common::wrapToPi(parseNumber(f[nn + 7], where, "odom_theta"))};
+  ++scans_;
+  scan.timestamp = stamp(parseNumber(f[nn + 8], where, "timestamp"), true);
+  const Pose2 mount = rear ? Pose2{info_.rear_offset_m, 0, M_PI} : Pose2{info_.front_offset_m, 0, 0};
+  setGeometry(scan, -M_PI / 2, resolutionForBeams(n), mount);
+  emitScan(std::move(scan), pose, odom);
+  last_was_scan_ = !rear;
+  last_scan_pose_ = pose;
+}
+
+void CarmenReader::handleRobotLaser(const std::vector<std::string>& f, const std::string& where) {
+  // ROBOTLASER1 type start_angle fov resolution max_range accuracy remission_mode n r1..rn
+  //   m rem1..remm laser_x laser_y laser_theta robot_x robot_y robot_theta tv rv fwd side turn
+  //   timestamp hostname logger_timestamp
+  if (f.size() < 9) throw InputError(where + ": truncated ROBOTLASER1 line");
+  const long n = parseInteger(f[8], where, "beam count");
+  if (n <= 0 || n > 100000) throw InputError(where + ": invalid beam count " + f[8]);
+  const size_t nn = static_cast<size_t>(n);
+  if (f.size() < 9 + nn + 1) throw InputError(where + ": truncated ROBOTLASER1 line");
+  const long m = parseInteger(f[9 + nn], where, "remission count");
+  if (m < 0 || f.size() < 10 + nn + static_cast<size_t>(m) + 13)
+    throw InputError(where + ": truncated ROBOTLASER1 line");
+  const size_t k = 10 + nn + static_cast<size_t>(m);
+  LaserScan scan;
+  scan.label = "ROBOTLASER1";
+  scan.max_range_m = parseNumber(f[5], where, "maximum_range");
+  readRanges(f, 9, n, scan.max_range_m, where, scan);
+  const Pose2 laser{parseNumber(f[k], where, "laser_x"), parseNumber(f[k + 1], where, "laser_y"),
+                    parseNumber(f[k + 2], where, "laser_theta")};
+  const Pose2 robot{parseNumber(f[k + 3], where, "robot_x"), parseNumber(f[k + 4], where, "robot_y"),
+                    common::wrapToPi(parseNumber(f[k + 5], where, "robot_theta"))};
+  ++scans_;
+  scan.timestamp = stamp(parseNumber(f[k + 12], where, "timestamp"), true);
+  setGeometry(scan, parseNumber(f[2], where, "start_angle"), parseNumber(f[4], where, "resolution"),
+              common::between(robot, laser));
+  emitScan(std::move(scan), robot, robot);
+  last_was_scan_ = true;
+  last_scan_pose_ = robot;
+}
+
+}  // namespace urbanslam::io

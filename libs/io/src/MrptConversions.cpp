@@ -1,0 +1,116 @@
+#include "MrptConversions.h"
+
+#include <mrpt/img/CImage.h>
+#include <mrpt/obs/CObservationImage.h>
+#include <mrpt/obs/CObservationOdometry.h>
+#include <mrpt/obs/CObservationRawDAQ.h>
+#include <mrpt/obs/CObservationRobotPose.h>
+#include <mrpt/poses/CPose3D.h>
+
+#include <cmath>
+
+#include "urbanslam/common/Error.h"
+
+namespace urbanslam::io::detail {
+
+using common::InputError;
+
+mrpt::Clock::time_point toMrptTime(double t) { return mrpt::Clock::fromDouble(t); }
+double fromMrptTime(const mrpt::Clock::time_point& t) { return mrpt::Clock::toDouble(t); }
+
+mrpt::obs::CObservation2DRangeScan::Ptr toMrptScan(const LaserScan& s) {
+  auto o = mrpt::obs::CObservation2DRangeScan::Create();
+  o->timestamp = toMrptTime(s.timestamp);
+  o->sensorLabel = s.label;
+  const size_t n = s.ranges.size();
+  o->resizeScan(n);
+  for (size_t i = 0; i < n; ++i) {
+    o->setScanRange(i, s.ranges[i]);
+    o->setScanRangeValidity(i, s.valid[i] != 0);
+  }
+  // MRPT's beams are symmetric about the sensor's x axis; any offset goes into the yaw.
+  const double span = s.angle_increment_rad * static_cast<double>(n > 0 ? n - 1 : 0);
+  o->aperture = static_cast<float>(std::abs(span));
+  o->rightToLeft = s.angle_increment_rad >= 0;
+  const double mid = s.angle_min_rad + span / 2;
+  o->sensorPose = mrpt::poses::CPose3D(s.sensor_pose.x, s.sensor_pose.y, 0, s.sensor_pose.phi + mid, 0, 0);
+  o->maxRange = static_cast<float>(s.max_range_m);
+  return o;
+}
+
+LaserScan fromMrptScan(const mrpt::obs::CObservation2DRangeScan& o, const std::string& where) {
+  LaserScan s;
+  s.timestamp = fromMrptTime(o.timestamp);
+  s.label = o.sensorLabel;
+  const size_t n = o.getScanSize();
+  if (n == 0) throw InputError(where + ": empty laser scan (0 beams)");
+  s.ranges.resize(n);
+  s.valid.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const float r = o.getScanRange(i);
+    const bool ok = o.getScanRangeValidity(i);
+    if (ok && (!std::isfinite(r) || r < 0))
+      throw InputError(where + ": laser beam " + std::to_string(i) + " has an invalid range (" +
+                       std::to_string(r) + ")");
+    s.ranges[i] = std::isfinite(r) ? r : 0.f;
+    s.valid[i] = ok && r > 0 && r < o.maxRange ? 1 : 0;
+  }
+  const double step = n > 1 ? o.aperture / static_cast<double>(n - 1) : 0.0;
+  s.angle_increment_rad = o.rightToLeft ? step : -step;
+  s.angle_min_rad = o.rightToLeft ? -o.aperture / 2.0 : o.aperture / 2.0;
+  s.max_range_m = o.maxRange;
+  s.sensor_pose = {o.sensorPose.x(), o.sensorPose.y(), o.sensorPose.yaw()};
+  return s;
+}
+
+namespace {
+
+struct ToMrpt {
+  mrpt::obs::CObservation::Ptr operator()(const LaserScan& s) const { return toMrptScan(s); }
+  mrpt::obs::CObservation::Ptr operator()(const OdometryReading& m) const {
+    auto o = mrpt::obs::CObservationOdometry::Create();
+    o->timestamp = toMrptTime(m.timestamp);
+    o->sensorLabel = "ODOMETRY";
+    o->odometry = mrpt::poses::CPose2D(m.pose.x, m.pose.y, m.pose.phi);
+    o->hasEncodersInfo = false;
+    o->hasVelocities = false;
+    return o;
+  }
+  mrpt::obs::CObservation::Ptr operator()(const DriveReading& m) const {
+    auto o = mrpt::obs::CObservationRawDAQ::Create();
+    o->timestamp = toMrptTime(m.timestamp);
+    o->sensorLabel = kDriveLabel;
+    o->AIN_double = {m.speed_mps, m.steering_rad};
+    return o;
+  }
+  mrpt::obs::CObservation::Ptr operator()(const CameraImage& m) const {
+    auto o = mrpt::obs::CObservationImage::Create();
+    o->timestamp = toMrptTime(m.timestamp);
+    o->sensorLabel = m.label;
+    o->image = mrpt::img::CImage(m.width, m.height, mrpt::img::CH_GRAY);
+    for (int r = 0; r < m.height; ++r)
+      std::copy_n(m.pixels->data() + static_cast<size_t>(r) * static_cast<size_t>(m.width),
+                  static_cast<size_t>(m.width), o->image.ptrLine<uint8_t>(static_cast<unsigned>(r)));
+    return o;
+  }
+  mrpt::obs::CObservation::Ptr operator()(const GpsFix& m) const {
+    auto o = mrpt::obs::CObservationRobotPose::Create();
+    o->timestamp = toMrptTime(m.timestamp);
+    o->sensorLabel = kGpsLabel;
+    o->pose.mean = mrpt::poses::CPose3D(m.x_m, m.y_m, 0, 0, 0, 0);
+    return o;
+  }
+  mrpt::obs::CObservation::Ptr operator()(const ReferencePose& m) const {
+    auto o = mrpt::obs::CObservationRobotPose::Create();
+    o->timestamp = toMrptTime(m.timestamp);
+    o->sensorLabel = kReferenceLabel;
+    o->pose.mean = mrpt::poses::CPose3D(m.pose.x, m.pose.y, 0, m.pose.phi, 0, 0);
+    return o;
+  }
+};
+
+}  // namespace
+
+mrpt::obs::CObservation::Ptr toMrpt(const Measurement& m) { return std::visit(ToMrpt{}, m); }
+
+}  // namespace urbanslam::io::detail

@@ -1,0 +1,26 @@
+#pragma once
+// Conversions between our measurement structs and MRPT's observation classes. Private to io:
+// only the rawlog reader/writer and the map writers include MRPT headers.
+#include <mrpt/obs/CObservation.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
+
+#include "urbanslam/io/Measurements.h"
+
+namespace urbanslam::io::detail {
+
+// Labels used for the measurement kinds that MRPT has no dedicated class for.
+constexpr const char* kDriveLabel = "DRIVE";          // CObservationRawDAQ: AIN_double = {speed, steering}
+constexpr const char* kGpsLabel = "GPS_LOCAL";        // CObservationRobotPose: local metres
+constexpr const char* kReferenceLabel = "REFERENCE";  // CObservationRobotPose: reference trajectory
+
+mrpt::Clock::time_point toMrptTime(double t);
+double fromMrptTime(const mrpt::Clock::time_point& t);
+
+mrpt::obs::CObservation2DRangeScan::Ptr toMrptScan(const LaserScan& s);
+// Throws common::InputError (with `where`) for an empty scan or a NaN/negative valid range.
+LaserScan fromMrptScan(const mrpt::obs::CObservation2DRangeScan& o, const std::string& where);
+
+// Any measurement as an MRPT observation.
+mrpt::obs::CObservation::Ptr toMrpt(const Measurement& m);
+
+}  // namespace urbanslam::io::detail

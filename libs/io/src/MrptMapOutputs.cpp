@@ -1,0 +1,75 @@
+// The outputs MRPT writes for us: .simplemap (RawLogViewer, observations2map and MRPT's
+// localisation apps read it) and the occupancy grid PNG.
+#include <mrpt/maps/COccupancyGridMap2D.h>
+#include <mrpt/maps/CSimpleMap.h>
+#include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/poses/CPose3DPDFGaussian.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "MrptConversions.h"
+#include "urbanslam/common/AtomicFile.h"
+#include "urbanslam/common/Error.h"
+#include "urbanslam/io/MapOutputs.h"
+
+namespace urbanslam::io {
+
+void writeSimpleMap(const std::string& path, const std::vector<PosedScan>& scans) {
+  mrpt::maps::CSimpleMap sm;
+  for (const auto& ps : scans) {
+    auto pose = mrpt::poses::CPose3DPDFGaussian::Create();
+    pose->mean = mrpt::poses::CPose3D(ps.pose.x, ps.pose.y, 0, ps.pose.phi, 0, 0);
+    auto sf = mrpt::obs::CSensoryFrame::Create();
+    sf->insert(detail::toMrptScan(*ps.scan));
+    sm.insert(pose, sf);
+  }
+  common::writeAtomically(path, [&](const std::string& tmp) {
+    if (!sm.saveToFile(tmp)) throw common::InputError(path + ": cannot write");
+  });
+}
+
+std::pair<int, int> writeOccupancyGrid(const std::string& prefix, const std::vector<PosedScan>& scans,
+                                       const OccupancyGridOptions& options) {
+  // Bounds first, so the grid is allocated once instead of growing scan by scan.
+  double x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+  bool first = true;
+  for (const auto& p : mapPoints(scans)) {
+    if (first) { x0 = x1 = p.x; y0 = y1 = p.y; first = false; }
+    x0 = std::min<double>(x0, p.x); x1 = std::max<double>(x1, p.x);
+    y0 = std::min<double>(y0, p.y); y1 = std::max<double>(y1, p.y);
+  }
+  for (const auto& ps : scans) {
+    x0 = std::min(x0, ps.pose.x); x1 = std::max(x1, ps.pose.x);
+    y0 = std::min(y0, ps.pose.y); y1 = std::max(y1, ps.pose.y);
+  }
+  const double margin = 1.0;
+  mrpt::maps::COccupancyGridMap2D grid(static_cast<float>(x0 - margin), static_cast<float>(x1 + margin),
+                                        static_cast<float>(y0 - margin), static_cast<float>(y1 + margin),
+                                        static_cast<float>(options.resolution_m));
+  grid.insertionOptions.maxDistanceInsertion = 80.f;
+  grid.insertionOptions.wideningBeamsWithDistance = false;
+  for (const auto& ps : scans) {
+    const auto obs = detail::toMrptScan(*ps.scan);
+    const mrpt::poses::CPose3D robot(ps.pose.x, ps.pose.y, 0, ps.pose.phi, 0, 0);
+    grid.insertObservation(*obs, robot);
+  }
+  common::writeAtomically(prefix + ".png", [&](const std::string& tmp) {
+    if (!grid.saveAsBitmapFile(tmp)) throw common::InputError(prefix + ".png: cannot write");
+  });
+  // map_server: origin is the pose of the lower-left pixel; the PNG's first row is the top.
+  common::AtomicFile yaml(prefix + ".yaml");
+  const std::string image = std::filesystem::path(prefix).filename().string() + ".png";
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "image: %s\nresolution: %.6f\norigin: [%.6f, %.6f, 0.0]\nnegate: 0\n"
+                "occupied_thresh: %.3f\nfree_thresh: %.3f\n",
+                image.c_str(), grid.getResolution(), grid.getXMin(), grid.getYMin(),
+                options.occupied_thresh, options.free_thresh);
+  yaml.stream() << buf;
+  yaml.commit();
+  return {static_cast<int>(grid.getSizeX()), static_cast<int>(grid.getSizeY())};
+}
+
+}  // namespace urbanslam::io

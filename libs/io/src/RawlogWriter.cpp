@@ -1,0 +1,92 @@
+#include "urbanslam/io/RawlogWriter.h"
+
+#include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/obs/CActionCollection.h>
+#include <mrpt/obs/CActionRobotMovement2D.h>
+#include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/poses/CPose2D.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <cstdio>
+
+#include "MrptConversions.h"
+#include "urbanslam/common/AtomicFile.h"
+#include "urbanslam/common/Error.h"
+
+namespace urbanslam::io {
+
+using common::InputError;
+
+struct RawlogWriter::Impl {
+  std::string path, temp;
+  RawlogLayout layout;
+  mrpt::io::CFileGZOutputStream out;
+  mrpt::obs::CSensoryFrame::Ptr frame;  // SensoryFrames layout: observations since the last odometry
+  bool have_odom = false;
+  common::Pose2 last_odom;
+  size_t written = 0;
+  bool closed = false;
+
+  void flushFrame() {
+    if (!frame || frame->size() == 0) return;
+    auto arch = mrpt::serialization::archiveFrom(out);
+    arch << *frame;
+    frame = mrpt::obs::CSensoryFrame::Create();
+  }
+};
+
+RawlogWriter::RawlogWriter(const std::string& path, RawlogLayout layout, int gz_level)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->path = path;
+  impl_->temp = common::temporaryPathFor(path);
+  impl_->layout = layout;
+  if (!impl_->out.open(impl_->temp, gz_level)) throw InputError(path + ": cannot write");
+  impl_->frame = mrpt::obs::CSensoryFrame::Create();
+}
+
+RawlogWriter::~RawlogWriter() {
+  if (!impl_->closed) {
+    impl_->out.close();
+    std::remove(impl_->temp.c_str());
+  }
+}
+
+void RawlogWriter::write(const Measurement& m) {
+  auto arch = mrpt::serialization::archiveFrom(impl_->out);
+  if (impl_->layout == RawlogLayout::Observations) {
+    arch << *detail::toMrpt(m);
+  } else if (const auto* od = std::get_if<OdometryReading>(&m)) {
+    // Classic layout: the frame gathered so far, then the odometry increment as an action.
+    impl_->flushFrame();
+    if (impl_->have_odom) {
+      const common::Pose2 inc = common::between(impl_->last_odom, od->pose);
+      mrpt::obs::CActionRobotMovement2D mv;
+      mv.timestamp = detail::toMrptTime(od->timestamp);
+      mrpt::obs::CActionRobotMovement2D::TMotionModelOptions opts;
+      opts.modelSelection = mrpt::obs::CActionRobotMovement2D::mmGaussian;
+      mv.computeFromOdometry(mrpt::poses::CPose2D(inc.x, inc.y, inc.phi), opts);
+      mv.timestamp = detail::toMrptTime(od->timestamp);
+      mrpt::obs::CActionCollection acts;
+      acts.insert(mv);
+      arch << acts;
+    }
+    impl_->have_odom = true;
+    impl_->last_odom = od->pose;
+  } else {
+    impl_->frame->insert(detail::toMrpt(m));
+  }
+  ++impl_->written;
+}
+
+void RawlogWriter::close() {
+  if (impl_->closed) return;
+  impl_->flushFrame();
+  impl_->out.close();
+  if (std::rename(impl_->temp.c_str(), impl_->path.c_str()) != 0)
+    throw InputError(impl_->path + ": cannot rename the finished file into place");
+  impl_->closed = true;
+}
+
+size_t RawlogWriter::written() const { return impl_->written; }
+
+}  // namespace urbanslam::io

@@ -1,0 +1,52 @@
+#pragma once
+// Line- and token-wise reading of (possibly gzipped, possibly zipped) text, in constant memory.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace urbanslam::io::detail {
+
+class ByteStream {
+ public:
+  virtual ~ByteStream() = default;
+  // Reads up to n bytes; 0 at the end. Throws common::InputError on a read error / truncation.
+  virtual size_t read(char* buf, size_t n) = 0;
+  virtual double progress() const = 0;
+};
+
+// A plain or gzip-compressed file (zlib detects which).
+std::unique_ptr<ByteStream> openGzFile(const std::string& path);
+// One entry of a zip archive (libzip), e.g. LASER.txt inside victoria_park_ascii.zip.
+std::unique_ptr<ByteStream> openZipEntry(const std::string& zip_path, const std::string& entry);
+
+class TextScanner {
+ public:
+  TextScanner(std::unique_ptr<ByteStream> in, std::string name);
+  // Next line without its terminator; false at the end of input.
+  bool nextLine(std::string& line);
+  // Next white-space separated token (ignores line structure); false at the end of input.
+  bool nextToken(std::string& token);
+  int lineNumber() const { return line_; }
+  const std::string& name() const { return name_; }
+  double progress() const { return in_->progress(); }
+
+ private:
+  bool fill();
+
+  std::unique_ptr<ByteStream> in_;
+  std::string name_;
+  std::vector<char> buf_;
+  size_t pos_ = 0, end_ = 0;
+  int line_ = 0;
+  bool eof_ = false;
+};
+
+// Splits a line on white space.
+void splitFields(const std::string& line, std::vector<std::string>& fields);
+// Strict numeric parsing: the whole field must be a finite number. Throws common::InputError
+// with "where: what".
+double parseNumber(const std::string& field, const std::string& where, const char* what);
+long parseInteger(const std::string& field, const std::string& where, const char* what);
+
+}  // namespace urbanslam::io::detail

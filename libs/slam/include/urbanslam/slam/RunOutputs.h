@@ -1,0 +1,19 @@
+#pragma once
+// Writes everything `urbanslam run` produces into one folder: trajectories (TUM), map point
+// clouds, .simplemap, occupancy grid, stats.json and the resolved config.ini. Each file is
+// written atomically; stats.json comes last, so its presence marks a complete run.
+#include <string>
+
+#include "urbanslam/common/Json.h"
+#include "urbanslam/slam/Pipeline.h"
+
+namespace urbanslam::slam {
+
+struct RunInfo {
+  std::string input_path, input_format, ini_path, resolved_ini;
+};
+
+// Returns the stats.json content that was written.
+common::Json writeRunOutputs(const Pipeline& pipeline, const std::string& dir, const RunInfo& info);
+
+}  // namespace urbanslam::slam

@@ -1,0 +1,119 @@
+#include "urbanslam/slam/RunOutputs.h"
+
+#include <filesystem>
+
+#include "urbanslam/common/AtomicFile.h"
+#include "urbanslam/common/Error.h"
+#include "urbanslam/common/OptionsSchema.h"
+#include "urbanslam/common/Timing.h"
+#include "urbanslam/io/MapOutputs.h"
+
+namespace urbanslam::slam {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+void ensureWritableDir(const std::string& dir) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir)) throw common::InputError(dir + ": cannot create the output folder");
+  const fs::path probe = fs::path(dir) / ".urbanslam-write-test";
+  {
+    std::ofstream f(probe);
+    if (!f) throw common::InputError(dir + ": output folder is not writable");
+  }
+  fs::remove(probe, ec);
+}
+
+}  // namespace
+
+common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const RunInfo& info) {
+  using common::Json;
+  ensureWritableDir(dir);
+  const auto path = [&](const std::string& name) { return (fs::path(dir) / name).string(); };
+  const PipelineOptions& o = p.options();
+  common::Stopwatch sw;
+
+  // config.ini first: whoever looks at the outputs can see how they were made.
+  {
+    common::AtomicFile f(path("config.ini"));
+    f.stream() << "// Resolved configuration of this run (input: " << info.input_path << ", ini: "
+               << (info.ini_path.empty() ? "built-in defaults" : info.ini_path) << ")\n"
+               << info.resolved_ini;
+    f.commit();
+  }
+
+  Json files = Json::array();
+  std::vector<io::StampedPose> kf_traj;
+  for (const auto& k : p.keyframes()) kf_traj.push_back({k.timestamp, k.pose});
+  io::writeTum(path("trajectory_keyframes.tum"), kf_traj);
+  files.push("trajectory_keyframes.tum");
+  io::writeTum(path("trajectory_odometry.tum"), p.odometryTrajectory());
+  files.push("trajectory_odometry.tum");
+  if (!p.referenceTrajectory().empty()) {
+    io::writeTum(path("reference.tum"), p.referenceTrajectory());
+    files.push("reference.tum");
+  }
+
+  const auto posed = p.posedKeyframes();
+  const auto pts = io::mapPoints(posed, o.map.point_decimation);
+  if (o.output.write_ply_binary) { io::writePly(path("map.ply"), pts, io::PlyEncoding::BinaryLittleEndian); files.push("map.ply"); }
+  if (o.output.write_ply_ascii) { io::writePly(path("map_ascii.ply"), pts, io::PlyEncoding::Ascii); files.push("map_ascii.ply"); }
+  if (o.output.write_pcd) { io::writePcd(path("map.pcd"), pts); files.push("map.pcd"); }
+  if (o.output.write_xyz) { io::writeXyz(path("map.xyz"), pts); files.push("map.xyz"); }
+  if (o.output.write_simplemap) { io::writeSimpleMap(path("map.simplemap"), posed); files.push("map.simplemap"); }
+  Json grid = Json::object();
+  if (o.output.write_grid && !posed.empty()) {
+    io::OccupancyGridOptions g;
+    g.resolution_m = o.map.grid_resolution_m;
+    const auto [w, h] = io::writeOccupancyGrid(path("grid"), posed, g);
+    grid["width"] = w;
+    grid["height"] = h;
+    grid["resolution_m"] = g.resolution_m;
+    files.push("grid.png");
+    files.push("grid.yaml");
+  }
+
+  const PipelineStats& s = p.stats();
+  Json j = Json::object();
+  j["input"] = info.input_path;
+  j["input_format"] = info.input_format;
+  j["ini"] = info.ini_path;
+  j["estimator"] = "dead_reckoning";
+  Json& c = j["counts"];
+  c["measurements"] = s.measurements;
+  c["scans"] = s.scans;
+  c["scans_used"] = s.scans_used;
+  c["odometry"] = s.odometry;
+  c["drive"] = s.drive;
+  c["images"] = s.images;
+  c["gps"] = s.gps;
+  c["reference_poses"] = s.reference;
+  c["keyframes"] = p.keyframes().size();
+  c["map_points"] = pts.size();
+  Json& t = j["timing"];
+  const double duration = s.last_timestamp - s.first_timestamp;
+  t["wall_s"] = s.wall_s;
+  t["log_duration_s"] = duration;
+  t["real_time_factor"] = s.wall_s > 0 ? duration / s.wall_s : 0.0;
+  t["step_ms_p50"] = common::percentile(s.step_ms, 50);
+  t["step_ms_p99"] = common::percentile(s.step_ms, 99);
+  t["step_ms_max"] = common::percentile(s.step_ms, 100);
+  t["outputs_s"] = sw.seconds();
+  t["peak_rss_mb"] = static_cast<double>(common::peakResidentBytes()) / (1024.0 * 1024.0);
+  if (grid.size() > 0) j["grid"] = grid;
+  j["files"] = files;
+  {
+    PipelineOptions copy = o;
+    common::OptionsSchema schema;
+    declareOptions(schema, copy);
+    j["config"] = schema.toJson();
+  }
+  common::AtomicFile f(path("stats.json"));
+  f.stream() << j.dump(2) << "\n";
+  f.commit();
+  return j;
+}
+
+}  // namespace urbanslam::slam

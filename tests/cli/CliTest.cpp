@@ -1,0 +1,84 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "CliRunner.h"
+
+using namespace urbanslam::test;
+namespace fs = std::filesystem;
+
+TEST(Cli, EverySubcommandHasHelp) {
+  const CliResult top = runCli("--help");
+  EXPECT_EQ(top.code, 0);
+  for (const char* cmd : {"run", "convert", "check-ini"}) {
+    EXPECT_NE(top.out.find(cmd), std::string::npos) << cmd;
+    const CliResult r = runCli(std::string(cmd) + " --help");
+    EXPECT_EQ(r.code, 0) << cmd;
+    EXPECT_EQ(r.out.rfind("usage: urbanslam " + std::string(cmd), 0), 0u) << r.out;
+  }
+  EXPECT_EQ(runCli("no-such-command").code, 2);
+  EXPECT_EQ(runCli("run --no-such-option").code, 2);
+}
+
+TEST(Cli, EveryShippedIniLoads) {
+  size_t n = 0;
+  for (const auto& e : fs::directory_iterator(repoPath("ini"))) {
+    if (e.path().extension() != ".ini") continue;
+    const CliResult r = runCli("check-ini " + e.path().string());
+    EXPECT_EQ(r.code, 0) << e.path() << ": " << r.err;
+    ++n;
+  }
+  EXPECT_GE(n, 1u);
+}
+
+// default.ini documents every key the program knows, with the built-in defaults.
+TEST(Cli, DefaultIniListsEveryKey) {
+  const CliResult r = runCli("check-ini " + repoPath("ini/default.ini"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string ini = slurp(repoPath("ini/default.ini"));
+  std::istringstream resolved(r.out);
+  std::string line;
+  size_t keys = 0;
+  while (std::getline(resolved, line)) {
+    const auto eq = line.find(" = ");
+    if (line.empty() || line[0] == '/' || line[0] == '[' || eq == std::string::npos) continue;
+    const std::string key = line.substr(0, eq);
+    EXPECT_NE(ini.find("\n" + key + " "), std::string::npos) << "ini/default.ini lacks " << key;
+    ++keys;
+  }
+  EXPECT_GE(keys, 10u);
+}
+
+TEST(Cli, RunOnTheShippedRawlogWritesEveryOutput) {
+  const fs::path out = scratchDir("cli_run");
+  const CliResult r = runCli("run --quiet --json --out " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  // --json: exactly one JSON object on stdout.
+  ASSERT_FALSE(r.out.empty());
+  EXPECT_EQ(r.out.front(), '{');
+  EXPECT_EQ(r.out.find('\n'), r.out.size() - 1);
+  EXPECT_NE(r.out.find("\"keyframes\":"), std::string::npos);
+  for (const char* f : {"trajectory_keyframes.tum", "trajectory_odometry.tum", "reference.tum", "map.ply", "map.pcd",
+                        "map.simplemap", "grid.png", "grid.yaml", "config.ini", "stats.json"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+  // No temporary files left behind.
+  for (const auto& e : fs::directory_iterator(out))
+    EXPECT_EQ(e.path().filename().string().find(".partial-"), std::string::npos) << e.path();
+  // The resolved config written beside the outputs is itself a valid ini.
+  EXPECT_EQ(runCli("check-ini " + (out / "config.ini").string()).code, 0);
+  // Same input, same output (no hidden state, no time-dependent behaviour).
+  const fs::path out2 = scratchDir("cli_run2");
+  ASSERT_EQ(runCli("run --quiet --out " + out2.string()).code, 0);
+  EXPECT_EQ(slurp((out / "trajectory_keyframes.tum").string()), slurp((out2 / "trajectory_keyframes.tum").string()));
+}
+
+TEST(Cli, ConvertWritesARawlogThatRunsTheSame) {
+  const fs::path d = scratchDir("cli_convert");
+  const std::string rawlog = (d / "x.rawlog").string();
+  const CliResult c = runCli("convert --quiet --json " + repoPath("rawlogs/intel-corrected-excerpt.log.gz") + " " + rawlog);
+  ASSERT_EQ(c.code, 0) << c.err;
+  EXPECT_NE(c.out.find("\"scans\":80"), std::string::npos) << c.out;
+  ASSERT_EQ(runCli("run --quiet --out " + (d / "a").string() + " " + repoPath("rawlogs/intel-corrected-excerpt.log.gz")).code, 0);
+  ASSERT_EQ(runCli("run --quiet --out " + (d / "b").string() + " " + rawlog).code, 0);
+  EXPECT_EQ(slurp((d / "a" / "trajectory_keyframes.tum").string()), slurp((d / "b" / "trajectory_keyframes.tum").string()));
+}

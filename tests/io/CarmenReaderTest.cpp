@@ -1,0 +1,185 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <zlib.h>
+
+#include "TestPaths.h"
+#include "urbanslam/common/Error.h"
+#include "urbanslam/io/CarmenReader.h"
+#include "urbanslam/io/DataSource.h"
+
+using namespace urbanslam;
+using common::Pose2;
+
+namespace {
+
+const std::string kExcerpt = test::repoPath("rawlogs/intel-corrected-excerpt.log.gz");
+
+std::vector<std::string> gzLines(const std::string& path) {
+  gzFile f = gzopen(path.c_str(), "rb");
+  std::vector<std::string> lines;
+  char buf[1 << 16];
+  while (gzgets(f, buf, sizeof buf)) {
+    std::string s(buf);
+    while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
+    lines.push_back(s);
+  }
+  gzclose(f);
+  return lines;
+}
+
+std::vector<std::string> split(const std::string& s) {
+  std::istringstream is(s);
+  std::vector<std::string> f;
+  std::string t;
+  while (is >> t) f.push_back(t);
+  return f;
+}
+
+struct ReadBack {
+  std::vector<io::LaserScan> scans;
+  std::vector<io::OdometryReading> odometry;
+  std::vector<io::ReferencePose> reference;
+  std::vector<Pose2> raw_at_scan;  // latest odometry when each scan arrived
+};
+
+ReadBack readAll(io::DataSource& src) {
+  ReadBack r;
+  io::Measurement m;
+  while (src.next(m)) {
+    if (auto* s = std::get_if<io::LaserScan>(&m)) {
+      r.scans.push_back(*s);
+      r.raw_at_scan.push_back(r.odometry.empty() ? Pose2{} : r.odometry.back().pose);
+    } else if (auto* o = std::get_if<io::OdometryReading>(&m)) {
+      r.odometry.push_back(*o);
+    } else if (auto* p = std::get_if<io::ReferencePose>(&m)) {
+      r.reference.push_back(*p);
+    }
+  }
+  return r;
+}
+
+std::string writeText(const std::string& name, const std::string& text) {
+  const auto p = test::scratchDir("carmen_" + name) / (name + ".log");
+  std::ofstream(p) << text;
+  return p.string();
+}
+
+std::string flaser(int n, const std::string& range_value, double ts) {
+  std::ostringstream os;
+  os << "FLASER " << n;
+  for (int i = 0; i < n; ++i) os << " " << (i == n / 2 ? range_value : "2.5");
+  os << " 0 0 0 0 0 0 " << ts << " host " << ts << "\n";
+  return os.str();
+}
+
+}  // namespace
+
+TEST(CarmenReader, CorrectedLogGivesScansReferenceAndTimestamps) {
+  io::CarmenReader reader(kExcerpt);
+  EXPECT_TRUE(reader.info().corrected);
+  const ReadBack r = readAll(reader);
+  ASSERT_EQ(r.scans.size(), 80u);
+  ASSERT_EQ(r.reference.size(), 80u);
+  // First FLASER of the Intel corrected log: 180 beams over 180° at 1°, timestamp 32.9068.
+  EXPECT_EQ(r.scans[0].ranges.size(), 180u);
+  EXPECT_NEAR(r.scans[0].timestamp, 32.9068, 1e-9);
+  EXPECT_NEAR(r.scans[0].angle_increment_rad, M_PI / 180, 1e-12);
+  EXPECT_NEAR(r.scans[0].sensor_pose.phi + r.scans[0].bearing(0), -M_PI / 2, 1e-12);   // first beam to the right
+  EXPECT_NEAR(r.scans[0].sensor_pose.phi + r.scans[0].bearing(179), 89 * M_PI / 180, 1e-12);
+  EXPECT_NEAR(r.reference[0].pose.x, 0.600266, 1e-9);
+  EXPECT_NEAR(r.reference[0].pose.phi, -0.354665, 1e-9);
+  // 81.83 m no-returns are invalid, real returns valid.
+  EXPECT_GT(r.scans[0].validCount(), 100u);
+  for (size_t i = 0; i < r.scans[0].size(); ++i)
+    if (r.scans[0].ranges[i] > 80) {
+      EXPECT_FALSE(r.scans[0].valid[i]);
+    }
+}
+
+// The raw odometry between two scans must equal the log's own increments inside the segment:
+// from the anchor ODOM (the corrected pose of scan k) to the last ODOM before scan k+1.
+TEST(CarmenReader, RawOdometryMatchesSegmentIncrements) {
+  io::CarmenReader reader(kExcerpt);
+  const ReadBack r = readAll(reader);
+  // Independent parse of the text: anchor and last ODOM per segment.
+  std::vector<Pose2> anchors, ends;
+  bool after_flaser = false;
+  Pose2 last{};
+  for (const auto& line : gzLines(kExcerpt)) {
+    const auto f = split(line);
+    if (f.empty()) continue;
+    if (f[0] == "FLASER") {
+      ends.push_back(last);
+      after_flaser = true;
+      continue;
+    }
+    if (f[0] == "ODOM") {
+      const Pose2 p{std::stod(f[1]), std::stod(f[2]), std::stod(f[3])};
+      if (after_flaser) anchors.push_back(p);
+      last = p;
+    }
+    after_flaser = false;
+  }
+  ASSERT_EQ(ends.size(), r.scans.size());
+  size_t checked = 0;
+  double largest_gap = 0;
+  for (size_t k = 0; k + 1 < r.scans.size(); ++k) {
+    const Pose2 expected = common::between(anchors[k], ends[k + 1]);
+    const Pose2 got = common::between(r.raw_at_scan[k], r.raw_at_scan[k + 1]);
+    EXPECT_NEAR(got.x, expected.x, 1e-9) << "scan " << k;
+    EXPECT_NEAR(got.y, expected.y, 1e-9) << "scan " << k;
+    EXPECT_NEAR(common::wrapToPi(got.phi - expected.phi), 0, 1e-9) << "scan " << k;
+    // Raw odometry must differ from the corrected poses (it is not fed the corrections).
+    const Pose2 corr = common::between(r.reference[k].pose, r.reference[k + 1].pose);
+    largest_gap = std::max(largest_gap, std::abs(common::wrapToPi(corr.phi - got.phi)));
+    ++checked;
+  }
+  EXPECT_EQ(checked, 79u);
+  EXPECT_GT(largest_gap, 1e-3);
+}
+
+TEST(CarmenReader, BadInputIsAClearError) {
+  const auto expectError = [](const std::string& path, const std::string& fragment) {
+    try {
+      io::CarmenReader reader(path);
+      io::Measurement m;
+      while (reader.next(m)) {
+      }
+      ADD_FAILURE() << "no error for " << path;
+    } catch (const common::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+  };
+  expectError(writeText("nan", flaser(5, "nan", 1.0)), "NaN");
+  expectError(writeText("neg", flaser(5, "-1.0", 1.0)), "negative range");
+  expectError(writeText("trunc", "FLASER 5 1 2 3\n"), ":1: truncated laser line");
+  expectError(writeText("count", "FLASER x 1 2\n"), "beam count");
+  expectError(writeText("odom", "ODOM 1 2\n"), "truncated ODOM line");
+  EXPECT_THROW(io::CarmenReader("/nonexistent.log"), common::InputError);
+}
+
+TEST(CarmenReader, LogWithoutOdomLinesUsesTheLaserOdometryFields) {
+  const std::string text = "# raw log\n" + flaser(3, "1.0", 10.0) + flaser(3, "1.0", 11.0);
+  io::CarmenReader reader(writeText("noodom", text));
+  EXPECT_FALSE(reader.info().corrected);
+  const ReadBack r = readAll(reader);
+  EXPECT_EQ(r.scans.size(), 2u);
+  EXPECT_EQ(r.odometry.size(), 2u);
+  EXPECT_TRUE(r.reference.empty());
+  EXPECT_EQ(r.scans[1].timestamp, 11.0);
+}
+
+TEST(CarmenReader, FreiburgCorrectedLogsFromSharedData) {
+  const std::string fr079 = test::sharedDataPath("freiburg_slam_benchmark/corrected_logs/freiburg-079-corrected.log.gz");
+  if (fr079.empty()) GTEST_SKIP() << "../shared/data (Freiburg corrected logs) not present";
+  io::CarmenReader reader(fr079);
+  const ReadBack r = readAll(reader);
+  EXPECT_TRUE(reader.info().corrected);
+  EXPECT_EQ(r.scans.size(), 4791u);
+  EXPECT_EQ(r.reference.size(), 4791u);
+  EXPECT_EQ(r.scans[0].ranges.size(), 360u);
+  EXPECT_NEAR(r.scans[0].angle_increment_rad, 0.5 * M_PI / 180, 1e-12);
+}

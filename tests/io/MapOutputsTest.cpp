@@ -1,0 +1,150 @@
+#include <gtest/gtest.h>
+
+#include <mrpt/maps/CSimpleMap.h>
+#include <mrpt/maps/CSimplePointsMap.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+
+#include "TestPaths.h"
+#include "urbanslam/io/DataSource.h"
+#include "urbanslam/io/MapOutputs.h"
+
+using namespace urbanslam;
+
+namespace {
+
+// Scans of the Intel excerpt placed at the log's reference (corrected) poses.
+struct Excerpt {
+  std::vector<io::LaserScan> scans;
+  std::vector<io::StampedPose> reference;
+  std::vector<io::PosedScan> posed() const {
+    std::vector<io::PosedScan> out;
+    for (size_t i = 0; i < scans.size(); ++i) out.push_back({reference[i].pose, &scans[i]});
+    return out;
+  }
+};
+
+Excerpt loadExcerpt() {
+  Excerpt e;
+  auto src = io::openDataSource(test::repoPath("rawlogs/intel-corrected-excerpt.log.gz"));
+  io::Measurement m;
+  while (src->next(m)) {
+    if (auto* s = std::get_if<io::LaserScan>(&m)) e.scans.push_back(*s);
+    if (auto* r = std::get_if<io::ReferencePose>(&m)) e.reference.push_back({r->timestamp, r->pose});
+  }
+  return e;
+}
+
+}  // namespace
+
+// Median distance from the points of scan k+step to the nearest point of scan k, both placed at
+// the reference poses.
+double medianOverlapDistance(const Excerpt& e, size_t step) {
+  std::vector<double> nn;
+  for (size_t k = 0; k + step < e.scans.size(); k += 4) {
+    const auto a = io::mapPoints({{e.reference[k].pose, &e.scans[k]}});
+    const auto b = io::mapPoints({{e.reference[k + step].pose, &e.scans[k + step]}});
+    for (size_t i = 0; i < b.size(); i += 5) {
+      double best = 1e9;
+      for (const auto& p : a) best = std::min<double>(best, std::hypot(p.x - b[i].x, p.y - b[i].y));
+      nn.push_back(best);
+    }
+  }
+  std::sort(nn.begin(), nn.end());
+  return nn[nn.size() / 2];
+}
+
+// The beam geometry (start angle, resolution, direction) is right when scans placed at the
+// reference poses land on the same walls; carmen2rawlog's 90° field of view smears them apart.
+TEST(MapOutputs, ScansAtReferencePosesOverlap) {
+  Excerpt e = loadExcerpt();
+  const double right = medianOverlapDistance(e, 2);
+  EXPECT_LT(right, 0.08);
+  for (auto& s : e.scans) {
+    s.angle_increment_rad /= 2;
+    s.angle_min_rad /= 2;
+  }
+  const double wrong = medianOverlapDistance(e, 2);
+  EXPECT_GT(wrong, 2 * right) << "the overlap measure cannot tell a wrong field of view: " << wrong;
+  RecordProperty("median_right_m", std::to_string(right));
+  RecordProperty("median_wrong_m", std::to_string(wrong));
+}
+
+TEST(MapOutputs, PlyReadBackByMrpt) {
+  const Excerpt e = loadExcerpt();
+  const auto pts = io::mapPoints(e.posed());
+  ASSERT_GT(pts.size(), 5000u);
+  const auto d = test::scratchDir("ply");
+  for (auto enc : {io::PlyEncoding::BinaryLittleEndian, io::PlyEncoding::Ascii}) {
+    const std::string f = (d / (enc == io::PlyEncoding::Ascii ? "a.ply" : "b.ply")).string();
+    io::writePly(f, pts, enc);
+    mrpt::maps::CSimplePointsMap m;
+    ASSERT_TRUE(m.loadFromPlyFile(f));
+    ASSERT_EQ(m.size(), pts.size());
+    for (size_t i = 0; i < pts.size(); i += 97) {
+      float x, y, z;
+      m.getPoint(i, x, y, z);
+      EXPECT_NEAR(x, pts[i].x, 1e-3);
+      EXPECT_NEAR(y, pts[i].y, 1e-3);
+    }
+  }
+}
+
+TEST(MapOutputs, PcdAndXyzHaveOneLinePerPoint) {
+  const Excerpt e = loadExcerpt();
+  const auto pts = io::mapPoints(e.posed(), 3);
+  const auto d = test::scratchDir("pcd");
+  io::writePcd((d / "m.pcd").string(), pts);
+  io::writeXyz((d / "m.xyz").string(), pts);
+  std::ifstream pcd(d / "m.pcd");
+  std::string line;
+  size_t declared = 0, data = 0;
+  bool in_data = false;
+  while (std::getline(pcd, line)) {
+    if (in_data) ++data;
+    else if (line.rfind("POINTS ", 0) == 0) declared = std::stoul(line.substr(7));
+    else if (line == "DATA ascii") in_data = true;
+  }
+  EXPECT_EQ(declared, pts.size());
+  EXPECT_EQ(data, pts.size());
+  std::ifstream xyz(d / "m.xyz");
+  size_t n = 0;
+  double x, y, z;
+  while (xyz >> x >> y >> z) ++n;
+  EXPECT_EQ(n, pts.size());
+}
+
+TEST(MapOutputs, SimpleMapLoadsInMrpt) {
+  const Excerpt e = loadExcerpt();
+  const auto d = test::scratchDir("simplemap");
+  io::writeSimpleMap((d / "m.simplemap").string(), e.posed());
+  mrpt::maps::CSimpleMap sm;
+  ASSERT_TRUE(sm.loadFromFile((d / "m.simplemap").string()));
+  ASSERT_EQ(sm.size(), e.scans.size());
+  const auto& [pose, sf] = sm.get(10);
+  EXPECT_NEAR(pose->getMeanVal().x(), e.reference[10].pose.x, 1e-9);
+  EXPECT_EQ(sf->size(), 1u);
+}
+
+TEST(MapOutputs, TumRoundTripAndGridYaml) {
+  const Excerpt e = loadExcerpt();
+  const auto d = test::scratchDir("tum");
+  io::writeTum((d / "t.tum").string(), e.reference);
+  const auto back = io::readTum((d / "t.tum").string());
+  ASSERT_EQ(back.size(), e.reference.size());
+  for (size_t i = 0; i < back.size(); ++i) {
+    EXPECT_NEAR(back[i].timestamp, e.reference[i].timestamp, 1e-6);
+    EXPECT_NEAR(back[i].pose.x, e.reference[i].pose.x, 1e-6);
+    EXPECT_NEAR(common::wrapToPi(back[i].pose.phi - e.reference[i].pose.phi), 0, 1e-8);
+  }
+  const auto [w, h] = io::writeOccupancyGrid((d / "grid").string(), e.posed(), {});
+  EXPECT_GT(w, 100);
+  EXPECT_GT(h, 100);
+  std::ifstream yaml(d / "grid.yaml");
+  std::string all((std::istreambuf_iterator<char>(yaml)), {});
+  EXPECT_NE(all.find("image: grid.png"), std::string::npos);
+  EXPECT_NE(all.find("resolution: 0.05"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(d / "grid.png"));
+}

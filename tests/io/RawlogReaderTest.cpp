@@ -1,0 +1,85 @@
+// MRPT's own rawlogs (package mrpt-common) as independent references.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "TestPaths.h"
+#include "urbanslam/common/Error.h"
+#include "urbanslam/io/DataSource.h"
+#include "urbanslam/io/RawlogReader.h"
+
+using namespace urbanslam;
+
+namespace {
+const std::string kSena = "/usr/share/mrpt/datasets/2006-01ENE-21-SENA_Telecom Faculty_one_loop_only.rawlog";
+}
+
+// The classic act/SF rawlog starts with a frame that has no action before it; MRPT's pair
+// iterator drops it (224 scans), RawLogViewer shows 225. Odometry path: 76.35 m (RawLogViewer).
+TEST(RawlogReader, SensoryFrameRawlogKeepsTheLeadingFrame) {
+  if (!std::filesystem::exists(kSena)) GTEST_SKIP() << kSena << " not installed (package mrpt-common)";
+  io::RawlogReader reader(kSena);
+  io::Measurement m;
+  size_t scans = 0, odo = 0;
+  double path = 0;
+  common::Pose2 last;
+  bool have = false;
+  while (reader.next(m)) {
+    if (auto* s = std::get_if<io::LaserScan>(&m)) {
+      ++scans;
+      EXPECT_EQ(s->size(), 361u);
+      EXPECT_NEAR(s->sensor_pose.x, 0.78, 1e-6);
+    }
+    if (auto* o = std::get_if<io::OdometryReading>(&m)) {
+      ++odo;
+      if (have) path += std::hypot(o->pose.x - last.x, o->pose.y - last.y);
+      else path += std::hypot(o->pose.x, o->pose.y);  // first increment from the origin
+      last = o->pose;
+      have = true;
+    }
+  }
+  EXPECT_EQ(scans, 225u);
+  EXPECT_EQ(odo, 224u);
+  EXPECT_NEAR(path, 76.35, 0.01);
+  EXPECT_EQ(reader.format(), "MRPT rawlog (actions/sensory frames)");
+}
+
+TEST(RawlogReader, CorruptAndTruncatedFilesAreClearErrors) {
+  const auto d = test::scratchDir("rawlog_bad");
+  const std::string src = test::repoPath("rawlogs/intel.rawlog");
+  // Truncated: the first 40% of the gzip stream.
+  {
+    std::ifstream in(src, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), {});
+    std::ofstream(d / "trunc.rawlog", std::ios::binary) << bytes.substr(0, bytes.size() * 4 / 10);
+  }
+  try {
+    auto r = io::openDataSource((d / "trunc.rawlog").string());
+    io::Measurement m;
+    while (r->next(m)) {
+    }
+    FAIL() << "no error on a truncated rawlog";
+  } catch (const common::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("trunc"), std::string::npos) << e.what();
+  }
+  // Binary garbage is not a rawlog.
+  {
+    std::ofstream f(d / "garbage.rawlog", std::ios::binary);
+    for (int i = 0; i < 4096; ++i) f.put(static_cast<char>((i * 7919) % 256));
+  }
+  EXPECT_THROW(
+      {
+        auto r = io::openDataSource((d / "garbage.rawlog").string());
+        io::Measurement m;
+        while (r->next(m)) {
+        }
+      },
+      common::InputError);
+  std::ofstream(d / "text.txt") << "hello, I am not a log\n";
+  EXPECT_THROW(io::openDataSource((d / "text.txt").string()), common::InputError);
+  std::ofstream(d / "empty.rawlog") << "";
+  EXPECT_THROW(io::openDataSource((d / "empty.rawlog").string()), common::InputError);
+  EXPECT_THROW(io::openDataSource((d / "missing.rawlog").string()), common::InputError);
+}
