@@ -1,0 +1,58 @@
+#pragma once
+// The one alignment call that the pipeline (loop closures, laser odometry) and `urbanslam align`
+// use: scan B aligned onto scan A, i.e. the pose of B seen from A (common::between(pose_A,
+// pose_B)), with its covariance, starting from a guess in the same convention.
+//
+// Methods: "icp" (point-to-point, thesis §3.3.1), "plicp" (point-to-line), "crf" (CRF-match,
+// §3.3.2) and "crf+icp" (CRF-match for the coarse alignment, ICP to refine, as in the thesis).
+// Failures (too few points, NaN input, no agreement, degenerate geometry such as a corridor) come
+// back with converged = false and a failure_reason; the transform is then the best available
+// estimate (the guess when nothing could be computed) and must not be used as a measurement.
+#include <string>
+
+#include <Eigen/Core>
+
+#include "urbanslam/alignment/AlignmentCovariance.h"
+#include "urbanslam/alignment/CrfMatch.h"
+#include "urbanslam/alignment/Icp.h"
+#include "urbanslam/alignment/ScanModel.h"
+#include "urbanslam/io/LaserScan.h"
+
+namespace urbanslam::alignment {
+
+enum class Method { Icp, PlIcp, Crf, CrfIcp };
+
+struct AlignerOptions {
+  Method method = Method::CrfIcp;
+  ScanModelOptions scan;
+  IcpOptions icp;
+  bool refine_point_to_line = true;   // crf+icp refines with PL-ICP (else point-to-point ICP)
+  CrfOptions crf;
+  CovarianceOptions covariance;
+  double min_constraint_ratio = 0.01; // below: the geometry leaves a direction free (degenerate)
+  bool in_vehicle_frame = true;       // LaserScan input: apply sensor_pose (vehicle relative pose)
+};
+
+struct AlignmentResult {
+  common::Pose2 transform;                   // pose of B in A's frame
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Identity() * 1e4;  // (x, y, phi)
+  int iterations = 0;                        // ICP iterations (+ BP iterations for CRF)
+  double time_ms = 0;                        // whole call, covariance included
+  double covariance_time_ms = 0;
+  bool converged = false;
+  std::string failure_reason;                // empty when converged
+  int matches = 0;                           // associations at the final transform
+  double rms_residual_m = 0;
+  double constraint_ratio = 0;               // translationConstraintRatio at the result
+  int points_a = 0, points_b = 0;            // after the scan model's gates
+};
+
+AlignmentResult align(const io::LaserScan& a, const io::LaserScan& b, const common::Pose2& guess,
+                      const AlignerOptions& options);
+AlignmentResult alignPointSets(const PointSet& a, const PointSet& b, const common::Pose2& guess,
+                               const AlignerOptions& options);
+
+Method parseMethod(const std::string& name);  // icp | plicp | crf | crf+icp; throws invalid_argument
+std::string methodName(Method method);
+
+}  // namespace urbanslam::alignment

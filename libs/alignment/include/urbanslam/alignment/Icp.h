@@ -1,0 +1,57 @@
+#pragma once
+// Iterative closest point (thesis §3.3.1; Besl & McKay 1992): each point of the moving scan is
+// associated with its nearest neighbour in the reference scan (kd-tree), pairs farther apart
+// than a distance gate are disregarded, the closed-form 2D least-squares rotation + translation
+// of the pairs is applied, and the procedure repeats with a progressively smaller gate.
+//
+// Point-to-line ICP (Censi 2008) is the same loop with a different error: the distance of the
+// moving point to the reference point's local line (LineNormals.h), minimised by Gauss-Newton.
+// It converges in fewer iterations on structured scenes because sliding along walls is free.
+//
+// Both accept a robust kernel (iteratively reweighted least squares) against the pairs that the
+// gate lets through but that are still wrong (clutter, moved objects, partial overlap).
+#include "urbanslam/alignment/LineNormals.h"
+#include "urbanslam/alignment/PointSet.h"
+#include "urbanslam/alignment/Registration.h"
+
+namespace urbanslam::alignment {
+
+enum class RobustKernel { None, Huber, Cauchy };
+
+struct IcpOptions {
+  double gate_initial_m = 1.5;     // association gate of the first iterations
+  double gate_final_m = 0.2;       // smallest gate; must exceed noise + beam spacing
+  double gate_shrink = 0.6;        // gate *= this each time the estimate settles at a gate
+  int max_iterations = 60;
+  double tolerance_m = 1e-4;       // an update smaller than this (and tolerance_rad) has settled
+  double tolerance_rad = 1e-4;
+  RobustKernel kernel = RobustKernel::Cauchy;
+  double kernel_scale_m = 0.1;     // residual at which the kernel starts to discount a pair
+  int min_matches = 8;             // fewer pairs than this: no solution
+  double min_overlap = 0.25;       // fraction of moving points matched at the final gate
+  LineNormalOptions normals;       // point-to-line only
+};
+
+class NearestNeighbours;
+
+// Point-to-point ICP of `moving` onto `reference`, starting from `guess`.
+RegistrationResult icp(const PointSet& reference, const PointSet& moving, const common::Pose2& guess,
+                       const IcpOptions& options);
+
+// Point-to-line ICP.
+RegistrationResult plIcp(const PointSet& reference, const PointSet& moving,
+                         const common::Pose2& guess, const IcpOptions& options);
+
+// The shared loop, for callers that run many alignments against one reference (sampling
+// covariance): a prebuilt index and normals (empty normals = point-to-point).
+RegistrationResult icpWithIndex(const PointSet& reference, const NearestNeighbours& index,
+                                const std::vector<LineNormal>& normals, const PointSet& moving,
+                                const common::Pose2& guess, const IcpOptions& options);
+
+// Closed-form weighted least-squares rigid transform mapping src[i] onto dst[i] (Arun/Umeyama in
+// 2D). Returns false when the total weight is zero or there are fewer than two pairs.
+bool leastSquaresTransform(const std::vector<Eigen::Vector2d>& src,
+                           const std::vector<Eigen::Vector2d>& dst, const std::vector<double>& weights,
+                           common::Pose2* transform);
+
+}  // namespace urbanslam::alignment

@@ -1,0 +1,31 @@
+#pragma once
+// Nearest-neighbour queries over a 2D point set through a nanoflann kd-tree (the one MRPT ships).
+// nanoflann stays behind a pimpl so that only this module needs its include path.
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace urbanslam::alignment {
+
+class NearestNeighbours {
+ public:
+  explicit NearestNeighbours(std::vector<Eigen::Vector2d> points);
+  ~NearestNeighbours();
+  NearestNeighbours(const NearestNeighbours&) = delete;
+  NearestNeighbours& operator=(const NearestNeighbours&) = delete;
+
+  size_t size() const;
+  // Index of the nearest point and its squared distance; false when the set is empty.
+  bool nearest(const Eigen::Vector2d& query, int* index, double* distance_sq) const;
+  // Up to k nearest, closest first.
+  size_t knn(const Eigen::Vector2d& query, size_t k, std::vector<int>* indices,
+             std::vector<double>* distances_sq) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace urbanslam::alignment

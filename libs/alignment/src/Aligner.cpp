@@ -1,0 +1,115 @@
+#include "urbanslam/alignment/Aligner.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "urbanslam/common/Timing.h"
+
+namespace urbanslam::alignment {
+
+using common::Pose2;
+
+AlignmentResult align(const io::LaserScan& a, const io::LaserScan& b, const Pose2& guess,
+                      const AlignerOptions& options) {
+  common::Stopwatch sw;
+  const PointSet pa = pointSetFromScan(a, options.scan, options.in_vehicle_frame);
+  const PointSet pb = pointSetFromScan(b, options.scan, options.in_vehicle_frame);
+  AlignmentResult r = alignPointSets(pa, pb, guess, options);
+  r.time_ms = sw.milliseconds();
+  return r;
+}
+
+AlignmentResult alignPointSets(const PointSet& a, const PointSet& b, const Pose2& guess,
+                               const AlignerOptions& options) {
+  common::Stopwatch sw;
+  AlignmentResult out;
+  out.transform = guess;
+  out.points_a = static_cast<int>(a.size());
+  out.points_b = static_cast<int>(b.size());
+  const Eigen::Matrix3d large =
+      Eigen::Vector3d(options.covariance.max_std_m * options.covariance.max_std_m,
+                      options.covariance.max_std_m * options.covariance.max_std_m,
+                      options.covariance.max_std_rad * options.covariance.max_std_rad)
+          .asDiagonal();
+  out.cov = large;
+  if (!std::isfinite(guess.x) || !std::isfinite(guess.y) || !std::isfinite(guess.phi)) {
+    out.transform = Pose2{};
+    out.failure_reason = "initial guess is not finite";
+    out.time_ms = sw.milliseconds();
+    return out;
+  }
+
+  RegistrationResult reg;
+  bool point_to_line = false;
+  switch (options.method) {
+    case Method::Icp: reg = icp(a, b, guess, options.icp); break;
+    case Method::PlIcp:
+      point_to_line = true;
+      reg = plIcp(a, b, guess, options.icp);
+      break;
+    case Method::Crf: reg = crfMatch(a, b, guess, options.crf); break;
+    case Method::CrfIcp: {
+      const RegistrationResult coarse = crfMatch(a, b, guess, options.crf);
+      // Without a CRF answer the refinement still starts from the caller's guess: for laser
+      // odometry that guess is good, and a converged ICP is still a valid result.
+      const Pose2 start = coarse.converged ? coarse.transform : guess;
+      point_to_line = options.refine_point_to_line;
+      reg = point_to_line ? plIcp(a, b, start, options.icp) : icp(a, b, start, options.icp);
+      reg.iterations += coarse.iterations;
+      if (!coarse.converged && !reg.converged)
+        reg.failure_reason = "CRF-match: " + coarse.failure_reason + "; ICP: " + reg.failure_reason;
+      break;
+    }
+  }
+  out.transform = reg.transform;
+  out.iterations = reg.iterations;
+  out.converged = reg.converged;
+  out.failure_reason = reg.failure_reason;
+  out.matches = static_cast<int>(reg.matches.size());
+  out.rms_residual_m = reg.rms_residual_m;
+
+  if (reg.converged) {
+    common::Stopwatch csw;
+    out.cov = alignmentCovariance(a, b, reg.transform, options.icp, point_to_line, options.covariance);
+    out.constraint_ratio = translationConstraintRatio(a, b, reg.transform, options.covariance);
+    out.covariance_time_ms = csw.milliseconds();
+    if (out.constraint_ratio < options.min_constraint_ratio) {
+      std::ostringstream os;
+      os << "degenerate geometry: the scans hardly constrain one direction of translation "
+            "(constraint ratio "
+         << out.constraint_ratio << " < " << options.min_constraint_ratio << ", e.g. a corridor)";
+      out.converged = false;
+      out.failure_reason = os.str();
+    }
+  }
+  if (!out.cov.allFinite()) {
+    out.cov = large;
+    if (out.converged) {
+      out.converged = false;
+      out.failure_reason = "covariance is not finite";
+    }
+  }
+  out.time_ms = sw.milliseconds();
+  return out;
+}
+
+Method parseMethod(const std::string& name) {
+  if (name == "icp") return Method::Icp;
+  if (name == "plicp" || name == "pl-icp") return Method::PlIcp;
+  if (name == "crf") return Method::Crf;
+  if (name == "crf+icp" || name == "crficp") return Method::CrfIcp;
+  throw std::invalid_argument("unknown alignment method '" + name + "' (icp, plicp, crf, crf+icp)");
+}
+
+std::string methodName(Method method) {
+  switch (method) {
+    case Method::Icp: return "icp";
+    case Method::PlIcp: return "plicp";
+    case Method::Crf: return "crf";
+    case Method::CrfIcp: return "crf+icp";
+  }
+  return "?";
+}
+
+}  // namespace urbanslam::alignment

@@ -1,0 +1,93 @@
+#include "urbanslam/alignment/LineNormals.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+
+namespace urbanslam::alignment {
+
+namespace {
+
+// Running sums of a 2D point set: mean, scatter and the principal line in O(1) per update.
+struct LineSums {
+  int n = 0;
+  double sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
+  void add(const Eigen::Vector2d& p) {
+    ++n;
+    sx += p.x();
+    sy += p.y();
+    sxx += p.x() * p.x();
+    sxy += p.x() * p.y();
+    syy += p.y() * p.y();
+  }
+  Eigen::Vector2d mean() const { return Eigen::Vector2d(sx, sy) / n; }
+  // Normal (eigenvector of the smallest eigenvalue), smallest and largest eigenvalue.
+  void fit(Eigen::Vector2d* normal, double* lmin, double* lmax) const {
+    const Eigen::Vector2d m = mean();
+    Eigen::Matrix2d C;
+    C << sxx / n - m.x() * m.x(), sxy / n - m.x() * m.y(), sxy / n - m.x() * m.y(), syy / n - m.y() * m.y();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(C);
+    *normal = es.eigenvectors().col(0).normalized();
+    *lmin = std::max(0.0, es.eigenvalues()(0));
+    *lmax = std::max(0.0, es.eigenvalues()(1));
+  }
+};
+
+bool adjacent(const ScanPoint& a, const ScanPoint& b, const LineNormalOptions& o) {
+  const double d = (a.p - b.p).norm();
+  if (d < o.max_gap_m) return true;
+  return std::abs(a.beam - b.beam) == 1 &&
+         d < o.max_gap_range_fraction * std::max(a.range_m, b.range_m);
+}
+
+}  // namespace
+
+std::vector<LineNormal> computeLineNormals(const PointSet& points, const LineNormalOptions& options) {
+  const int n = static_cast<int>(points.size());
+  std::vector<LineNormal> out(points.size());
+  int piece = 0;
+  for (int i = 0; i < n;) {
+    LineSums s;
+    s.add(points[i].p);
+    int j = i + 1;
+    Eigen::Vector2d normal(0, 1);
+    double lmin = 0, lmax = 0;
+    for (; j < n; ++j) {
+      if (!adjacent(points[j - 1], points[j], options)) break;
+      if (s.n >= 2) {
+        // The candidate must lie near the current line, and the line refitted with it must
+        // stay thin: the first stops at corners, the second at slow bends.
+        s.fit(&normal, &lmin, &lmax);
+        if (std::abs(normal.dot(points[j].p - s.mean())) > options.line_tolerance_m) break;
+        LineSums t = s;
+        t.add(points[j].p);
+        double tmin = 0, tmax = 0;
+        Eigen::Vector2d tn;
+        t.fit(&tn, &tmin, &tmax);
+        if (std::sqrt(tmin) > 0.5 * options.line_tolerance_m) break;
+      }
+      s.add(points[j].p);
+    }
+    // Piece [i, j).
+    if (s.n >= options.min_points) {
+      s.fit(&normal, &lmin, &lmax);
+      const double length = (points[j - 1].p - points[i].p).norm();
+      if (length >= options.min_length_m) {
+        for (int k = i; k < j; ++k) {
+          out[k].n = normal;
+          out[k].residual_var_m2 = lmin;
+          out[k].piece = piece;
+          out[k].valid = true;
+        }
+        ++piece;
+      }
+    }
+    // A piece broken by a corner restarts at the breaking point; one that would not grow at all
+    // (isolated point) moves on by one.
+    i = j;
+  }
+  return out;
+}
+
+}  // namespace urbanslam::alignment
