@@ -1,0 +1,167 @@
+#pragma once
+// The Exactly Sparse Delayed-state Filter (Eustice, Singh & Leonard; thesis chapter 2) over 2D
+// poses, in information form.
+//
+// * Prediction with augmentation adds the new pose and a link to the current one only: O(1).
+// * Prediction without augmentation marginalises the previous current pose (Schur complement on
+//   its neighbours), which is how a plain EKF-style filter would keep a single vehicle pose.
+// * An observation of the relative pose between any two poses adds information to their two
+//   block rows only, after an optional Mahalanobis gate.
+// * The mean is not maintained by the information form itself: recover() solves
+//   Lambda mu = eta with CHOLMOD; recoverRecent() solves for a window of recent poses with the
+//   older ones held fixed. Covariances of selected poses (and pairs) come from column solves.
+//
+// Beyond the thesis: every measurement is kept as a factor with its linearisation point, so
+// after a recovery the factors whose poses moved are re-linearised (their old contribution to
+// Lambda and eta is subtracted and a new one added) and the system re-solved. With it the
+// filter reaches the batch (Gauss-Newton) optimum after a large loop closure instead of keeping
+// the first linearisation's error.
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "urbanslam/esdf/Gating.h"
+#include "urbanslam/esdf/InformationState.h"
+#include "urbanslam/esdf/MotionModels.h"
+#include "urbanslam/esdf/Recovery.h"
+
+namespace urbanslam::esdf {
+
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+
+enum class CovarianceMode {
+  Exact,        // refactorise the current Lambda if needed, then column solves
+  Conservative  // last factorisation + dead-reckoning propagation: no refactorisation, never smaller
+};
+
+struct EsdfOptions {
+  // Diagonal of the stabilising noise Q_s (eq. 2.21) for the two-input vehicle models; as small
+  // as possible (thesis 2.2.4) while keeping Q invertible.
+  double stabilising_noise_xy_m2 = 1e-6;
+  double stabilising_noise_phi_rad2 = 1e-8;
+
+  // Innovation gate: the chi-square quantile probability (3 dof) for relative-pose observations.
+  double chi2_gate_probability = 0.999;
+  CovarianceMode gate_covariance = CovarianceMode::Exact;
+
+  // Relinearisation after a full recovery: factors whose poses moved more than these thresholds
+  // since their linearisation are re-linearised, then the system is re-solved, up to
+  // relinearise_max_passes times.
+  bool relinearise = true;
+  double relinearise_threshold_m = 1e-3;
+  double relinearise_threshold_rad = 1e-4;
+  int relinearise_max_passes = 10;
+
+  FillReducingOrdering ordering = FillReducingOrdering::Amd;
+};
+
+struct ObservationResult {
+  bool accepted = true;
+  GateResult gate;     // filled when the observation was gated
+  double chi2 = 0;     // e' Omega e of the innovation at the linearisation point
+};
+
+struct RecoveryStats {
+  int relinearise_passes = 0;
+  long long factors_relinearised = 0;
+  double seconds = 0;
+};
+
+class Esdf {
+ public:
+  explicit Esdf(EsdfOptions options = {});
+  ~Esdf();
+
+  const EsdfOptions& options() const { return options_; }
+  void reserve(int poses);
+
+  // Starts the trajectory: pose 0 with a Gaussian prior (mean, covariance).
+  int initialise(const Vec3& mean, const Mat3& covariance);
+
+  // Prediction with augmentation from the current (last) pose with a motion model: adds a pose
+  // with mean f(x_v, u) and returns its index. The filter keeps `model` for relinearisation.
+  int predictAugment(std::shared_ptr<const MotionModel> model, const VecU& u, const MatQ& q_v, double dt_s);
+  // Prediction without augmentation: the current pose is replaced by its prediction (augment,
+  // then marginalise the old current pose). The marginalised information stays linearised.
+  void predict(std::shared_ptr<const MotionModel> model, const VecU& u, const MatQ& q_v, double dt_s);
+  // Prediction with augmentation from any earlier pose `from` by a relative pose z with
+  // information omega (the laser/odometry model x ⊕ u with Q = J2⊕ Omega^-1 J2⊕'), using the
+  // g2o edge error so that pose-graph chi2 is minimised exactly.
+  int augmentRelative(int from, const Vec3& z, const Mat3& omega);
+
+  // Relative-pose observation z = ⊖x_i ⊕ x_j (+ noise with information omega), linearised at the
+  // current mean. When `gate` is true, it is first tested against the chi2 gate with the joint
+  // covariance of (x_i, x_j) (options().gate_covariance) and discarded when inconsistent.
+  ObservationResult observeRelative(int i, int j, const Vec3& z, const Mat3& omega, bool gate = false);
+  // The gate test alone (nothing is added): d^2 of the innovation at the current mean.
+  GateResult gateRelative(int i, int j, const Vec3& z, const Mat3& omega);
+
+  // Full recovery: factorise Lambda (CHOLMOD), mu = Lambda^-1 eta, then (if enabled) up to
+  // max_relinearise_passes rounds of relinearise + re-solve (-1: options().relinearise_max_passes).
+  RecoveryStats recover(int max_relinearise_passes = -1);
+  // Partial recovery of poses [first, size()) with the older poses held at their current mean.
+  void recoverRecent(int first);
+
+  // Marginal covariance of pose i and joint covariance of (x_i, x_j) (6x6, i's block first).
+  Mat3 marginalCovariance(int i, CovarianceMode mode = CovarianceMode::Exact);
+  Mat6 jointCovariance(int i, int j, CovarianceMode mode = CovarianceMode::Exact);
+
+  int size() const { return state_.size(); }
+  int currentPose() const { return state_.size() - 1; }
+  const Vec3& mean(int i) const { return state_.mean(i); }
+  const InformationState& state() const { return state_; }
+  size_t factorCount() const { return factors_.size(); }
+  long long factorNonZeros() const { return full_factor_.factorNonZeros(); }
+  size_t memoryBytes() const;
+
+  // Re-linearises every factor whose poses moved beyond the thresholds; returns their number.
+  // recover() calls it; exposed for tests and experiments.
+  long long relineariseMoved();
+
+ private:
+  struct Factor {
+    enum class Kind : std::uint8_t { Prior, Motion, Relative };
+    Kind kind;
+    int a, b;          // b = -1 for a prior
+    Vec3 z;            // prior mean, motion input u (padded), or relative measurement
+    Mat3 weight;       // prior information, Q_v (padded), or Omega
+    double dt = 0;
+    std::shared_ptr<const MotionModel> model;
+    Vec3 lin_a, lin_b;  // linearisation point
+  };
+  struct Linearisation {
+    Mat3 a_a, a_b, w;
+    Vec3 e0;
+  };
+  Linearisation linearise(const Factor& f, const Vec3& xa, const Vec3& xb) const;
+  // Adds (sign = +1) or removes (sign = -1) a factor's contribution at its linearisation point.
+  void apply(const Factor& f, double sign);
+  void addFactor(Factor f);
+  Vec3 stabilisingNoise(const MotionModel& m) const;
+  // Dead-reckoning propagation for conservative covariances (see jointCovariance).
+  void pushChain(int k, int from, const Mat3& f_x, const Mat3& q);
+  void ensureFactor();
+  Mat3 covarianceColumnsBlock(int i, Eigen::MatrixXd* columns);
+  Mat6 conservativeJoint(int i, int j);
+  void markChanged() { ++values_stamp_; }
+
+  EsdfOptions options_;
+  InformationState state_;
+  std::vector<Factor> factors_;
+  std::vector<int> first_factor_of_pose_;  // factors_.size() when the pose was created
+
+  SparseCholesky full_factor_;
+  SparseCholesky window_factor_;
+  std::uint64_t values_stamp_ = 0;          // bumped on every change of Lambda or eta
+  std::uint64_t full_factor_values_ = ~std::uint64_t{0};
+
+  // Conservative covariance support: for poses k >= chain_base_, x_k = Phi_k x_{base-1} + noise
+  // with accumulated noise C_k, valid while every such pose came from its predecessor.
+  int chain_base_ = 0;
+  std::vector<Mat3> chain_phi_, chain_cov_;
+  bool chain_valid_ = true;
+  Eigen::MatrixXd base_columns_;  // stale Sigma(:, base-1), from the last full factorisation
+};
+
+}  // namespace urbanslam::esdf

@@ -1,0 +1,44 @@
+#pragma once
+// State and covariance recovery for the information filter: a CHOLMOD (SuiteSparse) sparse
+// Cholesky factorisation of Lambda, or of the principal sub-block of a range of poses, with a
+// fill-reducing ordering (AMD). The symbolic analysis is reused while the block structure is
+// unchanged, which is the case between relinearisation passes.
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+
+#include "urbanslam/esdf/InformationState.h"
+
+namespace urbanslam::esdf {
+
+enum class FillReducingOrdering { Amd, Natural };
+
+class SparseCholesky {
+ public:
+  explicit SparseCholesky(FillReducingOrdering ordering = FillReducingOrdering::Amd);
+  ~SparseCholesky();
+  SparseCholesky(const SparseCholesky&) = delete;
+  SparseCholesky& operator=(const SparseCholesky&) = delete;
+
+  // Factorises Lambda restricted to poses [first, last). Throws std::runtime_error when the
+  // block is not positive definite (an unanchored or inconsistent problem).
+  void factorize(const InformationState& state, int first, int last);
+  bool valid() const;
+  int first() const { return first_; }
+  int last() const { return last_; }
+  // Stamp of the InformationState structure the factor was computed for.
+  std::uint64_t structureStamp() const { return stamp_; }
+
+  // Solves Lambda_sub x = b (b has 3*(last-first) rows and any number of columns).
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const;
+  // Non-zeros of the factor L (for statistics).
+  long long factorNonZeros() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  int first_ = 0, last_ = 0;
+  std::uint64_t stamp_ = ~std::uint64_t{0};
+};
+
+}  // namespace urbanslam::esdf

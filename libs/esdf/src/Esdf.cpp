@@ -1,0 +1,344 @@
+#include "urbanslam/esdf/Esdf.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <cmath>
+#include <stdexcept>
+
+#include "urbanslam/common/Timing.h"
+
+namespace urbanslam::esdf {
+
+Esdf::Esdf(EsdfOptions options)
+    : options_(options), full_factor_(options.ordering), window_factor_(options.ordering) {}
+Esdf::~Esdf() = default;
+
+void Esdf::reserve(int poses) {
+  state_.reserve(poses);
+  factors_.reserve(static_cast<size_t>(poses) * 2);
+  first_factor_of_pose_.reserve(static_cast<size_t>(poses));
+}
+
+Vec3 Esdf::stabilisingNoise(const MotionModel& m) const {
+  // Three-input models have a full-rank F_u Q_v F_u' and need no stabilisation.
+  if (m.inputDimension() >= 3) return Vec3::Zero();
+  return {options_.stabilising_noise_xy_m2, options_.stabilising_noise_xy_m2, options_.stabilising_noise_phi_rad2};
+}
+
+Esdf::Linearisation Esdf::linearise(const Factor& f, const Vec3& xa, const Vec3& xb) const {
+  Linearisation l;
+  switch (f.kind) {
+    case Factor::Kind::Prior:
+      l.e0 = poseDifference(xa, f.z);
+      l.a_a.setIdentity();
+      l.a_b.setZero();
+      l.w = f.weight;
+      break;
+    case Factor::Kind::Motion: {
+      const int dim = f.model->inputDimension();
+      Mat3 fx;
+      MatU fu;
+      const Vec3 pred = f.model->predict(xa, f.z.head(dim), f.dt, &fx, &fu);
+      // e = x_b - f(x_a, u): Lambda gets [F' W F, -F' W; -W F, W] (the ESDF augmentation).
+      l.e0 = poseDifference(xb, pred);
+      l.a_a = -fx;
+      l.a_b.setIdentity();
+      l.w = processInformation(fu, f.weight.topLeftCorner(dim, dim), stabilisingNoise(*f.model));
+      break;
+    }
+    case Factor::Kind::Relative:
+      l.e0 = relativePoseError(xa, xb, f.z);
+      relativePoseErrorJacobians(xa, xb, f.z, &l.a_a, &l.a_b);
+      l.w = f.weight;
+      break;
+  }
+  return l;
+}
+
+void Esdf::apply(const Factor& f, double sign) {
+  const Linearisation l = linearise(f, f.lin_a, f.lin_b);
+  // Linear model e(x) ~ A x - c with c = A lin - e0: Lambda += A' W A, eta += A' W c.
+  if (f.kind == Factor::Kind::Prior) {
+    const Mat3 atw = l.a_a.transpose() * l.w;
+    state_.addDiagonal(f.a, sign * atw * l.a_a);
+    state_.addEta(f.a, sign * atw * (l.a_a * f.lin_a - l.e0));
+  } else {
+    const Vec3 wc = l.w * (l.a_a * f.lin_a + l.a_b * f.lin_b - l.e0);
+    const Mat3 atw = l.a_a.transpose() * l.w, btw = l.a_b.transpose() * l.w;
+    state_.addDiagonal(f.a, sign * atw * l.a_a);
+    state_.addDiagonal(f.b, sign * btw * l.a_b);
+    state_.addBlock(f.a, f.b, sign * atw * l.a_b);
+    state_.addEta(f.a, sign * l.a_a.transpose() * wc);
+    state_.addEta(f.b, sign * l.a_b.transpose() * wc);
+  }
+  markChanged();
+}
+
+void Esdf::addFactor(Factor f) {
+  apply(f, +1.0);
+  factors_.push_back(std::move(f));
+}
+
+int Esdf::initialise(const Vec3& mean, const Mat3& covariance) {
+  if (state_.size() != 0) throw std::logic_error("Esdf::initialise called twice");
+  first_factor_of_pose_.push_back(0);
+  state_.addPose(mean);
+  Factor f{Factor::Kind::Prior, 0, -1, mean, covariance.inverse(), 0, nullptr, mean, Vec3::Zero()};
+  addFactor(std::move(f));
+  return 0;
+}
+
+void Esdf::pushChain(int k, int from, const Mat3& f_x, const Mat3& q) {
+  if (!chain_valid_) return;
+  if (from != k - 1 || k < chain_base_ || static_cast<size_t>(k - chain_base_) != chain_phi_.size()) {
+    chain_valid_ = false;
+    return;
+  }
+  if (k == chain_base_) {
+    chain_phi_.push_back(f_x);
+    chain_cov_.push_back(q);
+  } else {
+    const Mat3& phi = chain_phi_.back();
+    const Mat3& cov = chain_cov_.back();
+    chain_phi_.push_back(f_x * phi);
+    chain_cov_.push_back(f_x * cov * f_x.transpose() + q);
+  }
+}
+
+int Esdf::predictAugment(std::shared_ptr<const MotionModel> model, const VecU& u, const MatQ& q_v, double dt_s) {
+  if (state_.size() == 0) throw std::logic_error("Esdf: predict before initialise");
+  const int dim = model->inputDimension();
+  if (u.size() != dim || q_v.rows() != dim || q_v.cols() != dim)
+    throw std::invalid_argument("predictAugment: u/Q_v size does not match the model");
+  const int from = currentPose();
+  Factor f;
+  f.kind = Factor::Kind::Motion;
+  f.a = from;
+  f.z.setZero();
+  f.z.head(dim) = u;
+  f.weight.setZero();
+  f.weight.topLeftCorner(dim, dim) = q_v;
+  f.dt = dt_s;
+  f.model = std::move(model);
+  f.lin_a = state_.mean(from);
+  f.lin_b = f.model->predict(f.lin_a, u, dt_s, nullptr, nullptr);
+  first_factor_of_pose_.push_back(static_cast<int>(factors_.size()));
+  f.b = state_.addPose(f.lin_b);
+  // Dead-reckoning propagation for conservative covariances: x_b = F x_a + w, Cov w = Q.
+  Mat3 fx;
+  MatU fu;
+  f.model->predict(f.lin_a, u, dt_s, &fx, &fu);
+  pushChain(f.b, from, fx, processCovariance(fu, q_v, stabilisingNoise(*f.model)));
+  const int k = f.b;
+  addFactor(std::move(f));
+  return k;
+}
+
+int Esdf::augmentRelative(int from, const Vec3& z, const Mat3& omega) {
+  if (state_.size() == 0) throw std::logic_error("Esdf: augment before initialise");
+  if (from < 0 || from >= size()) throw std::out_of_range("augmentRelative: bad pose index");
+  Factor f{Factor::Kind::Relative, from, -1, z, omega, 0, nullptr, state_.mean(from), Vec3::Zero()};
+  f.lin_b = compose(f.lin_a, z);
+  first_factor_of_pose_.push_back(static_cast<int>(factors_.size()));
+  f.b = state_.addPose(f.lin_b);
+  // x_b = -A_b^-1 A_a x_a + A_b^-1 v from the linearised edge error A_a dx_a + A_b dx_b = v.
+  const Linearisation l = linearise(f, f.lin_a, f.lin_b);
+  const Mat3 ab_inv = l.a_b.inverse();
+  pushChain(f.b, from, -ab_inv * l.a_a, ab_inv * l.w.inverse() * ab_inv.transpose());
+  const int k = f.b;
+  addFactor(std::move(f));
+  return k;
+}
+
+void Esdf::predict(std::shared_ptr<const MotionModel> model, const VecU& u, const MatQ& q_v, double dt_s) {
+  const int old = currentPose();
+  predictAugment(std::move(model), u, q_v, dt_s);
+  // Factors on the old pose are absorbed into the marginal and can no longer be relinearised.
+  const int scan_from = first_factor_of_pose_[old];
+  size_t out = static_cast<size_t>(scan_from);
+  for (size_t f = static_cast<size_t>(scan_from); f < factors_.size(); ++f) {
+    if (factors_[f].a == old || factors_[f].b == old) continue;
+    factors_[out++] = std::move(factors_[f]);
+  }
+  factors_.resize(out);
+  for (size_t f = static_cast<size_t>(scan_from); f < factors_.size(); ++f) {
+    if (factors_[f].a > old) --factors_[f].a;
+    if (factors_[f].b > old) --factors_[f].b;
+  }
+  state_.marginalise(old);
+  first_factor_of_pose_.pop_back();  // the new pose takes the old one's slot and scan start
+  chain_valid_ = false;
+  full_factor_values_ = ~std::uint64_t{0};
+  markChanged();
+}
+
+ObservationResult Esdf::observeRelative(int i, int j, const Vec3& z, const Mat3& omega, bool gate) {
+  if (i < 0 || j < 0 || i >= size() || j >= size() || i == j)
+    throw std::out_of_range("observeRelative: bad pose indices");
+  Factor f{Factor::Kind::Relative, i, j, z, omega, 0, nullptr, state_.mean(i), state_.mean(j)};
+  const Linearisation l = linearise(f, f.lin_a, f.lin_b);
+  ObservationResult r;
+  r.chi2 = l.e0.dot(omega * l.e0);
+  if (gate) {
+    r.gate = gateRelative(i, j, z, omega);
+    r.accepted = r.gate.accepted;
+    if (!r.accepted) return r;
+  }
+  addFactor(std::move(f));
+  return r;
+}
+
+GateResult Esdf::gateRelative(int i, int j, const Vec3& z, const Mat3& omega) {
+  if (i < 0 || j < 0 || i >= size() || j >= size() || i == j) throw std::out_of_range("gateRelative: bad pose indices");
+  const Vec3 e0 = relativePoseError(state_.mean(i), state_.mean(j), z);
+  Mat3 ai, aj;
+  relativePoseErrorJacobians(state_.mean(i), state_.mean(j), z, &ai, &aj);
+  const Mat6 sigma = jointCovariance(i, j, options_.gate_covariance);
+  Eigen::Matrix<double, 3, 6> h;
+  h << ai, aj;
+  // S = H Sigma H' + R with the innovation -e0 (the measurement "e = 0").
+  const Mat3 s = h * sigma * h.transpose() + omega.inverse();
+  return mahalanobisGate(-e0, s, options_.chi2_gate_probability);
+}
+
+void Esdf::ensureFactor() {
+  if (full_factor_.valid() && full_factor_values_ == values_stamp_ && full_factor_.last() == size() &&
+      full_factor_.structureStamp() == state_.structureStamp())
+    return;
+  full_factor_.factorize(state_, 0, size());
+  full_factor_values_ = values_stamp_;
+  // A new reference for conservative covariances: chain restarts after the factored poses.
+  chain_base_ = size();
+  chain_phi_.clear();
+  chain_cov_.clear();
+  chain_valid_ = true;
+  base_columns_.resize(0, 0);
+}
+
+RecoveryStats Esdf::recover(int max_passes) {
+  common::Stopwatch sw;
+  RecoveryStats st;
+  if (max_passes < 0) max_passes = options_.relinearise_max_passes;
+  for (int pass = 0;; ++pass) {
+    ensureFactor();
+    Eigen::VectorXd eta = state_.denseEta();
+    const Eigen::VectorXd mu = full_factor_.solve(eta);
+    for (int p = 0; p < size(); ++p) state_.setMean(p, mu.segment<3>(3 * p));
+    if (!options_.relinearise || pass >= max_passes) break;
+    const long long n = relineariseMoved();
+    if (n == 0) break;
+    st.relinearise_passes = pass + 1;
+    st.factors_relinearised += n;
+  }
+  st.seconds = sw.seconds();
+  return st;
+}
+
+long long Esdf::relineariseMoved() {
+  const double tm = options_.relinearise_threshold_m, tr = options_.relinearise_threshold_rad;
+  auto moved = [&](int p, const Vec3& lin) {
+    const Vec3 d = state_.mean(p) - lin;
+    return d.head<2>().norm() > tm || std::fabs(d.z()) > tr;
+  };
+  long long count = 0;
+  for (Factor& f : factors_) {
+    if (!moved(f.a, f.lin_a) && (f.b < 0 || !moved(f.b, f.lin_b))) continue;
+    apply(f, -1.0);
+    f.lin_a = state_.mean(f.a);
+    if (f.b >= 0) f.lin_b = state_.mean(f.b);
+    apply(f, +1.0);
+    ++count;
+  }
+  return count;
+}
+
+void Esdf::recoverRecent(int first) {
+  const int n = size();
+  if (first <= 0) first = 0;
+  if (first >= n) return;
+  // Lambda_RR mu_R = eta_R - Lambda_RO mu_O, with O the poses before `first`.
+  Eigen::VectorXd rhs(3 * (n - first));
+  for (int p = first; p < n; ++p) {
+    Vec3 r = state_.eta(p);
+    for (const auto& l : state_.links(p))
+      if (l.other < first) r -= l.block * state_.mean(l.other);
+    rhs.segment<3>(3 * (p - first)) = r;
+  }
+  window_factor_.factorize(state_, first, n);
+  const Eigen::VectorXd mu = window_factor_.solve(rhs);
+  for (int p = first; p < n; ++p) state_.setMean(p, mu.segment<3>(3 * (p - first)));
+}
+
+Mat3 Esdf::covarianceColumnsBlock(int i, Eigen::MatrixXd* columns) {
+  const int n = full_factor_.last();
+  Eigen::MatrixXd e = Eigen::MatrixXd::Zero(3 * n, 3);
+  e.block<3, 3>(3 * i, 0).setIdentity();
+  *columns = full_factor_.solve(e);
+  return columns->block<3, 3>(3 * i, 0);
+}
+
+Mat3 Esdf::marginalCovariance(int i, CovarianceMode mode) { return jointCovariance(i, i, mode).topLeftCorner<3, 3>(); }
+
+Mat6 Esdf::jointCovariance(int i, int j, CovarianceMode mode) {
+  if (i < 0 || j < 0 || i >= size() || j >= size()) throw std::out_of_range("jointCovariance: bad pose");
+  if (mode == CovarianceMode::Conservative && full_factor_.valid() && chain_valid_ &&
+      full_factor_.last() == chain_base_ && chain_base_ > 0 && full_factor_.first() == 0 &&
+      static_cast<int>(chain_phi_.size()) == size() - chain_base_)
+    return conservativeJoint(i, j);
+  ensureFactor();
+  const int n = size();
+  Eigen::MatrixXd e = Eigen::MatrixXd::Zero(3 * n, 6);
+  e.block<3, 3>(3 * i, 0).setIdentity();
+  e.block<3, 3>(3 * j, 3) += Mat3::Identity();
+  if (i == j) e.block<3, 3>(3 * j, 3).setIdentity();
+  const Eigen::MatrixXd x = full_factor_.solve(e);
+  Mat6 s;
+  s << x.block<3, 3>(3 * i, 0), x.block<3, 3>(3 * i, 3), x.block<3, 3>(3 * j, 0), x.block<3, 3>(3 * j, 3);
+  return 0.5 * (s + s.transpose());
+}
+
+Mat6 Esdf::conservativeJoint(int i, int j) {
+  // The last factorisation is of an older Lambda, which holds less information than the current
+  // one (if no relinearisation happened since): its inverse bounds the current covariance from
+  // above. Poses added after it are reached by dead reckoning from the last factored pose m-1.
+  const int m = chain_base_;
+  if (base_columns_.size() == 0) covarianceColumnsBlock(m - 1, &base_columns_);
+  const Mat3 base = base_columns_.block<3, 3>(3 * (m - 1), 0);
+  auto chainPhi = [&](int p) -> const Mat3& { return chain_phi_[static_cast<size_t>(p - m)]; };
+  auto marginal = [&](int p) -> Mat3 {
+    if (p >= m) return chainPhi(p) * base * chainPhi(p).transpose() + chain_cov_[static_cast<size_t>(p - m)];
+    Eigen::MatrixXd cols;
+    return covarianceColumnsBlock(p, &cols);
+  };
+  auto cross = [&](int a, int b) -> Mat3 {  // Sigma(a, b) for a < b
+    if (b < m) {
+      Eigen::MatrixXd cols;
+      covarianceColumnsBlock(b, &cols);
+      return cols.block<3, 3>(3 * a, 0);
+    }
+    if (a < m) return base_columns_.block<3, 3>(3 * a, 0) * chainPhi(b).transpose();
+    // Both dead-reckoned: x_b = Phi_b Phi_a^-1 x_a + independent noise.
+    return marginal(a) * (chainPhi(b) * chainPhi(a).inverse()).transpose();
+  };
+  Mat6 s;
+  if (i == j) {
+    const Mat3 c = marginal(i);
+    s << c, c, c, c;
+  } else {
+    const int a = std::min(i, j), b = std::max(i, j);
+    const Mat3 saa = marginal(a), sbb = marginal(b), sab = cross(a, b);
+    if (i < j)
+      s << saa, sab, sab.transpose(), sbb;
+    else
+      s << sbb, sab.transpose(), sab, saa;
+  }
+  return 0.5 * (s + s.transpose());
+}
+
+size_t Esdf::memoryBytes() const {
+  return state_.memoryBytes() + factors_.capacity() * sizeof(Factor) +
+         first_factor_of_pose_.capacity() * sizeof(int) +
+         (chain_phi_.capacity() + chain_cov_.capacity()) * sizeof(Mat3);
+}
+
+}  // namespace urbanslam::esdf

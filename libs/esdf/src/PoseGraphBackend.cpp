@@ -1,0 +1,180 @@
+#include "urbanslam/esdf/PoseGraphBackend.h"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <unordered_map>
+
+#include "urbanslam/common/Error.h"
+#include "urbanslam/common/Timing.h"
+
+namespace urbanslam::esdf {
+namespace {
+
+// An edge b -> a given as a -> b: measurement ⊖z and the information of the reversed error
+// e' = z ⊕ ⊖e ⊕ ⊖z ~ M e, so Omega' = M^-T Omega M^-1.
+void reverseEdge(const Vec3& z, const Mat3& omega, Vec3* z_rev, Mat3* omega_rev) {
+  *z_rev = inverse(z);
+  const Vec3 zero = Vec3::Zero();
+  Mat3 j1, j2;
+  composeJacobians(compose(z, inverse(zero)), inverse(z), &j1, nullptr);
+  composeJacobians(z, inverse(zero), nullptr, &j2);
+  const Mat3 m = j1 * j2 * inverseJacobian(zero);
+  const Mat3 m_inv = m.inverse();
+  *omega_rev = m_inv.transpose() * omega * m_inv;
+}
+
+}  // namespace
+
+PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBackendOptions& opt) {
+  PoseGraphBackendResult res;
+  // Vertex ids: those declared plus those only named by edges (edges-only files).
+  std::vector<long> ids;
+  ids.reserve(g.vertices.size() + g.edges.size());
+  for (const auto& v : g.vertices) ids.push_back(v.id);
+  for (const auto& e : g.edges) {
+    ids.push_back(e.from);
+    ids.push_back(e.to);
+  }
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  if (ids.empty()) throw common::InputError("pose graph has no vertices");
+  std::unordered_map<long, int> index;
+  index.reserve(ids.size());
+  for (size_t k = 0; k < ids.size(); ++k) index.emplace(ids[k], static_cast<int>(k));
+  const int n = static_cast<int>(ids.size());
+
+  // Bucket edges by their later endpoint: they become usable when that pose is added.
+  std::vector<int> bucket_start(static_cast<size_t>(n) + 1, 0);
+  std::vector<int> order(g.edges.size());
+  {
+    std::vector<int> later(g.edges.size());
+    for (size_t e = 0; e < g.edges.size(); ++e) {
+      later[e] = std::max(index[g.edges[e].from], index[g.edges[e].to]);
+      ++bucket_start[static_cast<size_t>(later[e]) + 1];
+    }
+    for (int k = 0; k < n; ++k) bucket_start[k + 1] += bucket_start[k];
+    std::vector<int> fill(bucket_start.begin(), bucket_start.end() - 1);
+    for (size_t e = 0; e < g.edges.size(); ++e) order[static_cast<size_t>(fill[later[e]]++)] = static_cast<int>(e);
+  }
+
+  Vec3 first_pose = Vec3::Zero();
+  for (const auto& v : g.vertices)
+    if (v.id == ids[0]) first_pose = v.pose;
+
+  common::Stopwatch total;
+  Esdf filter(opt.filter);
+  filter.reserve(n);
+  const Vec3 anchor_var(opt.anchor_sigma_m * opt.anchor_sigma_m, opt.anchor_sigma_m * opt.anchor_sigma_m,
+                        opt.anchor_sigma_rad * opt.anchor_sigma_rad);
+  filter.initialise(first_pose, anchor_var.asDiagonal());
+  res.step_ms.reserve(g.edges.size());
+
+  int pending = 0;
+  for (int k = 1; k < n; ++k) {
+    const int b0 = bucket_start[k], b1 = bucket_start[k + 1];
+    // The augmenting edge: to the previous pose when there is one, else the first edge.
+    int aug = -1;
+    for (int q = b0; q < b1; ++q) {
+      const auto& e = g.edges[static_cast<size_t>(order[q])];
+      const int other = index[e.from] == k ? index[e.to] : index[e.from];
+      if (other == k - 1) {
+        aug = q;
+        break;
+      }
+      if (aug < 0) aug = q;
+    }
+    if (aug < 0)
+      throw common::InputError("pose graph: vertex " + std::to_string(ids[k]) +
+                               " has no edge to an earlier vertex (disconnected graph)");
+    double max_chi2 = 0;
+    int closures = 0;
+    // The augmenting edge first (the new pose must exist before it is observed).
+    std::swap(order[static_cast<size_t>(b0)], order[static_cast<size_t>(aug)]);
+    aug = b0;
+    for (int q = b0; q < b1; ++q) {
+      common::Stopwatch sw;
+      const auto& e = g.edges[static_cast<size_t>(order[q])];
+      const int a = index[e.from], b = index[e.to];
+      if (q == aug) {
+        if (b == k) {
+          filter.augmentRelative(a, e.measurement, e.information);
+        } else {
+          Vec3 z;
+          Mat3 om;
+          reverseEdge(e.measurement, e.information, &z, &om);
+          filter.augmentRelative(b, z, om);
+        }
+        ++res.augment_edges;
+      } else {
+        bool accepted = true;
+        if (opt.gate_loop_closures) {
+          GateResult gr = filter.gateRelative(a, b, e.measurement, e.information);
+          if (!gr.accepted && pending > 0) {
+            // The mean may be stale (recoveries deferred): judge the closure on a fresh one.
+            const RecoveryStats st = filter.recover(opt.incremental_relinearise_passes);
+            res.recovery_s += st.seconds;
+            res.factors_relinearised += st.factors_relinearised;
+            ++res.full_recoveries;
+            pending = 0;
+            gr = filter.gateRelative(a, b, e.measurement, e.information);
+          }
+          accepted = gr.accepted;
+        }
+        ++res.observation_edges;
+        ObservationResult r;
+        r.accepted = accepted;
+        if (accepted) r = filter.observeRelative(a, b, e.measurement, e.information, false);
+        if (!r.accepted) {
+          ++res.rejected_edges;
+        } else {
+          ++closures;
+          max_chi2 = std::max(max_chi2, r.chi2);
+        }
+      }
+      if (q + 1 == b1 && closures > 0) {
+        pending += closures;
+        if (pending >= opt.full_recovery_every_closures || max_chi2 > opt.full_recovery_innovation_chi2) {
+          const RecoveryStats st = filter.recover(opt.incremental_relinearise_passes);
+          res.recovery_s += st.seconds;
+          res.factors_relinearised += st.factors_relinearised;
+          ++res.full_recoveries;
+          pending = 0;
+        } else {
+          filter.recoverRecent(k - opt.recent_window_poses);
+          ++res.partial_recoveries;
+        }
+      }
+      res.step_ms.push_back(sw.milliseconds());
+    }
+  }
+  {
+    common::Stopwatch sw;
+    const RecoveryStats st = filter.recover();
+    res.recovery_s += st.seconds;
+    res.factors_relinearised += st.factors_relinearised;
+    ++res.full_recoveries;
+    if (!res.step_ms.empty()) res.step_ms.back() += sw.milliseconds();
+  }
+  res.time_s = total.seconds();
+  res.edges = static_cast<int>(g.edges.size());
+  res.memory_bytes = filter.memoryBytes();
+  res.vertex_ids = ids;
+  res.poses.resize(static_cast<size_t>(n));
+  for (int k = 0; k < n; ++k) {
+    res.poses[static_cast<size_t>(k)] = filter.mean(k);
+    res.poses[static_cast<size_t>(k)].z() = common::wrapToPi(filter.mean(k).z());
+  }
+  res.chi2 = poseGraphChi2(g, res.poses, ids);
+  return res;
+}
+
+PoseGraph withPoses(const PoseGraph& graph, const PoseGraphBackendResult& r) {
+  PoseGraph out;
+  out.format = graph.format;
+  out.edges = graph.edges;
+  out.vertices.reserve(r.poses.size());
+  for (size_t k = 0; k < r.poses.size(); ++k) out.vertices.push_back({r.vertex_ids[k], r.poses[k]});
+  return out;
+}
+
+}  // namespace urbanslam::esdf

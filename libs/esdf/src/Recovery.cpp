@@ -1,0 +1,143 @@
+#include "urbanslam/esdf/Recovery.h"
+
+#include <cholmod.h>
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace urbanslam::esdf {
+
+struct SparseCholesky::Impl {
+  cholmod_common common;
+  cholmod_factor* factor = nullptr;
+  FillReducingOrdering ordering;
+  // Pattern of the last analysed matrix: the symbolic factor is reused when it is unchanged.
+  std::vector<int> last_p, last_i;
+
+  explicit Impl(FillReducingOrdering o) : ordering(o) {
+    cholmod_start(&common);
+    common.nmethods = 1;
+    common.method[0].ordering = o == FillReducingOrdering::Amd ? CHOLMOD_AMD : CHOLMOD_NATURAL;
+    common.postorder = 1;
+    common.print = 0;
+  }
+  ~Impl() {
+    if (factor) cholmod_free_factor(&factor, &common);
+    cholmod_finish(&common);
+  }
+};
+
+SparseCholesky::SparseCholesky(FillReducingOrdering ordering) : impl_(std::make_unique<Impl>(ordering)) {}
+SparseCholesky::~SparseCholesky() = default;
+
+bool SparseCholesky::valid() const { return impl_->factor != nullptr; }
+
+void SparseCholesky::factorize(const InformationState& s, int first, int last) {
+  if (first < 0 || last > s.size() || first >= last) throw std::invalid_argument("factorize: bad pose range");
+  const int poses = last - first;
+  const size_t n = 3 * static_cast<size_t>(poses);
+  // Upper triangle (stype = 1), column by column: for block column p, the blocks Lambda(o, p)
+  // of linked poses o < p in the range (sorted), then the upper part of the diagonal block.
+  std::vector<int> colptr(n + 1, 0);
+  std::vector<int> rowind;
+  std::vector<double> values;
+  rowind.reserve(n * 6);
+  values.reserve(n * 6);
+  std::vector<std::pair<int, const Mat3*>> lower;
+  for (int p = first; p < last; ++p) {
+    lower.clear();
+    for (const auto& l : s.links(p))
+      if (l.other >= first && l.other < p) lower.emplace_back(l.other, &l.block);
+    std::sort(lower.begin(), lower.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    const Mat3& d = s.diagonal(p);
+    for (int c = 0; c < 3; ++c) {
+      for (const auto& [o, blk] : lower) {
+        // Lambda(o, p) = Lambda(p, o)' : entry (row r of o, col c of p) = blk(c, r).
+        for (int r = 0; r < 3; ++r) {
+          rowind.push_back(3 * (o - first) + r);
+          values.push_back((*blk)(c, r));
+        }
+      }
+      for (int r = 0; r <= c; ++r) {
+        rowind.push_back(3 * (p - first) + r);
+        values.push_back(d(r, c));
+      }
+      colptr[3 * (p - first) + c + 1] = static_cast<int>(rowind.size());
+    }
+  }
+  cholmod_sparse a{};
+  a.nrow = a.ncol = n;
+  a.nzmax = rowind.size();
+  a.p = colptr.data();
+  a.i = rowind.data();
+  a.x = values.data();
+  a.stype = 1;
+  a.itype = CHOLMOD_INT;
+  a.xtype = CHOLMOD_REAL;
+  a.dtype = CHOLMOD_DOUBLE;
+  a.sorted = 1;
+  a.packed = 1;
+
+  cholmod_common* cm = &impl_->common;
+  const bool same_pattern = impl_->factor && colptr == impl_->last_p && rowind == impl_->last_i;
+  if (!same_pattern) {
+    if (impl_->factor) cholmod_free_factor(&impl_->factor, cm);
+    impl_->factor = cholmod_analyze(&a, cm);
+    if (!impl_->factor) throw std::runtime_error("CHOLMOD analyze failed");
+    impl_->last_p = std::move(colptr);
+    impl_->last_i = std::move(rowind);
+  }
+  cholmod_factorize(&a, impl_->factor, cm);
+  if (cm->status != CHOLMOD_OK || impl_->factor->minor < n) {
+    cholmod_free_factor(&impl_->factor, cm);
+    impl_->last_p.clear();
+    throw std::runtime_error("information matrix is not positive definite (CHOLMOD status " +
+                             std::to_string(cm->status) + ")");
+  }
+  first_ = first;
+  last_ = last;
+  stamp_ = s.structureStamp();
+}
+
+Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& b) const {
+  if (!impl_->factor) throw std::logic_error("solve without a factor");
+  cholmod_common* cm = &impl_->common;
+  Eigen::MatrixXd rhs = b;
+  cholmod_dense bd{};
+  bd.nrow = static_cast<size_t>(rhs.rows());
+  bd.ncol = static_cast<size_t>(rhs.cols());
+  bd.nzmax = bd.nrow * bd.ncol;
+  bd.d = bd.nrow;
+  bd.x = rhs.data();
+  bd.xtype = CHOLMOD_REAL;
+  bd.dtype = CHOLMOD_DOUBLE;
+  cholmod_dense* x = cholmod_solve(CHOLMOD_A, impl_->factor, &bd, cm);
+  if (!x) throw std::runtime_error("CHOLMOD solve failed");
+  Eigen::MatrixXd out = Eigen::Map<Eigen::MatrixXd>(static_cast<double*>(x->x), rhs.rows(), rhs.cols());
+  cholmod_free_dense(&x, cm);
+  return out;
+}
+
+long long SparseCholesky::factorNonZeros() const {
+  if (!impl_->factor) return 0;
+  const cholmod_factor* f = impl_->factor;
+  if (f->is_super) {
+    // Supernodal: sum over supernodes of (rows x cols) lower-trapezoid storage.
+    long long nz = 0;
+    const int* super = static_cast<const int*>(f->super);
+    const int* pi = static_cast<const int*>(f->pi);
+    for (size_t k = 0; k < f->nsuper; ++k) {
+      const long long cols = super[k + 1] - super[k], rows = pi[k + 1] - pi[k];
+      nz += cols * rows - cols * (cols - 1) / 2;
+    }
+    return nz;
+  }
+  const int* colcount = static_cast<const int*>(f->ColCount);
+  long long nz = 0;
+  for (size_t j = 0; j < f->n; ++j) nz += colcount[j];
+  return nz;
+}
+
+}  // namespace urbanslam::esdf

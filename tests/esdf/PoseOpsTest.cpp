@@ -1,0 +1,96 @@
+// Analytic vs numerical Jacobians of the compounding operators (thesis appendix B).
+#include <gtest/gtest.h>
+
+#include "TestUtil.h"
+#include "urbanslam/common/Pose2.h"
+#include "urbanslam/esdf/PoseOps.h"
+
+namespace urbanslam::esdf {
+namespace {
+
+using test::numericalJacobian;
+using V = Eigen::VectorXd;
+
+TEST(PoseOps, ComposeInverseBetweenAgreeWithCommonPose2) {
+  std::mt19937 rng(1);
+  for (int t = 0; t < 100; ++t) {
+    const Vec3 a = test::randomPose(rng), b = test::randomPose(rng);
+    const auto pa = toPose(a), pb = toPose(b);
+    const auto c = common::compose(pa, pb);
+    const Vec3 c2 = compose(a, b);
+    EXPECT_NEAR(c.x, c2.x(), 1e-12);
+    EXPECT_NEAR(c.y, c2.y(), 1e-12);
+    EXPECT_NEAR(c.phi, common::wrapToPi(c2.z()), 1e-12);
+    const auto bt = common::between(pa, pb);
+    const Vec3 bt2 = between(a, b);
+    EXPECT_NEAR(bt.x, bt2.x(), 1e-12);
+    EXPECT_NEAR(bt.y, bt2.y(), 1e-12);
+    EXPECT_NEAR(bt.phi, bt2.z(), 1e-12);
+    // ⊖a ⊕ a = 0 and a ⊕ (⊖a ⊕ b) = b.
+    EXPECT_LT(compose(inverse(a), a).head<2>().norm(), 1e-12);
+    EXPECT_LT(poseDifference(compose(a, between(a, b)), b).norm(), 1e-12);
+  }
+}
+
+TEST(PoseOps, ComposeJacobiansMatchNumerical) {
+  std::mt19937 rng(2);
+  for (int t = 0; t < 50; ++t) {
+    const Vec3 a = test::randomPose(rng), b = test::randomPose(rng);
+    Mat3 j1, j2;
+    composeJacobians(a, b, &j1, &j2);
+    const Eigen::MatrixXd n1 = numericalJacobian([&](const V& x) -> V { return compose(x, b); }, a);
+    const Eigen::MatrixXd n2 = numericalJacobian([&](const V& x) -> V { return compose(a, x); }, b);
+    EXPECT_LT((j1 - n1).norm(), 1e-6);
+    EXPECT_LT((j2 - n2).norm(), 1e-6);
+  }
+}
+
+TEST(PoseOps, InverseJacobianMatchesNumerical) {
+  std::mt19937 rng(3);
+  for (int t = 0; t < 50; ++t) {
+    const Vec3 a = test::randomPose(rng);
+    const Eigen::MatrixXd n = numericalJacobian([&](const V& x) -> V { return inverse(x); }, a);
+    EXPECT_LT((inverseJacobian(a) - n).norm(), 1e-6);
+  }
+}
+
+TEST(PoseOps, BetweenJacobiansMatchNumericalAndCompositeRule) {
+  std::mt19937 rng(4);
+  for (int t = 0; t < 50; ++t) {
+    const Vec3 a = test::randomPose(rng), b = test::randomPose(rng);
+    Mat3 ja, jb;
+    betweenJacobians(a, b, &ja, &jb);
+    // Keep the numerical derivative away from the heading wrap.
+    auto f = [&](const V& x, bool first) -> V {
+      Vec3 r = first ? between(x, b) : between(a, x);
+      r.z() = (first ? b.z() - x(2) : x(2) - a.z());
+      return r;
+    };
+    EXPECT_LT((ja - numericalJacobian([&](const V& x) { return f(x, true); }, a)).norm(), 1e-6);
+    EXPECT_LT((jb - numericalJacobian([&](const V& x) { return f(x, false); }, b)).norm(), 1e-6);
+    // Appendix B.3: d(⊖a⊕b)/da = J1⊕(⊖a, b) J⊖(a), d/db = J2⊕(⊖a, b).
+    Mat3 j1, j2;
+    composeJacobians(inverse(a), b, &j1, &j2);
+    EXPECT_LT((ja - j1 * inverseJacobian(a)).norm(), 1e-12);
+    EXPECT_LT((jb - j2).norm(), 1e-12);
+  }
+}
+
+TEST(PoseOps, RelativePoseErrorJacobiansMatchNumerical) {
+  std::mt19937 rng(5);
+  for (int t = 0; t < 50; ++t) {
+    const Vec3 a = test::randomPose(rng), b = test::randomPose(rng);
+    // A measurement near the truth keeps the error heading far from +-pi.
+    Vec3 z = between(a, b) + Vec3(0.1, -0.2, 0.05);
+    Mat3 ja, jb;
+    relativePoseErrorJacobians(a, b, z, &ja, &jb);
+    const auto na = numericalJacobian([&](const V& x) -> V { return relativePoseError(x, b, z); }, a);
+    const auto nb = numericalJacobian([&](const V& x) -> V { return relativePoseError(a, x, z); }, b);
+    EXPECT_LT((ja - na).norm(), 1e-6);
+    EXPECT_LT((jb - nb).norm(), 1e-6);
+    EXPECT_LT(relativePoseError(a, b, between(a, b)).norm(), 1e-12);
+  }
+}
+
+}  // namespace
+}  // namespace urbanslam::esdf

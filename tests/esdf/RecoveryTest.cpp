@@ -1,0 +1,126 @@
+// State and covariance recovery (CHOLMOD) against dense solves and a dense inverse.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include "TestUtil.h"
+#include "urbanslam/esdf/Esdf.h"
+
+namespace urbanslam::esdf {
+namespace {
+
+const Mat3 kOdoInfo = Vec3(100.0, 100.0, 1000.0).asDiagonal();
+const Mat3 kLoopInfo = Vec3(50.0, 50.0, 500.0).asDiagonal();
+
+// A square-ish loop trajectory with noisy odometry and a few loop closures; no recovery yet.
+void buildGraph(Esdf& f, std::mt19937& rng, int poses, int closures) {
+  f.initialise(Vec3(0, 0, 0), Mat3::Identity() * 1e-6);
+  for (int k = 1; k < poses; ++k) {
+    const double turn = (k % 10 == 0) ? M_PI / 2 : 0.0;
+    f.augmentRelative(k - 1, Vec3(1.0 + test::gauss(rng, 0.05), test::gauss(rng, 0.05), turn + test::gauss(rng, 0.01)),
+                      kOdoInfo);
+  }
+  std::uniform_int_distribution<int> pick(0, poses - 1);
+  for (int c = 0; c < closures; ++c) {
+    int i = pick(rng), j = pick(rng);
+    if (std::abs(i - j) < 2) continue;
+    const Vec3 z = between(f.mean(i), f.mean(j)) + Vec3(test::gauss(rng, 0.3), test::gauss(rng, 0.3), test::gauss(rng, 0.05));
+    f.observeRelative(i, j, z, kLoopInfo);
+  }
+}
+
+Mat3 blk(const Eigen::MatrixXd& m, int i, int j) { return m.block<3, 3>(3 * i, 3 * j); }
+
+TEST(Recovery, FullRecoveryEqualsDenseSolve) {
+  std::mt19937 rng(30);
+  EsdfOptions o;
+  o.relinearise = false;
+  Esdf f(o);
+  buildGraph(f, rng, 80, 10);
+  const Eigen::MatrixXd lambda = f.state().denseInformation();
+  const Eigen::VectorXd mu_ref = lambda.ldlt().solve(f.state().denseEta());
+  f.recover();
+  EXPECT_LT((f.state().denseMean() - mu_ref).cwiseAbs().maxCoeff(), 1e-9);
+}
+
+TEST(Recovery, PartialRecoveryEqualsDenseConditionalSolve) {
+  std::mt19937 rng(31);
+  EsdfOptions o;
+  o.relinearise = false;
+  Esdf f(o);
+  buildGraph(f, rng, 60, 8);
+  const int first = 40, n = f.size();
+  const Eigen::MatrixXd lambda = f.state().denseInformation();
+  const Eigen::VectorXd eta = f.state().denseEta(), mu = f.state().denseMean();
+  const int r = 3 * (n - first);
+  const Eigen::VectorXd rhs = eta.tail(r) - lambda.bottomLeftCorner(r, 3 * first) * mu.head(3 * first);
+  const Eigen::VectorXd ref = lambda.bottomRightCorner(r, r).ldlt().solve(rhs);
+  f.recoverRecent(first);
+  EXPECT_LT((f.state().denseMean().tail(r) - ref).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT((f.state().denseMean().head(3 * first) - mu.head(3 * first)).norm(), 1e-15);  // older poses untouched
+}
+
+TEST(Recovery, MarginalsAndPairsEqualDenseInverse) {
+  std::mt19937 rng(32);
+  Esdf f;
+  buildGraph(f, rng, 70, 12);
+  f.recover();
+  const Eigen::MatrixXd sigma = f.state().denseInformation().inverse();
+  const double scale = sigma.cwiseAbs().maxCoeff();
+  for (int i = 0; i < f.size(); i += 7) {
+    EXPECT_LT((f.marginalCovariance(i) - blk(sigma, i, i)).cwiseAbs().maxCoeff() / scale, 1e-10);
+    for (int j : {0, 13, f.size() - 1}) {
+      if (i == j) continue;
+      const Mat6 joint = f.jointCovariance(i, j);
+      EXPECT_LT((joint.topLeftCorner<3, 3>() - blk(sigma, i, i)).cwiseAbs().maxCoeff() / scale, 1e-10);
+      EXPECT_LT((joint.topRightCorner<3, 3>() - blk(sigma, i, j)).cwiseAbs().maxCoeff() / scale, 1e-10);
+      EXPECT_LT((joint.bottomRightCorner<3, 3>() - blk(sigma, j, j)).cwiseAbs().maxCoeff() / scale, 1e-10);
+    }
+  }
+}
+
+double minEigen(const Mat6& m) { return Eigen::SelfAdjointEigenSolver<Mat6>(m).eigenvalues().minCoeff(); }
+
+TEST(Recovery, ConservativeCovarianceIsExactWithoutNewInformationAndAnUpperBoundWithIt) {
+  std::mt19937 rng(33);
+  EsdfOptions o;
+  o.relinearise = false;
+  Esdf f(o);
+  buildGraph(f, rng, 50, 6);
+  f.recover();  // factor of 50 poses
+  // Dead reckoning beyond the factor: conservative is exact.
+  for (int k = 50; k < 65; ++k) f.augmentRelative(k - 1, Vec3(1, 0, 0.05), kOdoInfo);
+  // All conservative queries first: an exact query refactorises and so refreshes the reference.
+  const std::vector<std::pair<int, int>> pairs1{{3, 20}, {10, 60}, {55, 64}, {64, 2}};
+  std::vector<Mat6> cons;
+  for (auto [i, j] : pairs1) cons.push_back(f.jointCovariance(i, j, CovarianceMode::Conservative));
+  for (size_t k = 0; k < pairs1.size(); ++k) {
+    const Mat6 e = f.jointCovariance(pairs1[k].first, pairs1[k].second, CovarianceMode::Exact);
+    EXPECT_LT((cons[k] - e).cwiseAbs().maxCoeff() / e.cwiseAbs().maxCoeff(), 1e-9) << k;
+  }
+  f.recover();  // new factor at 65
+  for (int k = 65; k < 80; ++k) f.augmentRelative(k - 1, Vec3(1, 0, 0.05), kOdoInfo);
+  // Loop closures after the factor add information: conservative >= exact (PSD difference).
+  f.observeRelative(5, 79, between(f.mean(5), f.mean(79)), kLoopInfo);
+  f.observeRelative(30, 70, between(f.mean(30), f.mean(70)), kLoopInfo);
+  const std::vector<std::pair<int, int>> pairs2{{5, 79}, {30, 40}, {70, 78}, {12, 66}};
+  cons.clear();
+  for (auto [i, j] : pairs2) cons.push_back(f.jointCovariance(i, j, CovarianceMode::Conservative));
+  for (size_t k = 0; k < pairs2.size(); ++k) {
+    const Mat6 e = f.jointCovariance(pairs2[k].first, pairs2[k].second, CovarianceMode::Exact);
+    EXPECT_GT(minEigen(cons[k] - e), -1e-9 * e.norm()) << k;
+    EXPECT_GT((cons[k] - e).norm(), 1e-6 * e.norm()) << "closures should make a difference for pair " << k;
+  }
+}
+
+TEST(Recovery, NotPositiveDefiniteThrows) {
+  InformationState s;
+  s.addPose(Vec3::Zero());
+  s.addPose(Vec3::Zero());
+  s.addDiagonal(0, Mat3::Identity());  // pose 1 has no information
+  SparseCholesky chol;
+  EXPECT_THROW(chol.factorize(s, 0, 2), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace urbanslam::esdf
