@@ -82,3 +82,24 @@ TEST(Cli, ConvertWritesARawlogThatRunsTheSame) {
   ASSERT_EQ(runCli("run --quiet --out " + (d / "b").string() + " " + rawlog).code, 0);
   EXPECT_EQ(slurp((d / "a" / "trajectory_keyframes.tum").string()), slurp((d / "b" / "trajectory_keyframes.tum").string()));
 }
+
+// MRPT's own tool opens what `convert` writes (independent reader of the file format).
+TEST(Cli, RawlogEditReadsConvertedRawlogs) {
+  if (!fs::exists("/usr/bin/rawlog-edit")) GTEST_SKIP() << "rawlog-edit not installed (package mrpt-apps)";
+  const fs::path d = scratchDir("cli_rawlog_edit");
+  for (const char* layout : {"observations", "frames"}) {
+    const std::string rawlog = (d / (std::string(layout) + ".rawlog")).string();
+    ASSERT_EQ(runCli(std::string("convert --quiet --layout ") + layout + " " +
+                     repoPath("rawlogs/intel-corrected-excerpt.log.gz") + " " + rawlog).code, 0);
+    const std::string info = (d / "info.txt").string();
+    const int rc = std::system(("rawlog-edit --info -i " + rawlog + " > " + info + " 2>&1").c_str());
+    const std::string text = slurp(info);
+    EXPECT_EQ(rc, 0) << text;
+    if (std::string(layout) == "observations") {
+      EXPECT_NE(text.find("Observations format               : Yes"), std::string::npos) << text;
+      EXPECT_NE(text.find("FLASER /     80"), std::string::npos) << text;
+    } else {
+      EXPECT_NE(text.find("Actions/SensoryFrame format       : Yes"), std::string::npos) << text;
+    }
+  }
+}

@@ -183,3 +183,23 @@ TEST(CarmenReader, FreiburgCorrectedLogsFromSharedData) {
   EXPECT_EQ(r.scans[0].ranges.size(), 360u);
   EXPECT_NEAR(r.scans[0].angle_increment_rad, 0.5 * M_PI / 180, 1e-12);
 }
+
+// Front and rear lasers are told apart by label; the rear one looks backwards.
+TEST(CarmenReader, FrontAndRearLasersByLabel) {
+  std::string rear = flaser(4, "1.0", 5.0);
+  rear.replace(0, 6, "RLASER");
+  const std::string text = "PARAM robot_rearlaser_offset -0.3 h 0\n" + flaser(4, "1.0", 5.0) + rear;
+  io::CarmenReader reader(writeText("rear", text));
+  const ReadBack r = readAll(reader);
+  ASSERT_EQ(r.scans.size(), 2u);
+  EXPECT_EQ(r.scans[0].label, "FLASER");
+  EXPECT_EQ(r.scans[1].label, "RLASER");
+  EXPECT_NEAR(r.scans[1].sensor_pose.x, -0.3, 1e-12);
+  // The rear laser looks backwards: its first (rightmost) beam points to the vehicle's left,
+  // its last to the vehicle's right.
+  const auto& s = r.scans[1];
+  EXPECT_NEAR(common::wrapToPi(s.sensor_pose.phi + s.bearing(0) - M_PI / 2), 0, 1e-12);
+  EXPECT_NEAR(common::wrapToPi(s.sensor_pose.phi + s.bearing(3) + M_PI / 2), 0, 1e-12);
+  const auto& f = r.scans[0];
+  EXPECT_NEAR(common::wrapToPi(f.sensor_pose.phi + f.bearing(0) + M_PI / 2), 0, 1e-12);
+}

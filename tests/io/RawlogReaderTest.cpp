@@ -83,3 +83,54 @@ TEST(RawlogReader, CorruptAndTruncatedFilesAreClearErrors) {
   EXPECT_THROW(io::openDataSource((d / "empty.rawlog").string()), common::InputError);
   EXPECT_THROW(io::openDataSource((d / "missing.rawlog").string()), common::InputError);
 }
+
+// Camera images: embedded in the rawlog, stored externally beside it in "<name>_Images/", and
+// the left image of a stereo pair.
+#include <mrpt/img/CImage.h>
+#include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/obs/CObservationImage.h>
+#include <mrpt/obs/CObservationStereoImages.h>
+#include <mrpt/serialization/CArchive.h>
+
+TEST(RawlogReader, ImagesEmbeddedExternalAndStereo) {
+  const auto d = test::scratchDir("rawlog_images");
+  std::filesystem::create_directories(d / "cam_Images");
+  mrpt::img::CImage img(64, 48, mrpt::img::CH_GRAY);
+  for (int r = 0; r < 48; ++r)
+    for (int c = 0; c < 64; ++c) *img.ptr<uint8_t>(c, r) = static_cast<uint8_t>(r * 4 + c);
+  img.saveToFile((d / "cam_Images" / "frame0.png").string());
+  {
+    mrpt::io::CFileGZOutputStream f((d / "cam.rawlog").string());
+    auto arch = mrpt::serialization::archiveFrom(f);
+    mrpt::obs::CObservationImage embedded;
+    embedded.sensorLabel = "CAMERA";
+    embedded.timestamp = mrpt::Clock::fromDouble(10.0);
+    embedded.image = img;
+    arch << embedded;
+    mrpt::obs::CObservationImage external;
+    external.sensorLabel = "CAMERA";
+    external.timestamp = mrpt::Clock::fromDouble(11.0);
+    external.image.setExternalStorage("frame0.png");
+    arch << external;
+    mrpt::obs::CObservationStereoImages stereo;
+    stereo.sensorLabel = "STEREO";
+    stereo.timestamp = mrpt::Clock::fromDouble(12.0);
+    stereo.imageLeft = img;
+    stereo.imageRight = mrpt::img::CImage(64, 48, mrpt::img::CH_GRAY);
+    arch << stereo;
+  }
+  io::RawlogReader reader((d / "cam.rawlog").string());
+  io::Measurement m;
+  std::vector<io::CameraImage> images;
+  while (reader.next(m))
+    if (auto* c = std::get_if<io::CameraImage>(&m)) images.push_back(*c);
+  ASSERT_EQ(images.size(), 3u);
+  for (const auto& c : images) {
+    ASSERT_EQ(c.width, 64);
+    ASSERT_EQ(c.height, 48);
+    EXPECT_EQ((*c.pixels)[5 * 64 + 7], 5 * 4 + 7);
+  }
+  EXPECT_EQ(images[1].source.find("frame0.png") != std::string::npos, true) << images[1].source;
+  EXPECT_EQ(images[2].label, "STEREO");
+  EXPECT_DOUBLE_EQ(images[1].timestamp, 11.0);
+}

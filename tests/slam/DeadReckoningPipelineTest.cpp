@@ -1,0 +1,92 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+
+#include "TestPaths.h"
+#include "urbanslam/slam/Pipeline.h"
+
+using namespace urbanslam;
+
+namespace {
+const std::string kExcerpt = test::repoPath("rawlogs/intel-corrected-excerpt.log.gz");
+
+struct CountingObserver : slam::PipelineObserver {
+  size_t keyframes = 0, steps = 0;
+  bool finished = false;
+  void onKeyframe(const slam::KeyframeEvent& e) override {
+    EXPECT_EQ(e.index, keyframes);
+    EXPECT_NE(e.scan, nullptr);
+    ++keyframes;
+  }
+  void onStep(const slam::StepEvent&) override { ++steps; }
+  void onFinished() override { finished = true; }
+};
+}  // namespace
+
+TEST(DeadReckoningPipeline, KeyframesSitAtTheOdometryOfTheirTime) {
+  // Independent reference: the odometry reading the reader gives with each scan's timestamp.
+  std::map<double, common::Pose2> odom_at;
+  {
+    auto src = io::openDataSource(kExcerpt);
+    io::Measurement m;
+    while (src->next(m))
+      if (auto* o = std::get_if<io::OdometryReading>(&m)) odom_at[o->timestamp] = o->pose;
+  }
+  slam::PipelineOptions o;
+  o.keyframes.min_translation_m = 0.3;
+  o.keyframes.min_rotation_deg = 15;
+  slam::Pipeline p(o);
+  CountingObserver obs;
+  p.addObserver(&obs);
+  auto src = io::openDataSource(kExcerpt);
+  p.run(*src);
+  EXPECT_TRUE(obs.finished);
+  EXPECT_EQ(obs.steps, 80u);
+  EXPECT_EQ(obs.keyframes, p.keyframes().size());
+  ASSERT_GT(p.keyframes().size(), 10u);
+  ASSERT_LT(p.keyframes().size(), 80u);  // the rule dropped scans taken while standing still
+  for (size_t i = 0; i < p.keyframes().size(); ++i) {
+    const auto& k = p.keyframes()[i];
+    ASSERT_TRUE(odom_at.count(k.timestamp)) << k.timestamp;
+    EXPECT_NEAR(k.pose.x, odom_at[k.timestamp].x, 1e-12);
+    EXPECT_NEAR(k.pose.phi, odom_at[k.timestamp].phi, 1e-12);
+    if (i == 0) continue;
+    const auto d = common::between(p.keyframes()[i - 1].pose, k.pose);
+    EXPECT_TRUE(std::hypot(d.x, d.y) >= 0.3 || std::abs(d.phi) >= 15 * M_PI / 180) << "keyframe " << i;
+  }
+  EXPECT_EQ(p.referenceTrajectory().size(), 80u);
+}
+
+TEST(DeadReckoningPipeline, LaserLabelsSelectSensors) {
+  slam::PipelineOptions o;
+  o.input.laser_labels = "RLASER, ROBOTLASER1";
+  slam::Pipeline p(o);
+  auto src = io::openDataSource(kExcerpt);
+  p.run(*src);
+  EXPECT_EQ(p.stats().scans, 80u);
+  EXPECT_EQ(p.stats().scans_used, 0u);
+  EXPECT_TRUE(p.keyframes().empty());
+  o.input.laser_labels = "FLASER";
+  slam::Pipeline q(o);
+  auto src2 = io::openDataSource(kExcerpt);
+  q.run(*src2);
+  EXPECT_EQ(q.stats().scans_used, 80u);
+}
+
+TEST(DeadReckoningPipeline, RangeLimitsInvalidateBeams) {
+  slam::PipelineOptions o;
+  o.keyframes.min_translation_m = 0;  // every scan a keyframe
+  o.input.max_range_m = 2.0;
+  slam::Pipeline p(o);
+  auto src = io::openDataSource(kExcerpt);
+  p.run(*src);
+  size_t valid = 0;
+  for (const auto& k : p.keyframes())
+    for (size_t i = 0; i < k.scan.size(); ++i)
+      if (k.scan.valid[i]) {
+        ++valid;
+        EXPECT_LT(k.scan.ranges[i], 2.0f);
+      }
+  EXPECT_GT(valid, 100u);
+}
