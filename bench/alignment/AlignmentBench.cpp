@@ -1,0 +1,429 @@
+// Scan-alignment evaluation on real scans (issue 4).
+//
+// Pairs with a known relative pose:
+//  * Freiburg corrected logs: the FLASER poses (GMapping output) are the reference trajectory.
+//    "near" pairs are scans 1-3 apart in the log; "far" pairs are revisits: scans at least 50
+//    apart in the log whose reference poses are within 2 m and 45 deg (loop-closure-like).
+//  * Victoria Park has no reference trajectory (GPS only): its "near" pairs (scans 1-3 apart)
+//    use a pseudo-truth, the answer on which ICP and PL-ICP started from the identity agree
+//    (within 2 cm / 0.2 deg; pairs where they disagree are skipped). It measures the basin of
+//    convergence on outdoor scans, not absolute accuracy.
+// For each pair and initial-error level, every method starts from the same perturbed guess
+// (uniform in +-E metres on x and y, +-R degrees on phi). Success: final error < 0.1 m and < 1 deg.
+//
+// Covariance: on the smallest error level, each covariance method is evaluated on the
+// successful alignments of the default method: NEES = e^T C^-1 e, e = estimate - reference
+// (consistent: mean NEES ~ 3, 95 % of pairs below 7.81). The reference itself has errors
+// (GMapping), which inflate the NEES of every method alike.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <mrpt/maps/CSimplePointsMap.h>
+#include <mrpt/poses/CPose2D.h>
+#include <mrpt/poses/CPosePDF.h>
+#include <mrpt/slam/CICP.h>
+
+#include <Eigen/Dense>
+
+#include "urbanslam/alignment/Aligner.h"
+#include "urbanslam/common/Json.h"
+#include "urbanslam/common/Timing.h"
+#include "urbanslam/io/DataSource.h"
+
+namespace ua = urbanslam::alignment;
+namespace uc = urbanslam::common;
+namespace uio = urbanslam::io;
+
+namespace {
+
+struct Sample {
+  uio::LaserScan scan;
+  uc::Pose2 ref;
+  bool has_ref = false;
+};
+
+std::vector<Sample> loadLog(const std::string& path, size_t max_scans) {
+  auto src = uio::openDataSource(path);
+  std::vector<Sample> out;
+  uio::Measurement m;
+  bool have_ref = false;
+  uio::ReferencePose last_ref;
+  while (src->next(m) && out.size() < max_scans) {
+    if (auto* r = std::get_if<uio::ReferencePose>(&m)) {
+      last_ref = *r;
+      have_ref = true;
+    } else if (auto* s = std::get_if<uio::LaserScan>(&m)) {
+      Sample smp;
+      smp.scan = std::move(*s);
+      // The corrected CARMEN reader emits the reference pose right before its scan.
+      if (have_ref && std::abs(last_ref.timestamp - smp.scan.timestamp) < 1e-6) {
+        smp.ref = last_ref.pose;
+        smp.has_ref = true;
+      }
+      have_ref = false;
+      out.push_back(std::move(smp));
+    }
+  }
+  return out;
+}
+
+struct PairCase {
+  std::string group;
+  int a = 0, b = 0;
+  uc::Pose2 truth;  // pose of b in a (vehicle frames)
+};
+
+struct Method {
+  std::string name;
+  bool mrpt = false;
+  ua::AlignerOptions options;
+};
+
+struct Outcome {
+  bool success = false, converged = false;
+  double time_ms = 0, err_m = 0, err_deg = 0;
+  uc::Pose2 est;
+  Eigen::Matrix3d cov;
+};
+
+double uniform(std::mt19937& rng, double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); }
+
+// MRPT's CICP, classic ICP with its own shrinking threshold, on the same points.
+Outcome runMrpt(const ua::PointSet& a, const ua::PointSet& b, const uc::Pose2& guess) {
+  mrpt::maps::CSimplePointsMap ma, mb;
+  for (const auto& q : a) ma.insertPoint(static_cast<float>(q.p.x()), static_cast<float>(q.p.y()));
+  for (const auto& q : b) mb.insertPoint(static_cast<float>(q.p.x()), static_cast<float>(q.p.y()));
+  mrpt::slam::CICP icp;
+  icp.options.ICP_algorithm = mrpt::slam::icpClassic;
+  icp.options.thresholdDist = 1.5;  // same first gate as ours, for a fair basin
+  icp.options.thresholdAng = 0.15 * M_PI / 180.0;
+  icp.options.ALFA = 0.5;
+  icp.options.smallestThresholdDist = 0.1;
+  icp.options.maxIterations = 80;
+  icp.options.corresponding_points_decimation = 1;
+  icp.options.skip_cov_calculation = true;
+  mrpt::slam::CICP::TReturnInfo info;
+  Outcome o;
+  uc::Stopwatch sw;
+  if (a.size() < 3 || b.size() < 3) {
+    o.time_ms = sw.milliseconds();
+    o.est = guess;
+    return o;
+  }
+  const auto pdf = icp.Align(&ma, &mb, mrpt::poses::CPose2D(guess.x, guess.y, guess.phi), info);
+  o.time_ms = sw.milliseconds();
+  const mrpt::poses::CPose2D p = pdf->getMeanVal();
+  o.est = {p.x(), p.y(), p.phi()};
+  o.converged = info.goodness > 0.25;
+  return o;
+}
+
+void score(Outcome& o, const uc::Pose2& truth) {
+  o.err_m = std::hypot(o.est.x - truth.x, o.est.y - truth.y);
+  o.err_deg = std::abs(uc::wrapToPi(o.est.phi - truth.phi)) * 180.0 / M_PI;
+  o.success = o.err_m < 0.1 && o.err_deg < 1.0;
+}
+
+struct Args {
+  std::string data = URBANSLAM_SHARED_DATA_DIR;
+  int pairs = 60;  // per group
+  unsigned seed = 42;
+  std::string json;
+  std::string methods = "icp,plicp,crf,crf+icp,mrpt";
+  bool covariance = true;
+  bool verbose = false;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Args args;
+  for (int i = 1; i < argc; ++i) {
+    const std::string k = argv[i];
+    auto val = [&]() -> std::string {
+      if (i + 1 >= argc) { std::cerr << k << " needs a value\n"; std::exit(2); }
+      return argv[++i];
+    };
+    if (k == "--data") args.data = val();
+    else if (k == "--pairs") args.pairs = std::stoi(val());
+    else if (k == "--seed") args.seed = static_cast<unsigned>(std::stoul(val()));
+    else if (k == "--json") args.json = val();
+    else if (k == "--methods") args.methods = val();
+    else if (k == "--no-covariance") args.covariance = false;
+    else if (k == "--verbose") args.verbose = true;
+    else {
+      std::cerr << "usage: alignment_bench [--data DIR] [--pairs N] [--seed S] [--methods a,b] "
+                   "[--no-covariance] [--json OUT]\n";
+      return 2;
+    }
+  }
+  std::mt19937 rng(args.seed);
+
+  // Datasets: name, path, max scans kept.
+  struct Dataset {
+    std::string name, path;
+    size_t max_scans;
+    bool reference;
+  };
+  const std::vector<Dataset> datasets = {
+      {"intel", args.data + "/freiburg_slam_benchmark/corrected_logs/intel-corrected.log.gz", 100000, true},
+      {"csail", args.data + "/freiburg_slam_benchmark/corrected_logs/csail-corrected.log.gz", 100000, true},
+      {"fr079", args.data + "/freiburg_slam_benchmark/corrected_logs/freiburg-079-corrected.log.gz", 100000, true},
+      {"fr-campus", args.data + "/freiburg_slam_benchmark/corrected_logs/freiburg-campus-corrected.log.gz", 100000, true},
+      {"victoria", args.data + "/victoria_park/victoria_park_ascii.zip", 2000, false},
+  };
+
+  ua::AlignerOptions base;  // library defaults
+  std::vector<Method> methods;
+  {
+    std::string s = args.methods;
+    size_t pos = 0;
+    while (pos <= s.size()) {
+      const size_t c = std::min(s.find(',', pos), s.size());
+      const std::string n = s.substr(pos, c - pos);
+      pos = c + 1;
+      if (n.empty()) continue;
+      Method m;
+      m.name = n;
+      m.options = base;
+      if (n == "mrpt") m.mrpt = true;
+      else m.options.method = ua::parseMethod(n);
+      m.options.covariance.method = ua::CovarianceMethod::LineVariance;
+      methods.push_back(m);
+    }
+  }
+  struct Level {
+    double m, deg;
+  };
+  const std::vector<Level> levels = {{0.25, 10}, {0.5, 15}, {1.0, 30}, {2.0, 45}};
+
+  uc::Json report = uc::Json::object();
+  report["seed"] = static_cast<long>(args.seed);
+  report["pairs_per_group"] = args.pairs;
+  uc::Json results = uc::Json::array();
+  // Aggregates: key group|level|method.
+  struct Agg {
+    int n = 0, ok = 0, conv = 0;
+    std::vector<double> t;
+  };
+  std::map<std::string, Agg> agg;
+  std::vector<std::string> keys_order;
+  // NEES accumulators per covariance method.
+  std::map<std::string, std::vector<double>> nees;
+  std::map<std::string, std::vector<double>> cov_time;
+
+  for (const auto& ds : datasets) {
+    std::vector<Sample> samples;
+    try {
+      samples = loadLog(ds.path, ds.max_scans);
+    } catch (const std::exception& e) {
+      std::cerr << "skip " << ds.name << ": " << e.what() << "\n";
+      continue;
+    }
+    if (samples.size() < 100) {
+      std::cerr << "skip " << ds.name << ": only " << samples.size() << " scans\n";
+      continue;
+    }
+    std::cerr << ds.name << ": " << samples.size() << " scans, " << samples[0].scan.size() << " beams\n";
+    std::vector<PairCase> cases;
+    // Near pairs.
+    for (int tries = 0; static_cast<int>(cases.size()) < args.pairs && tries < args.pairs * 50; ++tries) {
+      const int a = static_cast<int>(uniform(rng, 0, samples.size() - 4));
+      const int b = a + 1 + static_cast<int>(uniform(rng, 0, 3));
+      PairCase pc;
+      pc.group = ds.name + "/near";
+      pc.a = a;
+      pc.b = b;
+      if (ds.reference) {
+        if (!samples[a].has_ref || !samples[b].has_ref) continue;
+        pc.truth = uc::between(samples[a].ref, samples[b].ref);
+      } else {
+        // Pseudo-truth: ICP and PL-ICP from the identity must agree.
+        ua::AlignerOptions o = base;
+        o.method = ua::Method::Icp;
+        const auto r1 = ua::align(samples[a].scan, samples[b].scan, {}, o);
+        o.method = ua::Method::PlIcp;
+        const auto r2 = ua::align(samples[a].scan, samples[b].scan, {}, o);
+        if (!r1.converged || !r2.converged) continue;
+        if (std::hypot(r1.transform.x - r2.transform.x, r1.transform.y - r2.transform.y) > 0.02 ||
+            std::abs(uc::wrapToPi(r1.transform.phi - r2.transform.phi)) > 0.2 * M_PI / 180)
+          continue;
+        pc.truth = r2.transform;
+      }
+      cases.push_back(pc);
+    }
+    // Far pairs (revisits), reference datasets only.
+    if (ds.reference) {
+      int found = 0;
+      for (int tries = 0; found < args.pairs && tries < args.pairs * 2000; ++tries) {
+        const int a = static_cast<int>(uniform(rng, 0, samples.size()));
+        const int b = static_cast<int>(uniform(rng, 0, samples.size()));
+        if (std::abs(a - b) < 50 || !samples[a].has_ref || !samples[b].has_ref) continue;
+        const uc::Pose2 t = uc::between(samples[a].ref, samples[b].ref);
+        if (std::hypot(t.x, t.y) > 2.0 || std::abs(t.phi) > M_PI / 4) continue;
+        cases.push_back({ds.name + "/far", a, b, t});
+        ++found;
+      }
+    }
+
+    for (const auto& pc : cases) {
+      const auto& sa = samples[pc.a].scan;
+      const auto& sb = samples[pc.b].scan;
+      const ua::PointSet pa = ua::pointSetFromScan(sa, base.scan, true);
+      const ua::PointSet pb = ua::pointSetFromScan(sb, base.scan, true);
+      for (size_t li = 0; li < levels.size(); ++li) {
+        const Level& L = levels[li];
+        const uc::Pose2 guess{pc.truth.x + uniform(rng, -L.m, L.m), pc.truth.y + uniform(rng, -L.m, L.m),
+                              uc::wrapToPi(pc.truth.phi + uniform(rng, -L.deg, L.deg) * M_PI / 180)};
+        for (const auto& m : methods) {
+          Outcome o;
+          if (m.mrpt) {
+            o = runMrpt(pa, pb, guess);
+          } else {
+            ua::AlignerOptions opt = m.options;
+            const auto r = ua::align(sa, sb, guess, opt);
+            o.est = r.transform;
+            o.converged = r.converged;
+            o.time_ms = r.time_ms - r.covariance_time_ms;
+            o.cov = r.cov;
+          }
+          score(o, pc.truth);
+          if (args.verbose)
+            std::fprintf(stderr, "%s %d-%d L%zu %-8s conv %d ok %d err %.3f m %.2f deg  truth %.3f %.3f %.2f est %.3f %.3f %.2f  %.2f ms\n",
+                         pc.group.c_str(), pc.a, pc.b, li, m.name.c_str(), o.converged, o.success, o.err_m,
+                         o.err_deg, pc.truth.x, pc.truth.y, pc.truth.phi * 180 / M_PI, o.est.x, o.est.y,
+                         o.est.phi * 180 / M_PI, o.time_ms);
+          char key[200];
+          std::snprintf(key, sizeof key, "%s|%.2f m %2.0f deg|%s", pc.group.c_str(), L.m, L.deg, m.name.c_str());
+          if (!agg.count(key)) keys_order.push_back(key);
+          Agg& g = agg[key];
+          ++g.n;
+          g.ok += o.success;
+          g.conv += o.converged;
+          g.t.push_back(o.time_ms);
+
+          // Covariance NEES on the smallest level, for the default method's successes.
+          if (args.covariance && li == 0 && !m.mrpt && m.options.method == base.method && o.success &&
+              ds.reference) {
+            for (auto cm : {ua::CovarianceMethod::LineVariance, ua::CovarianceMethod::Hessian,
+                            ua::CovarianceMethod::Sampling}) {
+              ua::CovarianceOptions co = base.covariance;
+              co.method = cm;
+              uc::Stopwatch sw;
+              const Eigen::Matrix3d C = ua::alignmentCovariance(pa, pb, o.est, base.icp,
+                                                                base.refine_point_to_line, co);
+              cov_time[ua::covarianceMethodName(cm)].push_back(sw.milliseconds());
+              const Eigen::Vector3d e(o.est.x - pc.truth.x, o.est.y - pc.truth.y,
+                                      uc::wrapToPi(o.est.phi - pc.truth.phi));
+              const double v = e.dot(C.ldlt().solve(e));
+              nees[ua::covarianceMethodName(cm)].push_back(v);
+            }
+          }
+        }
+      }
+    }
+  }
+
+  // Table: per group and level, one column per method.
+  std::printf("%-26s %-14s", "pairs", "initial error");
+  for (const auto& m : methods) std::printf(" | %-22s", m.name.c_str());
+  std::printf("\n%-26s %-14s", "", "");
+  for (size_t i = 0; i < methods.size(); ++i) std::printf(" | %-22s", "success  med/p95 ms");
+  std::printf("\n");
+  std::vector<std::string> rows;
+  for (const auto& k : keys_order) {
+    const std::string row = k.substr(0, k.rfind('|'));
+    if (std::find(rows.begin(), rows.end(), row) == rows.end()) rows.push_back(row);
+  }
+  // Totals per level and method over all groups with a real reference.
+  std::map<std::string, Agg> total;
+  for (const auto& row : rows) {
+    const std::string group = row.substr(0, row.find('|'));
+    const std::string level = row.substr(row.find('|') + 1);
+    std::printf("%-26s %-14s", group.c_str(), level.c_str());
+    for (const auto& m : methods) {
+      const Agg& g = agg[row + "|" + m.name];
+      std::printf(" | %5.1f %%  %5.2f/%6.2f", g.n ? 100.0 * g.ok / g.n : 0.0, uc::percentile(g.t, 50),
+                  uc::percentile(g.t, 95));
+      uc::Json j = uc::Json::object();
+      j["group"] = group;
+      j["initial_error"] = level;
+      j["method"] = m.name;
+      j["pairs"] = g.n;
+      j["success_rate"] = g.n ? static_cast<double>(g.ok) / g.n : 0.0;
+      j["converged_rate"] = g.n ? static_cast<double>(g.conv) / g.n : 0.0;
+      j["time_ms_median"] = uc::percentile(g.t, 50);
+      j["time_ms_p95"] = uc::percentile(g.t, 95);
+      results.push(j);
+      if (group.find("victoria") == std::string::npos) {
+        Agg& t = total[level + "|" + m.name];
+        t.n += g.n;
+        t.ok += g.ok;
+        t.t.insert(t.t.end(), g.t.begin(), g.t.end());
+      }
+    }
+    std::printf("\n");
+  }
+  std::printf("\nAll Freiburg pairs (near + far):\n");
+  uc::Json totals = uc::Json::array();
+  for (const auto& L : levels) {
+    char level[64];
+    std::snprintf(level, sizeof level, "%.2f m %2.0f deg", L.m, L.deg);
+    std::printf("%-26s %-14s", "freiburg/all", level);
+    for (const auto& m : methods) {
+      const Agg& g = total[std::string(level) + "|" + m.name];
+      std::printf(" | %5.1f %%  %5.2f/%6.2f", g.n ? 100.0 * g.ok / g.n : 0.0, uc::percentile(g.t, 50),
+                  uc::percentile(g.t, 95));
+      uc::Json j = uc::Json::object();
+      j["initial_error"] = level;
+      j["method"] = m.name;
+      j["pairs"] = g.n;
+      j["success_rate"] = g.n ? static_cast<double>(g.ok) / g.n : 0.0;
+      j["time_ms_median"] = uc::percentile(g.t, 50);
+      totals.push(j);
+    }
+    std::printf("\n");
+  }
+  report["results"] = results;
+  report["freiburg_totals"] = totals;
+
+  if (args.covariance) {
+    std::printf("\nCovariance NEES (%s, successes at the smallest error level; consistent: mean ~ 3, 95 %% < 7.81)\n",
+                ua::methodName(base.method).c_str());
+    uc::Json nj = uc::Json::array();
+    for (const auto& [name, v] : nees) {
+      double mean = 0;
+      int in95 = 0;
+      for (double x : v) {
+        mean += x;
+        in95 += x < 7.81;
+      }
+      mean /= std::max<size_t>(1, v.size());
+      std::printf("  %-10s n=%4zu  mean NEES %10.2f  median %8.2f  within 95%% bound %5.1f %%  time %.2f ms\n",
+                  name.c_str(), v.size(), mean, uc::percentile(v, 50), 100.0 * in95 / std::max<size_t>(1, v.size()),
+                  uc::percentile(cov_time[name], 50));
+      uc::Json j = uc::Json::object();
+      j["method"] = name;
+      j["n"] = v.size();
+      j["mean_nees"] = mean;
+      j["median_nees"] = uc::percentile(v, 50);
+      j["fraction_within_95"] = static_cast<double>(in95) / std::max<size_t>(1, v.size());
+      j["time_ms_median"] = uc::percentile(cov_time[name], 50);
+      nj.push(j);
+    }
+    report["covariance_nees"] = nj;
+  }
+  if (!args.json.empty()) {
+    std::ofstream(args.json) << report.dump(2) << "\n";
+    std::cerr << "wrote " << args.json << "\n";
+  }
+  return 0;
+}
