@@ -36,6 +36,15 @@ void Pipeline::applyRangeLimits(io::LaserScan& scan) const {
 }
 
 bool Pipeline::step(io::DataSource& source) {
+  // Processing time (reading included) accumulates here, so a paused GUI run reports the same
+  // real-time factor as a batch run.
+  common::Stopwatch sw;
+  const bool more = stepOnce(source);
+  stats_.wall_s += sw.seconds();
+  return more;
+}
+
+bool Pipeline::stepOnce(io::DataSource& source) {
   io::Measurement m;
   if (!source.next(m)) return false;
   ++stats_.measurements;
@@ -57,8 +66,9 @@ bool Pipeline::step(io::DataSource& source) {
   } else if (const auto* ref = std::get_if<io::ReferencePose>(&m)) {
     ++stats_.reference;
     reference_.push_back({ref->timestamp, ref->pose});
-  } else if (std::holds_alternative<io::CameraImage>(m)) {
+  } else if (const auto* img = std::get_if<io::CameraImage>(&m)) {
     ++stats_.images;
+    for (auto* o : observers_) o->onImage(*img);
   } else if (std::holds_alternative<io::GpsFix>(m)) {
     ++stats_.gps;
   }
@@ -66,10 +76,12 @@ bool Pipeline::step(io::DataSource& source) {
 }
 
 void Pipeline::run(io::DataSource& source) {
-  common::Stopwatch wall;
   while (step(source)) {
   }
-  stats_.wall_s = wall.seconds();
+  finish();
+}
+
+void Pipeline::finish() {
   stats_.keyframes = keyframes_.size();
   for (auto* o : observers_) o->onFinished();
 }
@@ -116,7 +128,7 @@ void Pipeline::onScan(io::LaserScan scan, double progress) {
     Keyframe kf{keyframes_.size(), scan.timestamp, pose, std::move(scan)};
     keyframes_.push_back(std::move(kf));
     const Keyframe& k = keyframes_.back();
-    for (auto* o : observers_) o->onKeyframe({k.index, k.timestamp, k.pose, &k.scan});
+    for (auto* o : observers_) o->onKeyframe({k.index, k.timestamp, k.pose, {}, &k.scan});
   }
   const double ms = sw.milliseconds();
   stats_.step_ms.push_back(ms);

@@ -2,10 +2,14 @@
 // What the pipeline reports while it runs. The CLI (progress, stats) and the GUI subscribe;
 // the library never knows who listens. Callbacks run on the pipeline's thread and must be
 // quick: a GUI copies what it needs and redraws on its own thread.
+#include <array>
 #include <cstddef>
+#include <string>
+#include <vector>
 
 #include "urbanslam/common/Pose2.h"
 #include "urbanslam/io/LaserScan.h"
+#include "urbanslam/io/Measurements.h"
 
 namespace urbanslam::slam {
 
@@ -13,7 +17,30 @@ struct KeyframeEvent {
   size_t index = 0;             // keyframe id (0-based, in creation order)
   double timestamp = 0;
   common::Pose2 pose;           // current estimate of the vehicle pose
+  // Marginal covariance of (x, y, phi), row-major; all zero when the estimator has none
+  // (dead reckoning).
+  std::array<double, 9> covariance{};
   const io::LaserScan* scan = nullptr;  // valid during the callback (the pipeline keeps it)
+};
+
+// The estimates of earlier keyframes changed (after a loop closure): poses[i] is keyframe i.
+struct PosesUpdatedEvent {
+  const std::vector<common::Pose2>* poses = nullptr;
+};
+
+// A loop-closure hypothesis between the current keyframe and an earlier one, and its fate.
+struct LoopClosureEvent {
+  size_t from_keyframe = 0, to_keyframe = 0;  // earlier, current
+  double timestamp = 0;
+  std::string detector;      // "laser", "image"
+  double score = 0;
+  bool accepted = false;
+  std::string reason;        // why rejected: "classifier", "alignment", "gating"; empty if accepted
+};
+
+struct CandidatesEvent {
+  size_t keyframe = 0;                 // the current keyframe
+  const std::vector<size_t>* candidates = nullptr;
 };
 
 struct StepEvent {
@@ -28,6 +55,10 @@ class PipelineObserver {
  public:
   virtual ~PipelineObserver() = default;
   virtual void onKeyframe(const KeyframeEvent&) {}
+  virtual void onPosesUpdated(const PosesUpdatedEvent&) {}
+  virtual void onCandidates(const CandidatesEvent&) {}
+  virtual void onLoopClosure(const LoopClosureEvent&) {}
+  virtual void onImage(const io::CameraImage&) {}
   virtual void onStep(const StepEvent&) {}
   virtual void onFinished() {}
 };

@@ -23,7 +23,7 @@ struct PipelineStats {
   size_t measurements = 0, scans = 0, scans_used = 0, odometry = 0, drive = 0, images = 0, gps = 0,
          reference = 0, keyframes = 0;
   double first_timestamp = 0, last_timestamp = 0;
-  double wall_s = 0;
+  double wall_s = 0;             // processing time, reading included
   std::vector<double> step_ms;  // per processed scan
 };
 
@@ -35,8 +35,10 @@ class Pipeline {
   void addObserver(PipelineObserver* observer);
   // Processes one measurement. Returns false when the input is exhausted.
   bool step(io::DataSource& source);
-  // Runs to the end of the input.
+  // Runs to the end of the input, then finish().
   void run(io::DataSource& source);
+  // Tells observers the run is complete (call once after the last step()).
+  void finish();
 
   const std::vector<Keyframe>& keyframes() const { return keyframes_; }
   // Estimated pose at every odometry (or drive) reading's time.
@@ -49,6 +51,7 @@ class Pipeline {
   std::vector<io::PosedScan> posedKeyframes() const;
 
  private:
+  bool stepOnce(io::DataSource& source);
   void onScan(io::LaserScan scan, double progress);
   void onOdometry(const io::OdometryReading& m);
   void onDrive(const io::DriveReading& m);

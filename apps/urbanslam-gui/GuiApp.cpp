@@ -1,0 +1,70 @@
+// urbanslam-gui [FILE] [--ini FILE] [--autorun] [--screenshot FILE] [--exit-when-done]
+#include <wx/app.h>
+#include <wx/image.h>
+
+#include <cstring>
+#include <iostream>
+
+#include "MainFrame.h"
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: urbanslam-gui [FILE] [--ini FILE] [--autorun] [--screenshot FILE] [--exit-when-done]\n\n"
+    "Opens a log (MRPT rawlog, CARMEN log, Victoria Park folder/zip; default: the shipped\n"
+    "rawlogs/intel.rawlog) and shows the map and its loop closures as they are built.\n\n"
+    "  --ini FILE          configuration (default: ini/default.ini)\n"
+    "  --autorun           start processing at once\n"
+    "  --screenshot FILE   with --exit-when-done: save the final view as PNG\n"
+    "  --exit-when-done    quit when the log is processed; prints one JSON line with what was drawn\n";
+
+class GuiApp : public wxApp {
+ public:
+  bool OnInit() override {
+    wxInitAllImageHandlers();
+    urbanslam::gui::GuiOptions o;
+    const std::string home = [] {
+      const char* h = std::getenv("URBANSLAM_HOME");
+      return std::string(h && *h ? h : URBANSLAM_SOURCE_DIR);
+    }();
+    o.ini = home + "/ini/default.ini";
+    for (int i = 1; i < argc; ++i) {
+      const std::string a = argv[i].ToStdString();
+      const auto value = [&]() -> std::string {
+        if (i + 1 >= argc) {
+          std::cerr << "urbanslam-gui: error: " << a << " needs a value\n";
+          std::exit(2);
+        }
+        return argv[++i].ToStdString();
+      };
+      if (a == "--help" || a == "-h") {
+        std::cout << kUsage;
+        std::exit(0);
+      } else if (a == "--ini") o.ini = value();
+      else if (a == "--screenshot") o.screenshot = value();
+      else if (a == "--autorun") o.autorun = true;
+      else if (a == "--exit-when-done") o.exit_when_done = true;
+      else if (a.rfind("--", 0) == 0) {
+        std::cerr << "urbanslam-gui: error: unknown option " << a << " (see --help)\n";
+        std::exit(2);
+      } else o.log = a;
+    }
+    if (o.log.empty()) o.log = home + "/rawlogs/intel.rawlog";
+    frame_ = new urbanslam::gui::MainFrame(o);
+    frame_->Show();
+    return true;
+  }
+  int OnRun() override {
+    wxApp::OnRun();
+    return urbanslam::gui::g_exit_code;
+  }
+
+ private:
+  urbanslam::gui::MainFrame* frame_ = nullptr;
+};
+
+}  // namespace
+
+wxIMPLEMENT_APP_NO_MAIN(GuiApp);
+
+int main(int argc, char** argv) { return wxEntry(argc, argv); }

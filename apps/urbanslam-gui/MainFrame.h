@@ -1,0 +1,66 @@
+#pragma once
+// The main window: map view, side panels, menus (File/Run/View/Export), toolbar and status bar.
+// The pipeline runs in a PipelineWorker thread; a 20 Hz timer redraws from its snapshots.
+#include <wx/filehistory.h>
+#include <wx/frame.h>
+#include <wx/notebook.h>
+#include <wx/timer.h>
+
+#include <memory>
+#include <string>
+
+#include "MapCanvas.h"
+#include "SidePanels.h"
+#include "model/DrawList.h"
+#include "model/PipelineWorker.h"
+
+namespace urbanslam::gui {
+
+// Exit code of the process (set by the frame: 2 for bad input in unattended runs).
+inline int g_exit_code = 0;
+
+struct GuiOptions {
+  std::string log, ini;
+  bool autorun = false;
+  bool exit_when_done = false;
+  std::string screenshot;
+};
+
+class MainFrame : public wxFrame {
+ public:
+  explicit MainFrame(const GuiOptions& options);
+  ~MainFrame() override;
+
+  // Opens a log with the current ini; errors go to a dialog (the window stays).
+  bool openLog(const std::string& path);
+  bool loadIni(const std::string& path);
+
+ private:
+  void buildMenus();
+  void buildToolbar();
+  void onTimer(wxTimerEvent&);
+  void refreshView(bool force);
+  void restart();
+  void showError(const std::string& message);
+  void exportWith(const wxString& title, const wxString& wildcard, const wxString& default_name,
+                  const std::function<void(const slam::Pipeline&, const std::string&)>& write);
+  void finishAutomaticRun();
+  void updateTitle();
+
+  GuiOptions options_;
+  std::unique_ptr<PipelineWorker> worker_;
+  MapCanvas* canvas_ = nullptr;
+  wxNotebook* notebook_ = nullptr;
+  StatsPanel* stats_ = nullptr;
+  ClosuresPanel* closures_ = nullptr;
+  CameraPanel* camera_ = nullptr;
+  KeyframePanel* keyframe_ = nullptr;
+  wxTimer timer_;
+  wxFileHistory history_;
+  Layers layers_;
+  size_t drawn_version_ = static_cast<size_t>(-1);
+  MapSnapshot last_snapshot_;
+  bool auto_finished_ = false;
+};
+
+}  // namespace urbanslam::gui

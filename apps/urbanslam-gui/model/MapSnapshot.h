@@ -1,0 +1,44 @@
+#pragma once
+// A consistent copy of what the pipeline has built so far, handed from the pipeline's thread to
+// the GUI. Keyframe scans are shared (immutable once made), so a snapshot costs a copy of the
+// poses and small vectors, not of the map points.
+#include <array>
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "urbanslam/common/Pose2.h"
+#include "urbanslam/io/LaserScan.h"
+#include "urbanslam/io/Measurements.h"
+#include "urbanslam/slam/Observer.h"
+
+namespace urbanslam::gui {
+
+struct KeyframeView {
+  size_t index = 0;
+  double timestamp = 0;
+  common::Pose2 pose;
+  std::shared_ptr<const std::vector<io::Point2>> points;  // scan points in the vehicle frame
+};
+
+struct RunStats {
+  size_t scans = 0, keyframes = 0, closures_accepted = 0, closures_rejected = 0;
+  double log_time_s = 0;      // log time covered so far
+  double processing_s = 0;    // time spent in the pipeline
+  double progress = 0;
+  std::vector<double> step_ms;  // recent per-scan processing times (bounded)
+};
+
+struct MapSnapshot {
+  size_t version = 0;  // increases with every change; the GUI redraws only on a new version
+  std::vector<KeyframeView> keyframes;
+  std::array<double, 9> current_covariance{};
+  std::vector<slam::LoopClosureEvent> closures;
+  std::vector<size_t> candidates;  // of the current keyframe
+  std::shared_ptr<const io::CameraImage> last_image;
+  RunStats stats;
+  bool finished = false;
+};
+
+}  // namespace urbanslam::gui

@@ -1,0 +1,79 @@
+#include "SnapshotCollector.h"
+
+namespace urbanslam::gui {
+
+void SnapshotCollector::onKeyframe(const slam::KeyframeEvent& e) {
+  // Converting the scan to points happens outside the lock.
+  auto pts = std::make_shared<const std::vector<io::Point2>>(io::scanToPoints(*e.scan, true));
+  std::lock_guard<std::mutex> lock(mutex_);
+  state_.keyframes.push_back({e.index, e.timestamp, e.pose, std::move(pts)});
+  state_.current_covariance = e.covariance;
+  state_.stats.keyframes = state_.keyframes.size();
+  ++state_.version;
+}
+
+void SnapshotCollector::onPosesUpdated(const slam::PosesUpdatedEvent& e) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (size_t i = 0; i < e.poses->size() && i < state_.keyframes.size(); ++i) state_.keyframes[i].pose = (*e.poses)[i];
+  ++state_.version;
+}
+
+void SnapshotCollector::onCandidates(const slam::CandidatesEvent& e) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  state_.candidates = *e.candidates;
+  ++state_.version;
+}
+
+void SnapshotCollector::onLoopClosure(const slam::LoopClosureEvent& e) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  state_.closures.push_back(e);
+  (e.accepted ? state_.stats.closures_accepted : state_.stats.closures_rejected)++;
+  ++state_.version;
+}
+
+void SnapshotCollector::onImage(const io::CameraImage& image) {
+  auto copy = std::make_shared<const io::CameraImage>(image);
+  std::lock_guard<std::mutex> lock(mutex_);
+  state_.last_image = std::move(copy);
+  ++state_.version;
+}
+
+void SnapshotCollector::onStep(const slam::StepEvent& e) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto& s = state_.stats;
+  if (first_timestamp_ < 0) first_timestamp_ = e.timestamp;
+  s.scans = e.scans;
+  s.log_time_s = e.timestamp - first_timestamp_;
+  s.processing_s += e.step_ms / 1000.0;
+  s.progress = e.progress;
+  if (s.step_ms.size() >= kStepHistory) s.step_ms.erase(s.step_ms.begin(), s.step_ms.begin() + kStepHistory / 2);
+  s.step_ms.push_back(e.step_ms);
+  ++state_.version;
+}
+
+void SnapshotCollector::onFinished() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  state_.finished = true;
+  state_.stats.progress = 1.0;
+  ++state_.version;
+}
+
+MapSnapshot SnapshotCollector::snapshot() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return state_;
+}
+
+size_t SnapshotCollector::version() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return state_.version;
+}
+
+void SnapshotCollector::clear() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const size_t v = state_.version;
+  state_ = MapSnapshot{};
+  state_.version = v + 1;
+  first_timestamp_ = -1;
+}
+
+}  // namespace urbanslam::gui

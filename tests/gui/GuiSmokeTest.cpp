@@ -1,0 +1,53 @@
+// The real window under Xvfb on the shipped rawlog: exits 0, draws as many keyframes as the CLI
+// reports for the same input, and the screenshot shows the map.
+#include <gtest/gtest.h>
+
+#include <mrpt/img/CImage.h>
+
+#include <cstdlib>
+#include <filesystem>
+
+#include "CliRunner.h"
+#include "model/DrawList.h"
+
+using namespace urbanslam;
+namespace fs = std::filesystem;
+
+namespace {
+size_t jsonCount(const std::string& json, const std::string& key) {
+  const auto p = json.find("\"" + key + "\":");
+  if (p == std::string::npos) return static_cast<size_t>(-1);
+  return std::stoul(json.substr(p + key.size() + 3));
+}
+}  // namespace
+
+TEST(GuiSmoke, AutorunUnderXvfbDrawsTheMap) {
+  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run not installed (make deps)";
+  const fs::path d = test::scratchDir("gui_smoke");
+  const std::string shot = (d / "view.png").string(), out = (d / "gui.json").string();
+  const std::string cmd = "xvfb-run -a -s '-screen 0 1280x800x24' " + std::string(URBANSLAM_GUI) +
+                          " --autorun --exit-when-done --screenshot " + shot + " > " + out + " 2>" + (d / "err.txt").string();
+  const int status = std::system(cmd.c_str());
+  const std::string json = test::slurp(out);
+  ASSERT_EQ(WEXITSTATUS(status), 0) << json << test::slurp((d / "err.txt").string());
+  const test::CliResult cli = test::runCli("run --quiet --json --out " + (d / "cli").string());
+  ASSERT_EQ(cli.code, 0);
+  const size_t cli_keyframes = jsonCount(cli.out, "keyframes");
+  EXPECT_EQ(jsonCount(json, "keyframes_drawn"), cli_keyframes) << json;
+  EXPECT_GT(cli_keyframes, 100u);
+
+  mrpt::img::CImage img;
+  ASSERT_TRUE(img.loadFromFile(shot)) << shot;
+  const auto bg = gui::palette::kBackground;
+  size_t map = 0, total = 0;
+  for (unsigned y = 0; y < img.getHeight(); y += 2)
+    for (unsigned x = 0; x < img.getWidth(); x += 2) {
+      const uint8_t* px = img.ptr<uint8_t>(x, y);  // BGR
+      const int b = px[0], g = px[1], r = px[2];
+      ++total;
+      // Map points are coloured (saturated); the background and grid are grey.
+      const int spread = std::max({r, g, b}) - std::min({r, g, b});
+      if (spread > 60 && std::abs(r - bg.r) + std::abs(g - bg.g) + std::abs(b - bg.b) > 90) ++map;
+    }
+  EXPECT_GT(static_cast<double>(map) / static_cast<double>(total), 0.02) << map << " of " << total << " pixels in map colours";
+}
