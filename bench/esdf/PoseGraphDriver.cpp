@@ -2,6 +2,9 @@
 // and prints one line per file (chi2, time, recoveries). For tuning and quick comparisons; the
 // user-facing tool is `urbanslam graph`.
 //   esdf_pose_graph [--every N] [--innov CHI2] [--window W] [--passes P] [--no-relin] FILE...
+//   esdf_pose_graph --eval EDGES_FILE POSES_FILE   chi2 of EDGES_FILE's edges at POSES_FILE's vertices
+//   esdf_pose_graph --init IN OUT                  IN with dead-reckoned vertices (for batch tools
+//                                                  that need VERTEX lines), written as g2o
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -17,12 +20,34 @@ int main(int argc, char** argv) {
   int rc = 0;
   for (int a = 1; a < argc; ++a) {
     auto next = [&]() { return a + 1 < argc ? argv[++a] : (std::fprintf(stderr, "missing value\n"), std::exit(2), ""); };
+    if (!std::strcmp(argv[a], "--eval") && a + 2 < argc) {
+      const esdf::PoseGraph edges = esdf::readPoseGraph(argv[a + 1]);
+      const esdf::PoseGraph poses = esdf::readPoseGraph(argv[a + 2]);
+      std::vector<long> ids;
+      std::vector<esdf::Vec3> x;
+      for (const auto& v : poses.vertices) {
+        ids.push_back(v.id);
+        x.push_back(v.pose);
+      }
+      std::printf("%.6f\n", esdf::poseGraphChi2(edges, x, ids));
+      return 0;
+    }
+    if (!std::strcmp(argv[a], "--init") && a + 2 < argc) {
+      // Dead reckoning through the back end's augmenting edges = the filter before any update.
+      esdf::PoseGraph g = esdf::readPoseGraph(argv[a + 1]);
+      o.dead_reckoning_only = true;
+      o.filter.relinearise = false;
+      const auto r = esdf::runPoseGraphBackend(g, o);
+      esdf::writePoseGraph(esdf::withPoses(g, r), argv[a + 2], esdf::PoseGraphFormat::G2o);
+      return 0;
+    }
     if (!std::strcmp(argv[a], "--every")) o.full_recovery_every_closures = std::atoi(next());
     else if (!std::strcmp(argv[a], "--innov")) o.full_recovery_innovation_chi2 = std::atof(next());
     else if (!std::strcmp(argv[a], "--window")) o.recent_window_poses = std::atoi(next());
     else if (!std::strcmp(argv[a], "--passes")) o.incremental_relinearise_passes = std::atoi(next());
     else if (!std::strcmp(argv[a], "--no-relin")) o.filter.relinearise = false;
     else if (!std::strcmp(argv[a], "--gate")) o.gate_loop_closures = true;
+    else if (!std::strcmp(argv[a], "--gap")) o.full_recovery_min_gap_fraction = std::atof(next());
     else {
       try {
         common::Stopwatch sw;
@@ -30,9 +55,9 @@ int main(int argc, char** argv) {
         const double read_s = sw.seconds();
         const auto r = esdf::runPoseGraphBackend(g, o);
         std::printf("%-60s poses %6zu edges %6d chi2 %14.6f time %7.3f s (read %.3f, recovery %.3f) full %5d partial %5d "
-                    "relin %8lld p50 %.4f p99 %.4f ms\n",
+                    "relin %8lld final passes %d%s p50 %.4f p99 %.4f ms\n",
                     argv[a], r.poses.size(), r.edges, r.chi2, r.time_s, read_s, r.recovery_s, r.full_recoveries,
-                    r.partial_recoveries, r.factors_relinearised, common::percentile(r.step_ms, 50),
+                    r.partial_recoveries, r.factors_relinearised, r.final_relinearise_passes, r.converged ? " (converged)" : " (NOT converged)", common::percentile(r.step_ms, 50),
                     common::percentile(r.step_ms, 99));
       } catch (const std::exception& e) {
         std::fprintf(stderr, "%s: %s\n", argv[a], e.what());

@@ -226,7 +226,10 @@ RecoveryStats Esdf::recover(int max_passes) {
     for (int p = 0; p < size(); ++p) state_.setMean(p, mu.segment<3>(3 * p));
     if (!options_.relinearise || pass >= max_passes) break;
     const long long n = relineariseMoved();
-    if (n == 0) break;
+    if (n == 0) {
+      st.converged = true;
+      break;
+    }
     st.relinearise_passes = pass + 1;
     st.factors_relinearised += n;
   }

@@ -70,6 +70,7 @@ PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBa
   res.step_ms.reserve(g.edges.size());
 
   int pending = 0;
+  int last_full_size = 1;
   for (int k = 1; k < n; ++k) {
     const int b0 = bucket_start[k], b1 = bucket_start[k + 1];
     // The augmenting edge: to the previous pose when there is one, else the first edge.
@@ -106,6 +107,10 @@ PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBa
         }
         ++res.augment_edges;
       } else {
+        if (opt.dead_reckoning_only) {
+          res.step_ms.push_back(sw.milliseconds());
+          continue;
+        }
         bool accepted = true;
         if (opt.gate_loop_closures) {
           GateResult gr = filter.gateRelative(a, b, e.measurement, e.information);
@@ -133,7 +138,10 @@ PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBa
       }
       if (q + 1 == b1 && closures > 0) {
         pending += closures;
-        if (pending >= opt.full_recovery_every_closures || max_chi2 > opt.full_recovery_innovation_chi2) {
+        const bool wanted = pending >= opt.full_recovery_every_closures || max_chi2 > opt.full_recovery_innovation_chi2;
+        const bool allowed = k + 1 - last_full_size >= opt.full_recovery_min_gap_fraction * last_full_size;
+        if (wanted && allowed) {
+          last_full_size = k + 1;
           const RecoveryStats st = filter.recover(opt.incremental_relinearise_passes);
           res.recovery_s += st.seconds;
           res.factors_relinearised += st.factors_relinearised;
@@ -152,6 +160,8 @@ PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBa
     const RecoveryStats st = filter.recover();
     res.recovery_s += st.seconds;
     res.factors_relinearised += st.factors_relinearised;
+    res.final_relinearise_passes = st.relinearise_passes;
+    res.converged = st.converged;
     ++res.full_recoveries;
     if (!res.step_ms.empty()) res.step_ms.back() += sw.milliseconds();
   }

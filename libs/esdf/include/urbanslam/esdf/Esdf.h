@@ -65,6 +65,7 @@ struct ObservationResult {
 struct RecoveryStats {
   int relinearise_passes = 0;
   long long factors_relinearised = 0;
+  bool converged = false;  // the last relinearisation pass found nothing to relinearise
   double seconds = 0;
 };
 

@@ -23,12 +23,18 @@ struct PoseGraphBackendOptions {
   // ...or at once when a closure's innovation chi2 e' Omega e exceeds this (the estimate is far
   // from what the closure says, so deferring would linearise later closures badly).
   double full_recovery_innovation_chi2 = 50.0;
+  // ...but never sooner than this fraction of the trajectory after the previous one: full
+  // recoveries then come at geometrically spaced sizes, so their total cost stays a small
+  // multiple of one recovery of the final graph however many loop closures there are.
+  double full_recovery_min_gap_fraction = 0.25;
   // Relinearise + re-solve rounds in each incremental full recovery (the final recovery uses
   // filter.relinearise_max_passes): one round per recovery keeps the step cost bounded while
   // the linearisation error is still worked off over the following recoveries.
   int incremental_relinearise_passes = 1;
   // Poses re-solved by the partial recovery after a loop closure that did not trigger a full one.
-  int recent_window_poses = 200;
+  int recent_window_poses = 50;
+  // Only the augmenting edges (dead reckoning through the spanning edges; for initial guesses).
+  bool dead_reckoning_only = false;
   // Pose 0's prior (anchors the gauge freedom, as fixing the first vertex does in g2o).
   double anchor_sigma_m = 1e-4;
   double anchor_sigma_rad = 1e-5;
@@ -41,6 +47,8 @@ struct PoseGraphBackendResult {
   int edges = 0, augment_edges = 0, observation_edges = 0, rejected_edges = 0;
   int full_recoveries = 0, partial_recoveries = 0;
   long long factors_relinearised = 0;
+  int final_relinearise_passes = 0;
+  bool converged = false;        // the final relinearisation ended with nothing left to relinearise
   std::vector<double> step_ms;   // processing time of each edge (recovery charged to the last edge of a step)
   double time_s = 0;             // filter time (excludes reading the file)
   double recovery_s = 0;         // of which full recoveries
