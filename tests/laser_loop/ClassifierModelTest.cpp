@@ -1,0 +1,104 @@
+// Model file: save/load round trip and clear errors for malformed files.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "TestPaths.h"
+#include "urbanslam/common/Error.h"
+#include "urbanslam/laser_loop/ClassifierModel.h"
+
+using namespace urbanslam;
+using namespace urbanslam::laser_loop;
+
+namespace {
+
+ClassifierModel sample() {
+  ClassifierModel m;
+  m.params.r_max_m = 27.5;
+  m.params.g_max_dist_m = 1.25;
+  m.params.g_min_size = 4;
+  m.factor = 0.45;
+  m.comments = {"command: urbanslam train-laser-loop a.log --out m.model"};
+  m.provenance = {{"data", "a.log b.log"}, {"pairs", "120 positive, 120 negative"}};
+  m.classifier = StrongClassifier({{{static_cast<int>(Feature::Area), 1.0 / 3, 1}, 0.1 + 0.2},
+                                   {{static_cast<int>(Feature::StdRange), 12345.678901234567, -1}, 2.5e-7}});
+  return m;
+}
+
+std::string modelWith(const std::string& from, const std::string& to) {
+  std::string t = modelToText(sample());
+  const auto at = t.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return t.replace(at, from.size(), to);
+}
+
+std::string errorOf(const std::string& text) {
+  try {
+    parseModel(text, "m.model");
+  } catch (const common::InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+}  // namespace
+
+TEST(ClassifierModel, SaveLoadRoundTripIsExact) {
+  const auto dir = test::scratchDir("laser_model_roundtrip");
+  const std::string path = (dir / "m.model").string();
+  const ClassifierModel m = sample();
+  saveModel(m, path);
+  const ClassifierModel r = loadModel(path);
+  EXPECT_EQ(r.params.r_max_m, m.params.r_max_m);
+  EXPECT_EQ(r.params.g_max_dist_m, m.params.g_max_dist_m);
+  EXPECT_EQ(r.params.g_min_size, m.params.g_min_size);
+  EXPECT_EQ(r.factor, m.factor);
+  EXPECT_EQ(r.comments, m.comments);
+  EXPECT_EQ(r.provenance, m.provenance);
+  ASSERT_EQ(r.classifier.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(r.classifier.stumps()[i].stump.feature, m.classifier.stumps()[i].stump.feature);
+    EXPECT_EQ(r.classifier.stumps()[i].stump.threshold, m.classifier.stumps()[i].stump.threshold);  // bit-exact
+    EXPECT_EQ(r.classifier.stumps()[i].stump.polarity, m.classifier.stumps()[i].stump.polarity);
+    EXPECT_EQ(r.classifier.stumps()[i].alpha, m.classifier.stumps()[i].alpha);
+  }
+  EXPECT_EQ(modelToText(r), modelToText(m));
+  EXPECT_EQ(r.provenanceValue("pairs"), "120 positive, 120 negative");
+}
+
+TEST(ClassifierModel, MalformedFilesGiveClearErrors) {
+  EXPECT_NE(errorOf("").find("empty file"), std::string::npos);
+  EXPECT_NE(errorOf("hello 1\n").find("m.model:1: not a laser loop-closure model"), std::string::npos);
+  EXPECT_NE(errorOf(modelWith("urbanslam-laser-loop-model 1", "urbanslam-laser-loop-model 7")).find("version 7 is not supported"),
+            std::string::npos);
+  EXPECT_NE(errorOf(modelWith("end\n", "")).find("truncated"), std::string::npos);
+  EXPECT_NE(errorOf(modelWith("r_max_m 27.5", "r_max_m abc")).find("r_max_m: 'abc' is not a finite number"),
+            std::string::npos);
+  EXPECT_NE(errorOf(modelWith("r_max_m 27.5\n", "")).find("missing required key(s): r_max_m"), std::string::npos);
+  EXPECT_NE(errorOf(modelWith("factor", "fudge")).find("unknown key 'fudge'"), std::string::npos);
+  EXPECT_NE(errorOf(modelWith("stumps 2", "stumps 3")).find("'stumps 3' declared but 2 stump lines"), std::string::npos);
+  EXPECT_NE(errorOf(modelWith("stump area", "stump areal")).find("unknown feature 'areal'"), std::string::npos);
+  EXPECT_NE(errorOf(modelWith(" +1 ", " +2 ")).find("polarity must be +1 or -1"), std::string::npos);
+  EXPECT_NE(errorOf(modelWith("features 20 area", "features 20 size")).find("different feature set"), std::string::npos);
+  EXPECT_NE(errorOf(modelWith("end\n", "end\nstump area 1 +1 1\n")).find("text after 'end'"), std::string::npos);
+  // The line number points at the culprit.
+  EXPECT_NE(errorOf(modelWith("g_min_size 4", "g_min_size 4.5")).find("m.model:5:"), std::string::npos);
+}
+
+TEST(ClassifierModel, MissingFileNamesThePath) {
+  try {
+    loadModel("/nonexistent/x.model");
+    FAIL();
+  } catch (const common::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/x.model"), std::string::npos);
+  }
+}
+
+TEST(ClassifierModel, ShippedDefaultModelLoads) {
+  const std::string path = test::repoPath("share/laser_loop/default.model");
+  std::ifstream probe(path);
+  if (!probe) GTEST_SKIP() << "share/laser_loop/default.model not trained yet";
+  const ClassifierModel m = loadModel(path);
+  EXPECT_GT(m.classifier.size(), 0u);
+  EXPECT_FALSE(m.provenanceValue("data").empty());
+}
