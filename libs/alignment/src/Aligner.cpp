@@ -50,14 +50,42 @@ AlignmentResult alignPointSets(const PointSet& a, const PointSet& b, const Pose2
       break;
     case Method::Crf: reg = crfMatch(a, b, guess, options.crf); break;
     case Method::CrfIcp: {
-      const RegistrationResult coarse = crfMatch(a, b, guess, options.crf);
-      // Without a CRF answer the refinement still starts from the caller's guess: for laser
-      // odometry that guess is good, and a converged ICP is still a valid result.
-      const Pose2 start = coarse.converged ? coarse.transform : guess;
+      // CRF-match proposes, ICP verifies: ICP runs from the CRF transform, from the CRF's other
+      // consensus hypotheses and from the caller's guess; the refinement that explains most
+      // points wins (near ties go to the one closest to the guess, the filter's prior). In
+      // repetitive scenes (corridors) the CRF's best hypothesis is often a sliding or mirrored
+      // one, and a good guess (laser odometry) must never be made worse.
+      CrfDiagnostics diag;
+      const RegistrationResult coarse = crfMatch(a, b, guess, options.crf, &diag);
+      std::vector<Pose2> starts;
+      if (coarse.converged) starts.push_back(coarse.transform);
+      for (const auto& h : diag.hypotheses) starts.push_back(h);
+      starts.push_back(guess);
       point_to_line = options.refine_point_to_line;
-      reg = point_to_line ? plIcp(a, b, start, options.icp) : icp(a, b, start, options.icp);
-      reg.iterations += coarse.iterations;
-      if (!coarse.converged && !reg.converged)
+      bool have = false;
+      int total_iterations = coarse.iterations;
+      double best_count = -1;
+      for (const auto& st : starts) {
+        RegistrationResult r = point_to_line ? plIcp(a, b, st, options.icp) : icp(a, b, st, options.icp);
+        total_iterations += r.iterations;
+        if (!r.converged) {
+          if (!have) reg = r;
+          continue;
+        }
+        const double count = static_cast<double>(r.matches.size());
+        const auto dist = [&](const Pose2& p) {
+          return std::hypot(p.x - guess.x, p.y - guess.y) + 2.0 * std::abs(common::wrapToPi(p.phi - guess.phi));
+        };
+        const bool better = !have || count > best_count * 1.02 ||
+                            (count >= best_count * 0.98 && dist(r.transform) < dist(reg.transform));
+        if (better) {
+          reg = r;
+          best_count = std::max(best_count, count);
+          have = true;
+        }
+      }
+      reg.iterations = total_iterations;
+      if (!have && !coarse.converged)
         reg.failure_reason = "CRF-match: " + coarse.failure_reason + "; ICP: " + reg.failure_reason;
       break;
     }

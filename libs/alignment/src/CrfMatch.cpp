@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 #include <sstream>
 
 #include "urbanslam/alignment/Icp.h"
@@ -36,6 +37,24 @@ std::vector<std::vector<double>> crfShapeFeatures(const SubsamplingResult& s,
 }
 
 namespace {
+
+// Direction of the scan polyline at each point of `segmented`, oriented along the sweep: from
+// the first point at least `radius` behind to the first at least `radius` ahead (within the
+// segment; the segment's ends fall back to the nearest available neighbour).
+std::vector<double> sweepTangents(const SubsamplingResult& s, double radius) {
+  const int n = static_cast<int>(s.segmented.size());
+  std::vector<double> t(n, 0.0);
+  const double r2 = radius * radius;
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector2d& p = s.segmented[i].p;
+    int b = i, e = i;
+    while (b - 1 >= 0 && s.segment[b - 1] == s.segment[i] && (s.segmented[b].p - p).squaredNorm() < r2) --b;
+    while (e + 1 < n && s.segment[e + 1] == s.segment[i] && (s.segmented[e].p - p).squaredNorm() < r2) ++e;
+    const Eigen::Vector2d d = s.segmented[e].p - s.segmented[b].p;
+    t[i] = std::atan2(d.y(), d.x());
+  }
+  return t;
+}
 
 // Sparse pairwise table of one edge: for each state j of the first node, the states k of the
 // second node with a non-negligible distance-consistency term g(j, k) (CSR layout).
@@ -100,16 +119,31 @@ RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, c
     phi[static_cast<size_t>(i) * S + OUT] = options.outlier_local;
   }
 
-  // Reference distances, each row sorted, so that an edge's table is a range search per row.
+  // Pairwise geometry of the reference: distances (each row sorted, so that an edge's table is
+  // a range search per row) and the direction to every other point relative to the local sweep
+  // tangent. Distances alone are also preserved by a mirror image; the relative directions are
+  // preserved by rotations only.
+  const std::vector<double> tan_a_all = sweepTangents(ref, options.tangent_radius_m);
+  const std::vector<double> tan_b_all = sweepTangents(mov, options.tangent_radius_m);
   std::vector<std::vector<std::pair<double, int>>> sorted_d(M);
+  std::vector<double> rel_dir_a(static_cast<size_t>(M) * M, 0.0);
   for (int j = 0; j < M; ++j) {
     sorted_d[j].reserve(M - 1);
-    for (int k = 0; k < M; ++k)
-      if (k != j) sorted_d[j].emplace_back((ref.points[j].p - ref.points[k].p).norm(), k);
+    const double tj = tan_a_all[ref.selected[j]];
+    for (int k = 0; k < M; ++k) {
+      if (k == j) continue;
+      const Eigen::Vector2d d = ref.points[k].p - ref.points[j].p;
+      sorted_d[j].emplace_back(d.norm(), k);
+      rel_dir_a[static_cast<size_t>(j) * M + k] = common::wrapToPi(std::atan2(d.y(), d.x()) - tj);
+    }
     std::sort(sorted_d[j].begin(), sorted_d[j].end());
   }
   const double ps = options.pair_sigma_m;
   const double cut = 3.0 * ps;
+  const double inv_s2_dir = options.pair_direction_sigma_rad > 0
+                                ? 1.0 / (options.pair_direction_sigma_rad * options.pair_direction_sigma_rad)
+                                : 0.0;
+  const double keep = 1e-3;  // table entries below this (times the peak) fall to the floor
   std::vector<EdgeTable> edges;
   for (int s : options.edge_offsets) {
     if (s <= 0) continue;
@@ -117,16 +151,28 @@ RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, c
       EdgeTable e;
       e.a = i;
       e.b = i + s;
-      const double d = (mov.points[i].p - mov.points[i + s].p).norm();
+      const Eigen::Vector2d db = mov.points[i + s].p - mov.points[i].p;
+      const double d = db.norm();
+      const double dir_ab = common::wrapToPi(std::atan2(db.y(), db.x()) - tan_b_all[mov.selected[i]]);
+      const double dir_ba = common::wrapToPi(std::atan2(-db.y(), -db.x()) - tan_b_all[mov.selected[i + s]]);
       e.row.assign(M + 1, 0);
       for (int j = 0; j < M; ++j) {
         e.row[j] = static_cast<int>(e.col.size());
         const auto& row = sorted_d[j];
         auto it = std::lower_bound(row.begin(), row.end(), std::make_pair(d - cut, -1));
         for (; it != row.end() && it->first <= d + cut; ++it) {
+          const int k = it->second;
           const double x = (it->first - d) / ps;
-          e.col.push_back(it->second);
-          e.val.push_back(std::exp(-0.5 * x * x));
+          double q = 0.5 * x * x;
+          if (inv_s2_dir > 0) {
+            const double u = common::wrapToPi(rel_dir_a[static_cast<size_t>(j) * M + k] - dir_ab);
+            const double v = common::wrapToPi(rel_dir_a[static_cast<size_t>(k) * M + j] - dir_ba);
+            q += 0.5 * (u * u + v * v) * inv_s2_dir;
+          }
+          const double g = std::exp(-q);
+          if (g < keep) continue;
+          e.col.push_back(k);
+          e.val.push_back(g);
         }
       }
       e.row[M] = static_cast<int>(e.col.size());
@@ -176,12 +222,20 @@ RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, c
           hs += h[j];
         }
         const double h_states = hs - h[OUT];
-        // psi(j,k) = floor + g(j,k) for two reference points (g symmetric in j, k, so the same
-        // table serves both directions), outlier_pair when either side is the outlier state.
+        // psi(j,k) = floor + g(j,k) for two reference points (rows j: state of node a,
+        // columns k: state of node b), outlier_pair when either side is the outlier state.
         for (int k = 0; k < M; ++k) out[k] = options.pair_floor * h_states + options.outlier_pair * h[OUT];
-        for (int j = 0; j < M; ++j) {
-          if (h[j] == 0) continue;
-          for (int q = t.row[j]; q < t.row[j + 1]; ++q) out[t.col[q]] += t.val[q] * h[j];
+        if (dir == 0) {
+          for (int j = 0; j < M; ++j) {
+            if (h[j] == 0) continue;
+            for (int q = t.row[j]; q < t.row[j + 1]; ++q) out[t.col[q]] += t.val[q] * h[j];
+          }
+        } else {
+          for (int j = 0; j < M; ++j) {
+            double acc = 0;
+            for (int q = t.row[j]; q < t.row[j + 1]; ++q) acc += t.val[q] * h[t.col[q]];
+            out[j] += acc;
+          }
         }
         out[OUT] = options.outlier_pair * hs;
         double z = 0;
@@ -201,49 +255,126 @@ RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, c
   diag.bp_iterations = std::min(iter, options.bp_iterations);
   computeBeliefs();
 
-  // Most probable association of each moving point, weighted by its marginal.
-  std::vector<Eigen::Vector2d> src, dst;
-  std::vector<double> w;
-  std::vector<int> mi, rj;
+  // Candidate associations: the few most probable states of each moving point. Where the
+  // scene repeats itself (walls, corridors) the marginals are mixtures of several consistent
+  // hypotheses, and the per-point maxima need not belong to the same one.
+  struct Candidate {
+    int node, state;
+    double w;
+  };
+  std::vector<Candidate> cand;
+  std::vector<int> order(M);
   for (int i = 0; i < N; ++i) {
     const double* bl = &belief[static_cast<size_t>(i) * S];
-    int best = 0;
-    for (int j = 1; j < S; ++j)
-      if (bl[j] > bl[best]) best = j;
-    if (best == OUT || bl[best] < options.min_marginal) continue;
-    src.push_back(mov.points[i].p);
-    dst.push_back(ref.points[best].p);
-    w.push_back(bl[best]);
-    mi.push_back(mov.source[mov.selected[i]]);
-    rj.push_back(ref.source[ref.selected[best]]);
+    for (int j = 0; j < M; ++j) order[j] = j;
+    const int K = std::min(M, std::max(1, options.candidates_per_point));
+    std::partial_sort(order.begin(), order.begin() + K, order.end(),
+                      [&](int x, int y) { return bl[x] > bl[y]; });
+    for (int k = 0; k < K; ++k)
+      if (bl[order[k]] >= options.min_marginal && bl[order[k]] > bl[OUT]) cand.push_back({i, order[k], bl[order[k]]});
   }
-  diag.associations = static_cast<int>(src.size());
+  diag.associations = static_cast<int>(cand.size());
   result.iterations = diag.bp_iterations;
-  Pose2 T;
-  if (static_cast<int>(src.size()) < min_assoc || !leastSquaresTransform(src, dst, w, &T)) {
+  if (static_cast<int>(cand.size()) < min_assoc) {
     std::ostringstream os;
-    os << "only " << src.size() << " confident associations (need " << min_assoc << ")";
+    os << "only " << cand.size() << " confident associations (need " << min_assoc << ")";
     result.failure_reason = os.str();
     if (diagnostics) *diagnostics = diag;
     return result;
   }
-  // Re-estimate on the inliers with a shrinking gate: a few confident but wrong associations
-  // (repeated structure) must not pull the transform.
-  std::vector<char> inlier(src.size(), 1);
-  for (double gate : {4.0 * options.inlier_gate_m, 2.0 * options.inlier_gate_m, options.inlier_gate_m}) {
-    const Rigid2 R = Rigid2::fromPose(T);
-    std::vector<Eigen::Vector2d> s2, d2;
-    std::vector<double> w2;
-    for (size_t k = 0; k < src.size(); ++k) {
-      inlier[k] = (R * src[k] - dst[k]).norm() < gate;
-      if (!inlier[k]) continue;
-      s2.push_back(src[k]);
-      d2.push_back(dst[k]);
-      w2.push_back(w[k]);
+  // Consensus among the candidates: transforms from two associations (drawn in proportion to
+  // their marginals), scored by the marginal mass of the points that one of their candidates
+  // puts within the inlier gate. The best hypothesis selects one association per point.
+  const double gate = options.inlier_gate_m;
+  auto bestPerNode = [&](const Pose2& hyp, std::vector<int>* pick, double* score) {
+    const Rigid2 R = Rigid2::fromPose(hyp);
+    pick->assign(N, -1);
+    std::vector<double> best_r(N, gate);
+    for (size_t c = 0; c < cand.size(); ++c) {
+      const double r = (R * mov.points[cand[c].node].p - ref.points[cand[c].state].p).norm();
+      if (r < best_r[cand[c].node]) {
+        best_r[cand[c].node] = r;
+        (*pick)[cand[c].node] = static_cast<int>(c);
+      }
     }
-    if (static_cast<int>(s2.size()) < min_assoc) break;
+    *score = 0;
+    for (int i = 0; i < N; ++i)
+      if ((*pick)[i] >= 0) *score += cand[(*pick)[i]].w * (1.0 - best_r[i] / gate);
+  };
+  std::mt19937 rng(options.seed);
+  std::vector<double> cw;
+  for (const auto& c : cand) cw.push_back(c.w);
+  std::discrete_distribution<size_t> draw(cw.begin(), cw.end());
+  Pose2 T;
+  double best_score = -1;
+  std::vector<int> pick;
+  std::vector<std::pair<double, Pose2>> ranked;
+  for (int h = 0; h < options.consensus_hypotheses; ++h) {
+    const Candidate& c1 = cand[draw(rng)];
+    const Candidate& c2 = cand[draw(rng)];
+    if (c1.node == c2.node || c1.state == c2.state) continue;
+    const Eigen::Vector2d db = mov.points[c2.node].p - mov.points[c1.node].p;
+    const Eigen::Vector2d da = ref.points[c2.state].p - ref.points[c1.state].p;
+    if (db.norm() < 4 * gate || std::abs(db.norm() - da.norm()) > gate) continue;
+    const double phi = common::wrapToPi(std::atan2(da.y(), da.x()) - std::atan2(db.y(), db.x()));
+    const Eigen::Vector2d mb = 0.5 * (mov.points[c1.node].p + mov.points[c2.node].p);
+    const Eigen::Vector2d ma = 0.5 * (ref.points[c1.state].p + ref.points[c2.state].p);
+    const double c = std::cos(phi), s = std::sin(phi);
+    const Pose2 hyp{ma.x() - (c * mb.x() - s * mb.y()), ma.y() - (s * mb.x() + c * mb.y()), phi};
+    double score = 0;
+    std::vector<int> p;
+    bestPerNode(hyp, &p, &score);
+    if (score > best_score) {
+      best_score = score;
+      T = hyp;
+      pick = p;
+    }
+    // Keep the best few distinct hypotheses for a verifier (CRF+ICP) to choose from.
+    bool merged = false;
+    for (auto& [sc, ph] : ranked) {
+      if (std::hypot(ph.x - hyp.x, ph.y - hyp.y) < 0.5 && std::abs(common::wrapToPi(ph.phi - hyp.phi)) < 0.1) {
+        if (score > sc) {
+          sc = score;
+          ph = hyp;
+        }
+        merged = true;
+        break;
+      }
+    }
+    if (!merged) ranked.emplace_back(score, hyp);
+    std::sort(ranked.begin(), ranked.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+    if (static_cast<int>(ranked.size()) > std::max(1, options.hypotheses_kept)) ranked.resize(std::max(1, options.hypotheses_kept));
+  }
+  for (const auto& r : ranked) diag.hypotheses.push_back(r.second);
+  if (best_score < 0) {
+    result.failure_reason = "no two associations agree on a transform";
+    if (diagnostics) *diagnostics = diag;
+    return result;
+  }
+  // Weighted least squares on the chosen associations, re-selected once at the new transform.
+  std::vector<Eigen::Vector2d> src, dst;
+  std::vector<double> w;
+  std::vector<int> mi, rj;
+  for (int round = 0; round < 3; ++round) {
+    src.clear();
+    dst.clear();
+    w.clear();
+    mi.clear();
+    rj.clear();
+    for (int i = 0; i < N; ++i) {
+      if (pick[i] < 0) continue;
+      const Candidate& c = cand[pick[i]];
+      src.push_back(mov.points[c.node].p);
+      dst.push_back(ref.points[c.state].p);
+      w.push_back(c.w);
+      mi.push_back(mov.source[mov.selected[c.node]]);
+      rj.push_back(ref.source[ref.selected[c.state]]);
+    }
     Pose2 T2;
-    if (leastSquaresTransform(s2, d2, w2, &T2)) T = T2;
+    if (static_cast<int>(src.size()) < min_assoc || !leastSquaresTransform(src, dst, w, &T2)) break;
+    T = T2;
+    double unused = 0;
+    bestPerNode(T, &pick, &unused);
   }
   const Rigid2 R = Rigid2::fromPose(T);
   double sse = 0;
