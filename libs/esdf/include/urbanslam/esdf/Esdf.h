@@ -51,7 +51,7 @@ struct EsdfOptions {
   bool relinearise = true;
   double relinearise_threshold_m = 1e-3;
   double relinearise_threshold_rad = 1e-4;
-  int relinearise_max_passes = 10;
+  int relinearise_max_passes = 20;
 
   FillReducingOrdering ordering = FillReducingOrdering::Amd;
 };
