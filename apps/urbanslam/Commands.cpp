@@ -7,6 +7,8 @@ const std::vector<Command>& commands() {
       {"run", "build a map and trajectory from a log (the main job)", runCommand},
       {"convert", "write any supported log as an MRPT rawlog", convertCommand},
       {"check-ini", "validate an ini file and print the resolved configuration", checkIniCommand},
+      {"train-laser-loop", "train the laser loop-closure classifier (AdaBoost) from logs with a reference", trainLaserLoopCommand},
+      {"eval-laser-loop", "ROC of a laser loop-closure model on held-out logs", evalLaserLoopCommand},
   };
   return all;
 }

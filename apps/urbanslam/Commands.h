@@ -18,6 +18,8 @@ struct Command {
 int runCommand(const Argv& args);
 int convertCommand(const Argv& args);
 int checkIniCommand(const Argv& args);
+int trainLaserLoopCommand(const Argv& args);
+int evalLaserLoopCommand(const Argv& args);
 
 // Every registered subcommand, in the order `urbanslam --help` lists them.
 const std::vector<Command>& commands();

@@ -15,6 +15,7 @@ namespace {
 struct TimedScan {
   double t;
   FeatureVector f;
+  long stream_ref;  // index of the reference pose read since the previous scan, or −1
 };
 struct TimedRef {
   double t;
@@ -36,10 +37,13 @@ ScanSet loadLabelledScans(const std::string& path, const ScanLoadOptions& opt) {
   std::vector<TimedGps> gps;
   io::Measurement m;
   size_t count = 0;
+  long since_last_scan = -1;
   while (source->next(m)) {
     if (const auto* s = std::get_if<io::LaserScan>(&m)) {
-      scans.push_back({s->timestamp, computeFeatures(*s, opt.params)});
+      scans.push_back({s->timestamp, computeFeatures(*s, opt.params), since_last_scan});
+      since_last_scan = -1;
     } else if (const auto* r = std::get_if<io::ReferencePose>(&m)) {
+      since_last_scan = static_cast<long>(refs.size());
       refs.push_back({r->timestamp, r->pose});
     } else if (const auto* g = std::get_if<io::GpsFix>(&m)) {
       gps.push_back({g->timestamp, g->x_m, g->y_m});
@@ -50,6 +54,9 @@ ScanSet loadLabelledScans(const std::string& path, const ScanLoadOptions& opt) {
   if (refs.empty() && gps.empty())
     throw common::InputError(path + ": no reference trajectory (neither reference poses nor GPS) to label scan pairs");
   auto by_t = [](const auto& a, const auto& b) { return a.t < b.t; };
+  // A reference pose read right before its scan (corrected CARMEN logs) is that scan's pose even
+  // when the log's timestamps are too coarse to tell scans apart (csail: 6 significant digits).
+  std::vector<TimedRef> stream_refs = refs;
   std::stable_sort(refs.begin(), refs.end(), by_t);
   std::stable_sort(gps.begin(), gps.end(), by_t);
   set.reference_kind = refs.empty() ? "GPS (interpolated between fixes within " + std::to_string(opt.gps_max_gap_s) + " s)"
@@ -62,7 +69,10 @@ ScanSet loadLabelledScans(const std::string& path, const ScanLoadOptions& opt) {
     ls.features = s.f;
     ls.timestamp = s.t;
     bool ok = false;
-    if (!refs.empty()) {
+    if (s.stream_ref >= 0 && std::fabs(stream_refs[static_cast<size_t>(s.stream_ref)].t - s.t) <= opt.ref_max_gap_s) {
+      ls.pose = stream_refs[static_cast<size_t>(s.stream_ref)].pose;
+      ok = true;
+    } else if (!refs.empty()) {
       auto it = std::lower_bound(refs.begin(), refs.end(), s.t, [](const TimedRef& r, double t) { return r.t < t; });
       const TimedRef* best = nullptr;
       if (it != refs.end()) best = &*it;
@@ -126,8 +136,10 @@ std::vector<LabelledPair> samplePairs(const ScanSet& set, uint32_t set_index, co
   for (uint32_t i = 0; i < n; ++i)
     for (uint32_t j = i + 1; j < n; ++j) {
       const double dx = s[i].pose.x - s[j].pose.x, dy = s[i].pose.y - s[j].pose.y;
-      if (dx * dx + dy * dy <= d2 && std::fabs(s[j].path_m - s[i].path_m) >= rules.min_travel_m)
-        pos.push_back(make(i, j, true));
+      if (dx * dx + dy * dy <= d2 && std::fabs(s[j].path_m - s[i].path_m) >= rules.min_travel_m) {
+        LabelledPair p = make(i, j, true);
+        if (p.heading_diff_rad <= rules.max_heading_diff_rad) pos.push_back(p);
+      }
     }
   std::shuffle(pos.begin(), pos.end(), rng);
   if (pos.size() > rules.max_positives) pos.resize(rules.max_positives);

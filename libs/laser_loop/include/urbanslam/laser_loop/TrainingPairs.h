@@ -18,6 +18,7 @@
 // at least min_travel_m long. Otherwise consecutive scans of a slowly moving robot — the same
 // place seen a second later from the same heading — would dominate the positives and measure
 // nothing about loop closure.
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -62,6 +63,10 @@ struct PairRules {
   double d_pos_m = 1.0;
   double d_neg_m = 3.0;
   double min_travel_m = 10.0;
+  // Positives only up to this heading difference (π: any heading, the definition). A
+  // 180° scanner sees disjoint halves of a place from opposite headings, so restricting it
+  // measures the classifier on pairs whose scans can overlap. Scans without a heading pass.
+  double max_heading_diff_rad = M_PI;
   size_t max_positives = 20000;          // random subset when more exist
   double negatives_per_positive = 1.0;   // 1 = balanced (training); more for FA resolution (eval)
   size_t min_negatives = 0;              // at least this many negatives (when available)
