@@ -8,7 +8,7 @@ CMAKE_ARGS ?=
 DEB_PACKAGES = cmake g++ make ninja-build ccache pkg-config \
   libmrpt-dev mrpt-common mrpt-apps libopencv-dev libeigen3-dev libsuitesparse-dev \
   libwxgtk3.2-dev libgtest-dev libbenchmark-dev zlib1g-dev libzip-dev \
-  xvfb xauth
+  xvfb xauth opencv-doc plasma-workspace-wallpapers
 
 .PHONY: all deps configure build demo test bench clean
 

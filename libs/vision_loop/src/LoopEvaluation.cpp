@@ -68,7 +68,8 @@ SweepResult sweepThresholds(const std::vector<EvaluationFrame>& frames, const Gr
     return p;
   };
   // Timings at the detector's own α, measured before the cache holds any verification.
-  run(options.min_normalized_score, nullptr, &out.mean_query_ms, &out.mean_verification_ms);
+  out.at_default =
+      run(options.min_normalized_score, &out.detections_at_default, &out.mean_query_ms, &out.mean_verification_ms);
   for (double t : thresholds) {
     out.curve.push_back(run(t, nullptr, nullptr, nullptr));
     const PrPoint& p = out.curve.back();

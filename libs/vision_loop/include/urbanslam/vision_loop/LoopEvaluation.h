@@ -58,6 +58,8 @@ struct SweepResult {
   double recall_at_precision_1 = 0;      // best recall among points without false positives
   double threshold_at_precision_1 = 0;   // the smallest α reaching it
   std::vector<Detection> detections_at_precision_1;
+  PrPoint at_default;                    // at the detector's own α
+  std::vector<Detection> detections_at_default;
   double mean_query_ms = 0, mean_verification_ms = 0;  // at the detector's own α
 };
 
