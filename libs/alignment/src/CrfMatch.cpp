@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "urbanslam/alignment/Icp.h"
+#include "urbanslam/common/Timing.h"
 
 namespace urbanslam::alignment {
 
@@ -37,6 +38,13 @@ std::vector<std::vector<double>> crfShapeFeatures(const SubsamplingResult& s,
 }
 
 namespace {
+
+// Wraps the difference of two angles in (-pi, pi] (so within (-2pi, 2pi)) without fmod.
+inline double wrapDiff(double a) {
+  if (a > M_PI) return a - 2 * M_PI;
+  if (a <= -M_PI) return a + 2 * M_PI;
+  return a;
+}
 
 // Direction of the scan polyline at each point of `segmented`, oriented along the sweep: from
 // the first point at least `radius` behind to the first at least `radius` ahead (within the
@@ -72,6 +80,7 @@ RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, c
   RegistrationResult result;
   result.transform = guess;
   CrfDiagnostics diag;
+  common::Stopwatch sw;
   const SubsamplingResult ref = subsample(reference, options.subsampling);
   const SubsamplingResult mov = subsample(moving, options.subsampling);
   const int M = static_cast<int>(ref.points.size());
@@ -105,7 +114,7 @@ RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, c
       for (size_t k = 0; k < F; ++k) {
         const bool ha = std::isfinite(fa[k]), hb = std::isfinite(fb[k]);
         if (ha && hb) {
-          const double d = common::wrapToPi(fa[k] - fb[k]);
+          const double d = wrapDiff(fa[k] - fb[k]);
           cost += d * d * inv2s2;
         } else if (ha != hb) {
           cost += options.missing_feature_cost;
@@ -144,6 +153,7 @@ RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, c
                                 ? 1.0 / (options.pair_direction_sigma_rad * options.pair_direction_sigma_rad)
                                 : 0.0;
   const double keep = 1e-3;  // table entries below this (times the peak) fall to the floor
+  const double max_q = -std::log(keep);
   std::vector<EdgeTable> edges;
   for (int s : options.edge_offsets) {
     if (s <= 0) continue;
@@ -165,10 +175,11 @@ RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, c
           const double x = (it->first - d) / ps;
           double q = 0.5 * x * x;
           if (inv_s2_dir > 0) {
-            const double u = common::wrapToPi(rel_dir_a[static_cast<size_t>(j) * M + k] - dir_ab);
-            const double v = common::wrapToPi(rel_dir_a[static_cast<size_t>(k) * M + j] - dir_ba);
+            const double u = wrapDiff(rel_dir_a[static_cast<size_t>(j) * M + k] - dir_ab);
+            const double v = wrapDiff(rel_dir_a[static_cast<size_t>(k) * M + j] - dir_ba);
             q += 0.5 * (u * u + v * v) * inv_s2_dir;
           }
+          if (q > max_q) continue;  // cheaper than the exp below for the many rejected pairs
           const double g = std::exp(-q);
           if (g < keep) continue;
           e.col.push_back(k);
@@ -180,7 +191,10 @@ RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, c
     }
   }
   diag.edges = static_cast<int>(edges.size());
+  for (const auto& e : edges) diag.table_entries += static_cast<long>(e.col.size());
 
+  diag.time_potentials_ms = sw.milliseconds();
+  sw.restart();
   // Loopy belief propagation. msg[2e] : a -> b, msg[2e+1] : b -> a, each over S states.
   const size_t E = edges.size();
   std::vector<double> msg(2 * E * S, 1.0 / S);
@@ -254,6 +268,8 @@ RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, c
   }
   diag.bp_iterations = std::min(iter, options.bp_iterations);
   computeBeliefs();
+  diag.time_bp_ms = sw.milliseconds();
+  sw.restart();
 
   // Candidate associations: the few most probable states of each moving point. Where the
   // scene repeats itself (walls, corridors) the marginals are mixtures of several consistent
@@ -385,6 +401,7 @@ RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, c
     sse += r * r;
   }
   diag.inliers = static_cast<int>(result.matches.size());
+  diag.time_transform_ms = sw.milliseconds();
   result.transform = T;
   result.rms_residual_m = result.matches.empty() ? 0 : std::sqrt(sse / result.matches.size());
   if (diag.inliers < min_assoc) {

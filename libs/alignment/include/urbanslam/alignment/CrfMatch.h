@@ -62,6 +62,8 @@ struct CrfOptions {
 struct CrfDiagnostics {
   int nodes = 0, states = 0, edges = 0, bp_iterations = 0, associations = 0, inliers = 0;
   std::vector<common::Pose2> hypotheses;  // distinct consensus hypotheses, best first (before WLS)
+  double time_potentials_ms = 0, time_bp_ms = 0, time_transform_ms = 0;
+  long table_entries = 0;  // non-negligible pairwise entries over all edges
 };
 
 // CRF-match of `moving` onto `reference`. `guess` only matters when guess_sigma_m > 0.

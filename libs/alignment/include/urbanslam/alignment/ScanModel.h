@@ -18,8 +18,12 @@ namespace urbanslam::alignment {
 struct ScanModelOptions {
   double max_range_m = 50.0;          // r_max gate; the smaller of this and the scan's own limit
   double min_range_m = 0.02;          // below this a return is the sensor's own housing / noise
-  double range_sigma_m = 0.05;        // sigma_r of eq. 3.3 (at r = 0)
-  double bearing_sigma_rad = 0.0087;  // sigma_alpha of eq. 3.3 (0.5 deg)
+  // sigma_r and sigma_alpha of eq. 3.3. Like the thesis (§3.3.3) we use values well above the
+  // SICK's specification (1 cm): with them the line-variance covariance is consistent on real
+  // scans (bench/alignment: mean NEES 2.4 over verified Freiburg pairs, against a reference that
+  // has errors of its own); with 5 cm / 0.5 deg the mean NEES was 31 (overconfident).
+  double range_sigma_m = 0.2;
+  double bearing_sigma_rad = 0.035;   // 2 deg
 };
 
 // Eq. 3.3: covariance of (r, alpha) for a reading at range r with gate r_max.
