@@ -46,6 +46,37 @@ std::vector<LoopDetector::Match> LoopDetector::query(const FeatureVector& q, con
   return out;
 }
 
+namespace {
+
+// One block of keyframes against every stump. Built for AVX2 and for the baseline ISA; the
+// loader picks the variant the CPU supports (GCC function multi-versioning), so the binary stays
+// portable while an AVX2 machine screens 8 keyframes per instruction.
+struct BlockStump {
+  const float* column;
+  float query, threshold, alpha;
+  int polarity;
+};
+
+__attribute__((target_clones("avx2", "default")))
+void screenBlock(const BlockStump* stumps, size_t n_stumps, size_t base, size_t m, float inv_total, float* out) {
+  constexpr size_t kBlock = 512;
+  alignas(64) float acc[kBlock];
+  for (size_t i = 0; i < kBlock; ++i) acc[i] = 0.f;
+  for (size_t k = 0; k < n_stumps; ++k) {
+    const BlockStump& st = stumps[k];
+    const float* v = st.column + base;
+    const float qv = st.query, thr = st.threshold, a = st.alpha;
+    if (st.polarity > 0) {
+      for (size_t i = 0; i < m; ++i) acc[i] += std::fabs(qv - v[i]) < thr ? a : 0.f;
+    } else {
+      for (size_t i = 0; i < m; ++i) acc[i] += std::fabs(qv - v[i]) > thr ? a : 0.f;
+    }
+  }
+  for (size_t i = 0; i < m; ++i) out[base + i] = acc[i] * inv_total;
+}
+
+}  // namespace
+
 void LoopDetector::screen(const FeatureVector& query, std::vector<float>& scores) const {
   const size_t n = keyframes_.size();
   scores.resize(n);
@@ -53,24 +84,15 @@ void LoopDetector::screen(const FeatureVector& query, std::vector<float>& scores
   // Blocks small enough that the accumulator and the column slices stay in L1 while every stump
   // passes over them; the inner loops are branch-free so the compiler vectorises them.
   constexpr size_t kBlock = 512;
-  alignas(64) float acc[kBlock];
   const float inv_total = alpha_total_ > 0 ? static_cast<float>(1.0 / alpha_total_) : 0.f;
-  std::vector<float> q(used_features_.size());
-  for (size_t c = 0; c < q.size(); ++c) q[c] = static_cast<float>(query[used_features_[c]]);
-  for (size_t base = 0; base < n; base += kBlock) {
-    const size_t m = std::min(kBlock, n - base);
-    std::fill(acc, acc + kBlock, 0.f);
-    for (const auto& st : stumps_) {
-      const float* v = columns_[static_cast<size_t>(st.column)].data() + base;
-      const float qv = q[static_cast<size_t>(st.column)], thr = st.threshold, a = st.alpha;
-      if (st.polarity > 0) {
-        for (size_t i = 0; i < m; ++i) acc[i] += std::fabs(qv - v[i]) < thr ? a : 0.f;
-      } else {
-        for (size_t i = 0; i < m; ++i) acc[i] += std::fabs(qv - v[i]) > thr ? a : 0.f;
-      }
-    }
-    for (size_t i = 0; i < m; ++i) scores[base + i] = acc[i] * inv_total;
-  }
+  std::vector<BlockStump> bs;
+  bs.reserve(stumps_.size());
+  for (const auto& st : stumps_)
+    bs.push_back({columns_[static_cast<size_t>(st.column)].data(),
+                  static_cast<float>(query[used_features_[static_cast<size_t>(st.column)]]), st.threshold, st.alpha,
+                  st.polarity});
+  for (size_t base = 0; base < n; base += kBlock)
+    screenBlock(bs.data(), bs.size(), base, std::min(kBlock, n - base), inv_total, scores.data());
 }
 
 std::vector<LoopDetector::Match> LoopDetector::queryAll(const FeatureVector& q) const {

@@ -27,6 +27,9 @@ struct Beams {
   bool closed = false;
 };
 
+// Ranges are metres, far from overflow: plain sqrt is several times cheaper than std::hypot.
+inline double norm2(double x, double y) { return std::sqrt(x * x + y * y); }
+
 // Welford's running mean/variance: the textbook Σx² − n·mean² cancels catastrophically when the
 // spread is small next to the mean (a regular scan), giving a noise floor instead of 0.
 struct Running {
@@ -89,11 +92,14 @@ FeatureVector compute(const Beams& b, const FeatureParams& p) {
   double area2 = 0, far_dist = 0, dist = 0, close_dist = 0;
   Running d_stats;
   thread_local std::vector<uint8_t> link;  // pair i is short–short and within g_max_dist
+  thread_local std::vector<double> dpair;  // |p_i p_{i+1}|
   link.assign(n, 0);
+  dpair.assign(n, 0.0);
   for (size_t i = 0; i < n_pairs; ++i) {
     const size_t j = i + 1 == n ? 0 : i + 1;
     area2 += xs[i] * ys[j] - xs[j] * ys[i];  // r_i r_j sin(α_j − α_i), the triangle of 3.6
-    const double d = std::hypot(xs[j] - xs[i], ys[j] - ys[i]);
+    const double d = norm2(xs[j] - xs[i], ys[j] - ys[i]);
+    dpair[i] = d;
     far_dist += d;
     if (sh[i] && sh[j]) {
       dist += d;
@@ -156,8 +162,8 @@ FeatureVector compute(const Beams& b, const FeatureParams& p) {
       if (!(sh[ia] && sh[ib] && sh[ic])) continue;
       const double ux = xs[ib] - xs[ia], uy = ys[ib] - ys[ia];  // a→b
       const double vx = xs[ic] - xs[ib], vy = ys[ic] - ys[ib];  // b→c
-      const double lu = std::hypot(ux, uy), lv = std::hypot(vx, vy);
-      const double lw = std::hypot(xs[ic] - xs[ia], ys[ic] - ys[ia]);
+      const double lu = dpair[ia], lv = dpair[ib];
+      const double lw = norm2(xs[ic] - xs[ia], ys[ic] - ys[ia]);
       if (lu > 0 && lv > 0) {
         const double cosang = std::clamp((ux * vx + uy * vy) / (lu * lv), -1.0, 1.0);
         mad += std::acos(cosang);
@@ -181,7 +187,7 @@ FeatureVector compute(const Beams& b, const FeatureParams& p) {
     double dev = 0, mx = 0, my = 0;
     for (size_t i = 0; i < n; ++i)
       if (sh[i]) {
-        dev += std::hypot(xs[i] - xm, ys[i] - ym);
+        dev += norm2(xs[i] - xm, ys[i] - ym);
         mx += xs[i];
         my += ys[i];
       }

@@ -21,7 +21,7 @@ struct WeightedStump {
 class StrongClassifier {
  public:
   StrongClassifier() = default;
-  explicit StrongClassifier(std::vector<WeightedStump> stumps) : stumps_(std::move(stumps)) {}
+  explicit StrongClassifier(std::vector<WeightedStump> stumps);
 
   const std::vector<WeightedStump>& stumps() const { return stumps_; }
   size_t size() const { return stumps_.size(); }
@@ -35,7 +35,17 @@ class StrongClassifier {
   }
 
  private:
+  // Compact branch-free form for score(): stump outcomes are data-dependent coin flips to the
+  // branch predictor, so each vote is computed as arithmetic instead.
+  struct Compiled {
+    int feature;
+    double signed_threshold_sign;  // polarity
+    double threshold;
+    double alpha;
+  };
   std::vector<WeightedStump> stumps_;
+  std::vector<Compiled> compiled_;
+  double alpha_total_ = 0;
 };
 
 }  // namespace urbanslam::laser_loop
