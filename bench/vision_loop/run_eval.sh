@@ -1,0 +1,50 @@
+#!/bin/sh
+# Reproduces the Tree of Words figures (issue 6): vocabulary reproducibility, precision-recall on
+# the RTAB-Map loop sequence with the shipped vocabularies (trained on other images), and the
+# speed benches. Usage: bench/vision_loop/run_eval.sh [BUILD_DIR] (default: build).
+# Outputs: out/vision_loop/ (JSON per run, PR curves as CSV and PNG, bench.json).
+set -eu
+cd "$(dirname "$0")/../.."
+BUILD=${1:-build}
+U=$BUILD/apps/urbanslam/urbanslam
+OUT=out/vision_loop
+mkdir -p "$OUT"
+
+# 1. The shipped vocabularies are what their recorded command produces (needs make deps).
+if bench/vision_loop/training_images.sh > "$OUT/training_images.txt" 2>/dev/null; then
+  cmp -s "$OUT/training_images.txt" share/vision_loop/training_images.txt || echo "note: training image list differs from the shipped one"
+  for d in sift orb; do
+    "$U" build-vocabulary share/vision_loop/training_images.txt --out "$OUT/${d}_k10_L4.usvoc" \
+      --descriptor $d --k 10 --levels 4 --max-features 500 --threads 2 --quiet --json > "$OUT/build_$d.json"
+    if cmp -s "$OUT/${d}_k10_L4.usvoc" "share/vision_loop/${d}_k10_L4.usvoc"; then
+      echo "vocabulary $d: rebuilt bit-identical to share/vision_loop/${d}_k10_L4.usvoc"
+    else
+      echo "vocabulary $d: rebuilt file DIFFERS from the shipped one"
+    fi
+  done
+else
+  echo "skipping vocabulary rebuild: training packages missing (make deps)"
+fi
+
+# 2. Precision-recall on the full RTAB-Map sequence (84 frames, 44 loop frames).
+R=../shared/data/images/rtabmap_samples
+if [ -d "$R/samples" ]; then
+  for d in sift orb; do
+    for v in "" --no-verification; do
+      tag=$d${v:+_bow_only}
+      "$U" eval-image-loop "share/vision_loop/${d}_k10_L4.usvoc" "$R/samples" --gt "$R/ground_truth_loops.txt" \
+        --out "$OUT/rtabmap_$tag" --quiet --json $v > "$OUT/rtabmap_$tag.json"
+      printf '%-22s ' "rtabmap $tag:"; cat "$OUT/rtabmap_$tag.json"
+    done
+  done
+else
+  echo "skipping RTAB-Map evaluation: $R not found"
+fi
+for d in sift orb; do
+  "$U" eval-image-loop "share/vision_loop/${d}_k10_L4.usvoc" rawlogs/rtabmap-loop-excerpt \
+    --gt rawlogs/rtabmap-loop-excerpt/ground_truth_loops.txt --out "$OUT/excerpt_$d" --quiet --json > "$OUT/excerpt_$d.json"
+  printf '%-22s ' "excerpt $d:"; cat "$OUT/excerpt_$d.json"
+done
+
+# 3. Speed: quantisation, query vs database size (10^3..10^6), vocabulary load, per frame.
+"$BUILD/bench/vision_loop/vision_loop_bench" --benchmark_out="$OUT/bench.json" --benchmark_out_format=json
