@@ -4,6 +4,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "urbanslam/alignment/NearestNeighbours.h"
 #include "urbanslam/common/Timing.h"
 
 namespace urbanslam::alignment {
@@ -58,15 +59,27 @@ AlignmentResult alignPointSets(const PointSet& a, const PointSet& b, const Pose2
       CrfDiagnostics diag;
       const RegistrationResult coarse = crfMatch(a, b, guess, options.crf, &diag);
       std::vector<Pose2> starts;
-      if (coarse.converged) starts.push_back(coarse.transform);
-      for (const auto& h : diag.hypotheses) starts.push_back(h);
-      starts.push_back(guess);
+      auto addStart = [&](const Pose2& p) {
+        // Starts this close converge to the same answer: one ICP run is enough.
+        for (const auto& q : starts)
+          if (std::hypot(p.x - q.x, p.y - q.y) < 0.2 && std::abs(common::wrapToPi(p.phi - q.phi)) < 0.05) return;
+        starts.push_back(p);
+      };
+      if (coarse.converged) addStart(coarse.transform);
+      for (const auto& h : diag.hypotheses) addStart(h);
+      addStart(guess);
       point_to_line = options.refine_point_to_line;
+      std::vector<Eigen::Vector2d> ref_pts;
+      ref_pts.reserve(a.size());
+      for (const auto& q : a) ref_pts.push_back(q.p);
+      const NearestNeighbours index(std::move(ref_pts));
+      const std::vector<LineNormal> normals =
+          point_to_line ? computeLineNormals(a, options.icp.normals) : std::vector<LineNormal>{};
       bool have = false;
       int total_iterations = coarse.iterations;
       double best_count = -1;
       for (const auto& st : starts) {
-        RegistrationResult r = point_to_line ? plIcp(a, b, st, options.icp) : icp(a, b, st, options.icp);
+        RegistrationResult r = icpWithIndex(a, index, normals, b, st, options.icp);
         total_iterations += r.iterations;
         if (!r.converged) {
           if (!have) reg = r;
