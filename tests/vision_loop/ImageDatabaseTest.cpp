@@ -100,3 +100,19 @@ TEST(ImageDatabase, QueryRestrictedToCandidatesAndOlderImages) {
   EXPECT_GT(db.query(bags[17], all).size(), 4u);
   EXPECT_EQ(db.query(bags[17], all)[0].image, 17u);
 }
+
+#include "urbanslam/vision_loop/CandidateSelection.h"
+
+TEST(CandidateSelection, GatesByMahalanobisDistanceBeyondViewRange) {
+  using urbanslam::common::Pose2;
+  const std::vector<Pose2> poses = {{0, 0, 0}, {10, 0, 0}, {20, 0, 0}, {0, 40, 0}};
+  // Image 3 is uncertain along y only: 35 m beyond view range / σ_y = 20 m → m² ≈ 3.1, inside.
+  const std::vector<PositionCovariance> cov = {{1, 0, 1}, {1, 0, 1}, {1, 0, 1}, {1, 0, 400}};
+  CandidateGateOptions o;
+  o.view_range_m = 5;
+  const auto c = selectCandidates(poses, cov, Pose2{1, 0, 0}, o);
+  // Image 0 (1 m away), image 1 (9 m: 4 m beyond range, m² = 16 > 9.21 → out), image 2 far, image 3 in.
+  EXPECT_EQ(c, (std::vector<ImageId>{0, 3}));
+  o.chi2_gate = 20;
+  EXPECT_EQ(selectCandidates(poses, cov, Pose2{1, 0, 0}, o), (std::vector<ImageId>{0, 1, 3}));
+}
