@@ -36,6 +36,8 @@ int graphCommand(const Argv& args) {
   ap.addFlag("json", "print one JSON object on stdout instead of text");
   ap.addFlag("gate", "gate loop closures with the chi2 test (rejected edges still count in chi2)");
   ap.addOption("gate-probability", "P", "chi2 quantile probability of the gate", "0.999");
+  ap.addOption("gate-covariance", "MODE",
+               "exact (refactorise when stale) or conservative (last factorisation + dead reckoning)", "exact");
   ap.addFlag("no-relinearise", "linearise every edge once, as the thesis filter does");
   ap.addOption("full-every", "N", "full recovery after N loop closures", "20");
   ap.addOption("innovation-chi2", "X", "full recovery at once after a closure with innovation chi2 above X", "50");
@@ -51,6 +53,10 @@ int graphCommand(const Argv& args) {
   o.filter.chi2_gate_probability = ap.optionDouble("gate-probability");
   if (!(o.filter.chi2_gate_probability > 0 && o.filter.chi2_gate_probability < 1))
     throw common::InputError("--gate-probability: must be in (0, 1)");
+  const std::string gate_cov = ap.option("gate-covariance");
+  if (gate_cov == "exact") o.filter.gate_covariance = esdf::CovarianceMode::Exact;
+  else if (gate_cov == "conservative") o.filter.gate_covariance = esdf::CovarianceMode::Conservative;
+  else throw common::InputError("--gate-covariance: '" + gate_cov + "' is not one of exact|conservative");
   o.filter.relinearise = !ap.flag("no-relinearise");
   o.full_recovery_every_closures = static_cast<int>(ap.optionInt("full-every"));
   o.full_recovery_innovation_chi2 = ap.optionDouble("innovation-chi2");

@@ -47,6 +47,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[a], "--passes")) o.incremental_relinearise_passes = std::atoi(next());
     else if (!std::strcmp(argv[a], "--no-relin")) o.filter.relinearise = false;
     else if (!std::strcmp(argv[a], "--gate")) o.gate_loop_closures = true;
+    else if (!std::strcmp(argv[a], "--conservative")) o.filter.gate_covariance = esdf::CovarianceMode::Conservative;
     else if (!std::strcmp(argv[a], "--gap")) o.full_recovery_min_gap_fraction = std::atof(next());
     else {
       try {
@@ -54,9 +55,9 @@ int main(int argc, char** argv) {
         const esdf::PoseGraph g = esdf::readPoseGraph(argv[a]);
         const double read_s = sw.seconds();
         const auto r = esdf::runPoseGraphBackend(g, o);
-        std::printf("%-60s poses %6zu edges %6d chi2 %14.6f time %7.3f s (read %.3f, recovery %.3f) full %5d partial %5d "
+        std::printf("%-60s rejected %d poses %6zu edges %6d chi2 %14.6f time %7.3f s (read %.3f, recovery %.3f) full %5d partial %5d "
                     "relin %8lld final passes %d%s p50 %.4f p99 %.4f ms\n",
-                    argv[a], r.poses.size(), r.edges, r.chi2, r.time_s, read_s, r.recovery_s, r.full_recoveries,
+                    argv[a], r.rejected_edges, r.poses.size(), r.edges, r.chi2, r.time_s, read_s, r.recovery_s, r.full_recoveries,
                     r.partial_recoveries, r.factors_relinearised, r.final_relinearise_passes, r.converged ? " (converged)" : " (NOT converged)", common::percentile(r.step_ms, 50),
                     common::percentile(r.step_ms, 99));
       } catch (const std::exception& e) {

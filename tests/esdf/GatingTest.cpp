@@ -1,6 +1,8 @@
 // Chi-square quantiles and the innovation gate on consistent and inconsistent loop closures.
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
+
 #include "TestUtil.h"
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/esdf/Gating.h"
@@ -50,6 +52,41 @@ TEST_P(GatingLoop, AcceptsConsistentRejectsInconsistentClosure) {
   const ObservationResult good = f.observeRelative(0, 40, z_true + Vec3(0.05, -0.05, 0.01), loop, true);
   EXPECT_TRUE(good.accepted) << good.gate.mahalanobis2 << " vs " << good.gate.threshold;
   EXPECT_NEAR(good.gate.threshold, chi2Quantile(0.99, 3), 1e-9);
+}
+
+TEST(Gating, BoundShortcutNeverAcceptsWhatTheFullTestRejects) {
+  // d^2 = e' (H Sigma H' + R)^-1 e <= e' Omega e: the shortcut is conservative in the right
+  // direction. Check it against the full test on random closures of a drifting loop.
+  std::mt19937 rng(41);
+  EsdfOptions o;
+  o.chi2_gate_probability = 0.95;
+  Esdf f(o);
+  f.initialise(Vec3::Zero(), Mat3::Identity() * 1e-8);
+  for (int k = 1; k <= 60; ++k)
+    f.augmentRelative(k - 1, Vec3(1.0, 0.0, (k % 15 == 0) ? M_PI / 2 : 0.0), Vec3(400.0, 400.0, 4000.0).asDiagonal());
+  const Mat3 omega = Vec3(100.0, 100.0, 1000.0).asDiagonal();
+  int shortcut = 0, full = 0;
+  for (int t = 0; t < 200; ++t) {
+    const int i = t % 30, j = 30 + t % 30;
+    const Vec3 z = between(f.mean(i), f.mean(j)) + Vec3(test::gauss(rng, 0.3), test::gauss(rng, 0.3), test::gauss(rng, 0.1));
+    const GateResult g = f.gateRelative(i, j, z, omega);
+    Mat3 ai, aj;
+    relativePoseErrorJacobians(f.mean(i), f.mean(j), z, &ai, &aj);
+    Eigen::Matrix<double, 3, 6> h;
+    h << ai, aj;
+    const Eigen::MatrixXd s = h * f.jointCovariance(i, j) * h.transpose() + omega.inverse();
+    const GateResult ref = mahalanobisGate(-relativePoseError(f.mean(i), f.mean(j), z), s, 0.95);
+    EXPECT_EQ(g.accepted, ref.accepted);
+    if (!g.covariance_used) {
+      EXPECT_LE(ref.mahalanobis2, g.mahalanobis2 + 1e-12);
+      ++shortcut;
+    } else {
+      EXPECT_NEAR(g.mahalanobis2, ref.mahalanobis2, 1e-9 * ref.mahalanobis2);
+      ++full;
+    }
+  }
+  EXPECT_GT(shortcut, 0);
+  EXPECT_GT(full, 0);
 }
 
 INSTANTIATE_TEST_SUITE_P(Modes, GatingLoop, ::testing::Values(CovarianceMode::Exact, CovarianceMode::Conservative));

@@ -191,6 +191,21 @@ ObservationResult Esdf::observeRelative(int i, int j, const Vec3& z, const Mat3&
 GateResult Esdf::gateRelative(int i, int j, const Vec3& z, const Mat3& omega) {
   if (i < 0 || j < 0 || i >= size() || j >= size() || i == j) throw std::out_of_range("gateRelative: bad pose indices");
   const Vec3 e0 = relativePoseError(state_.mean(i), state_.mean(j), z);
+  if (gate_probability_ != options_.chi2_gate_probability) {
+    gate_probability_ = options_.chi2_gate_probability;
+    gate_threshold_ = chi2Quantile(gate_probability_, 3);
+  }
+  // S = H Sigma H' + R >= R, so d^2 = e' S^-1 e <= e' Omega e: a closure within the gate by
+  // this bound is accepted without recovering any covariance (the common, consistent case).
+  const double bound = e0.dot(omega * e0);
+  if (bound <= gate_threshold_) {
+    GateResult r;
+    r.accepted = true;
+    r.mahalanobis2 = bound;
+    r.threshold = gate_threshold_;
+    r.covariance_used = false;
+    return r;
+  }
   Mat3 ai, aj;
   relativePoseErrorJacobians(state_.mean(i), state_.mean(j), z, &ai, &aj);
   const Mat6 sigma = jointCovariance(i, j, options_.gate_covariance);
@@ -198,7 +213,7 @@ GateResult Esdf::gateRelative(int i, int j, const Vec3& z, const Mat3& omega) {
   h << ai, aj;
   // S = H Sigma H' + R with the innovation -e0 (the measurement "e = 0").
   const Mat3 s = h * sigma * h.transpose() + omega.inverse();
-  return mahalanobisGate(-e0, s, options_.chi2_gate_probability);
+  return mahalanobisGate(-e0, s, gate_probability_);
 }
 
 void Esdf::ensureFactor() {

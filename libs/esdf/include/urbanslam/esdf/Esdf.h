@@ -154,6 +154,7 @@ class Esdf {
 
   SparseCholesky full_factor_;
   SparseCholesky window_factor_;
+  double gate_probability_ = -1, gate_threshold_ = 0;  // cached chi2 quantile
   std::uint64_t values_stamp_ = 0;          // bumped on every change of Lambda or eta
   std::uint64_t full_factor_values_ = ~std::uint64_t{0};
 

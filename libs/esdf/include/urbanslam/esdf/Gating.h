@@ -19,6 +19,9 @@ struct GateResult {
   bool accepted = true;
   double mahalanobis2 = 0;  // d^2
   double threshold = 0;     // chi2 quantile used
+  // False when the test was decided by the bound d^2 <= nu' R^-1 nu (S >= R), in which case
+  // mahalanobis2 holds that bound and no covariance was recovered.
+  bool covariance_used = true;
 };
 
 // d^2 of innovation nu with covariance s against the p-quantile (dof = nu.size()).
