@@ -31,11 +31,10 @@ void writePrCurvePng(const std::vector<PrPoint>& curve, const std::string& title
   cv::putText(img, "recall", cv::Point(left + pw / 2 - 25, h - 15), font, 0.55, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
   cv::putText(img, "precision", cv::Point(5, top - 12), font, 0.55, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
   cv::putText(img, title, cv::Point(left, 25), font, 0.5, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-  // Points ordered by recall (thresholds decrease along the curve).
+  // Connected in order of decreasing threshold: the curve a user walks by lowering α (recall
+  // need not grow monotonically: islands and temporal consistency change with α).
   std::vector<PrPoint> pts = curve;
-  std::sort(pts.begin(), pts.end(), [](const PrPoint& a, const PrPoint& b) {
-    return a.recall < b.recall || (a.recall == b.recall && a.precision > b.precision);
-  });
+  std::sort(pts.begin(), pts.end(), [](const PrPoint& a, const PrPoint& b) { return a.threshold > b.threshold; });
   for (size_t i = 1; i < pts.size(); ++i)
     cv::line(img, px(pts[i - 1].recall, pts[i - 1].precision), px(pts[i].recall, pts[i].precision),
              cv::Scalar(200, 80, 0), 2, cv::LINE_AA);
