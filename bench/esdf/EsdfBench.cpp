@@ -12,12 +12,13 @@
 //     recovery of the 50 most recent poses, and the joint covariance of a pair 20 poses after
 //     that factorisation: exact (refactorise + column solves) / conservative (old factor + dead
 //     reckoning, no refactorisation).
-// Usage: esdf_bench [--no-full-above N] SIZE...   (default sizes 1000 10000 100000 1000000)
+// Usage: esdf_bench [--no-full-above N] [--ordering amd|metis|auto|natural] SIZE...   (default sizes 1000 10000 100000 1000000)
 #include <Eigen/Core>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <random>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -40,12 +41,15 @@ struct Row {
   long long factor_nnz = 0;
 };
 
+esdf::FillReducingOrdering g_ordering = esdf::FillReducingOrdering::Amd;
+
 Row runSize(long n, long no_full_above) {
   std::mt19937 rng(static_cast<unsigned>(n));
   std::normal_distribution<double> g(0.0, 1.0);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   esdf::EsdfOptions opt;
   opt.relinearise = true;
+  opt.ordering = g_ordering;
   esdf::Esdf f(opt);
   f.reserve(static_cast<int>(n));
   f.initialise(Vec3::Zero(), Mat3::Identity() * 1e-8);
@@ -134,6 +138,12 @@ int main(int argc, char** argv) {
   long no_full_above = 100000000;
   for (int a = 1; a < argc; ++a) {
     if (!std::strcmp(argv[a], "--no-full-above") && a + 1 < argc) no_full_above = std::atol(argv[++a]);
+    else if (!std::strcmp(argv[a], "--ordering") && a + 1 < argc) {
+      const std::string o = argv[++a];
+      g_ordering = o == "metis" ? esdf::FillReducingOrdering::Metis
+                   : o == "auto" ? esdf::FillReducingOrdering::Auto
+                   : o == "natural" ? esdf::FillReducingOrdering::Natural : esdf::FillReducingOrdering::Amd;
+    }
     else sizes.push_back(std::atol(argv[a]));
   }
   if (sizes.empty()) sizes = {1000, 10000, 100000, 1000000};

@@ -47,6 +47,8 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[a], "--passes")) o.incremental_relinearise_passes = std::atoi(next());
     else if (!std::strcmp(argv[a], "--no-relin")) o.filter.relinearise = false;
     else if (!std::strcmp(argv[a], "--gate")) o.gate_loop_closures = true;
+    else if (!std::strcmp(argv[a], "--metis")) o.filter.ordering = esdf::FillReducingOrdering::Metis;
+    else if (!std::strcmp(argv[a], "--auto")) o.filter.ordering = esdf::FillReducingOrdering::Auto;
     else if (!std::strcmp(argv[a], "--conservative")) o.filter.gate_covariance = esdf::CovarianceMode::Conservative;
     else if (!std::strcmp(argv[a], "--gap")) o.full_recovery_min_gap_fraction = std::atof(next());
     else {

@@ -134,18 +134,25 @@ int Esdf::predictAugment(std::shared_ptr<const MotionModel> model, const VecU& u
   return k;
 }
 
-int Esdf::augmentRelative(int from, const Vec3& z, const Mat3& omega) {
+int Esdf::augmentRelative(int from, const Vec3& z, const Mat3& omega, bool measured_from_new) {
   if (state_.size() == 0) throw std::logic_error("Esdf: augment before initialise");
   if (from < 0 || from >= size()) throw std::out_of_range("augmentRelative: bad pose index");
-  Factor f{Factor::Kind::Relative, from, -1, z, omega, 0, nullptr, state_.mean(from), Vec3::Zero()};
-  f.lin_b = compose(f.lin_a, z);
+  const Vec3 x_from = state_.mean(from);
+  const Vec3 x_new = compose(x_from, measured_from_new ? inverse(z) : z);
   first_factor_of_pose_.push_back(static_cast<int>(factors_.size()));
-  f.b = state_.addPose(f.lin_b);
-  // x_b = -A_b^-1 A_a x_a + A_b^-1 v from the linearised edge error A_a dx_a + A_b dx_b = v.
+  const int k = state_.addPose(x_new);
+  Factor f{Factor::Kind::Relative, from, k, z, omega, 0, nullptr, x_from, x_new};
+  if (measured_from_new) {
+    std::swap(f.a, f.b);
+    std::swap(f.lin_a, f.lin_b);
+  }
+  // x_new = -A_new^-1 A_from x_from + A_new^-1 v from the linearised edge error
+  // A_from dx_from + A_new dx_new = v (for the conservative-covariance dead reckoning).
   const Linearisation l = linearise(f, f.lin_a, f.lin_b);
-  const Mat3 ab_inv = l.a_b.inverse();
-  pushChain(f.b, from, -ab_inv * l.a_a, ab_inv * l.w.inverse() * ab_inv.transpose());
-  const int k = f.b;
+  const Mat3& a_from = measured_from_new ? l.a_b : l.a_a;
+  const Mat3& a_new = measured_from_new ? l.a_a : l.a_b;
+  const Mat3 an_inv = a_new.inverse();
+  pushChain(k, from, -an_inv * a_from, an_inv * l.w.inverse() * an_inv.transpose());
   addFactor(std::move(f));
   return k;
 }

@@ -10,19 +10,6 @@
 namespace urbanslam::esdf {
 namespace {
 
-// An edge b -> a given as a -> b: measurement ⊖z and the information of the reversed error
-// e' = z ⊕ ⊖e ⊕ ⊖z ~ M e, so Omega' = M^-T Omega M^-1.
-void reverseEdge(const Vec3& z, const Mat3& omega, Vec3* z_rev, Mat3* omega_rev) {
-  *z_rev = inverse(z);
-  const Vec3 zero = Vec3::Zero();
-  Mat3 j1, j2;
-  composeJacobians(compose(z, inverse(zero)), inverse(z), &j1, nullptr);
-  composeJacobians(z, inverse(zero), nullptr, &j2);
-  const Mat3 m = j1 * j2 * inverseJacobian(zero);
-  const Mat3 m_inv = m.inverse();
-  *omega_rev = m_inv.transpose() * omega * m_inv;
-}
-
 }  // namespace
 
 PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBackendOptions& opt) {
@@ -97,14 +84,10 @@ PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBa
       const auto& e = g.edges[static_cast<size_t>(order[q])];
       const int a = index[e.from], b = index[e.to];
       if (q == aug) {
-        if (b == k) {
+        if (b == k)
           filter.augmentRelative(a, e.measurement, e.information);
-        } else {
-          Vec3 z;
-          Mat3 om;
-          reverseEdge(e.measurement, e.information, &z, &om);
-          filter.augmentRelative(b, z, om);
-        }
+        else  // an edge new -> earlier: kept as given so that its g2o error is what is minimised
+          filter.augmentRelative(b, e.measurement, e.information, true);
         ++res.augment_edges;
       } else {
         if (opt.dead_reckoning_only) {

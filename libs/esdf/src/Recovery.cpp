@@ -18,8 +18,12 @@ struct SparseCholesky::Impl {
 
   explicit Impl(FillReducingOrdering o) : ordering(o) {
     cholmod_start(&common);
-    common.nmethods = 1;
-    common.method[0].ordering = o == FillReducingOrdering::Amd ? CHOLMOD_AMD : CHOLMOD_NATURAL;
+    switch (o) {
+      case FillReducingOrdering::Amd: common.nmethods = 1; common.method[0].ordering = CHOLMOD_AMD; break;
+      case FillReducingOrdering::Metis: common.nmethods = 1; common.method[0].ordering = CHOLMOD_METIS; break;
+      case FillReducingOrdering::Natural: common.nmethods = 1; common.method[0].ordering = CHOLMOD_NATURAL; break;
+      case FillReducingOrdering::Auto: break;  // cholmod_start's defaults
+    }
     common.postorder = 1;
     common.print = 0;
   }

@@ -89,7 +89,9 @@ class Esdf {
   // Prediction with augmentation from any earlier pose `from` by a relative pose z with
   // information omega (the laser/odometry model x ⊕ u with Q = J2⊕ Omega^-1 J2⊕'), using the
   // g2o edge error so that pose-graph chi2 is minimised exactly.
-  int augmentRelative(int from, const Vec3& z, const Mat3& omega);
+  // With measured_from_new, z is the pose of `from` seen from the new pose (an edge new -> from,
+  // as pose-graph files sometimes store odometry); the edge is kept as given, not inverted.
+  int augmentRelative(int from, const Vec3& z, const Mat3& omega, bool measured_from_new = false);
 
   // Relative-pose observation z = ⊖x_i ⊕ x_j (+ noise with information omega), linearised at the
   // current mean. When `gate` is true, it is first tested against the chi2 gate with the joint

@@ -1,8 +1,9 @@
 #pragma once
 // State and covariance recovery for the information filter: a CHOLMOD (SuiteSparse) sparse
 // Cholesky factorisation of Lambda, or of the principal sub-block of a range of poses, with a
-// fill-reducing ordering (AMD). The symbolic analysis is reused while the block structure is
-// unchanged, which is the case between relinearisation passes.
+// fill-reducing ordering (AMD by default; METIS nested dissection pays off on very large
+// grid-like graphs). The symbolic analysis is reused while the block structure is unchanged,
+// which is the case between relinearisation passes.
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
@@ -11,7 +12,12 @@
 
 namespace urbanslam::esdf {
 
-enum class FillReducingOrdering { Amd, Natural };
+enum class FillReducingOrdering {
+  Amd,     // approximate minimum degree
+  Metis,   // METIS nested dissection
+  Auto,    // CHOLMOD's default strategy (AMD, then METIS when AMD's fill is high)
+  Natural  // pose order (no reordering; for comparisons)
+};
 
 class SparseCholesky {
  public:
