@@ -39,14 +39,17 @@ int trainLaserLoopCommand(const Argv& args) {
   ap.addOption("d-neg", "M", "negative pair: reference positions farther apart than this", "3.0");
   ap.addOption("min-travel", "M", "positive pair: at least this much reference trajectory between the scans", "10");
   ap.addOption("max-heading-diff", "DEG", "positive pair: heading difference at most this (180: any heading)", "180");
-  ap.addOption("max-positives", "N", "positives per log (random subset beyond)", "20000");
+  ap.addOption("max-positives", "N", "positives per log (random subset beyond; keeps one big log from dominating)", "3000");
   ap.addOption("t-max", "N", "cross-validate T = 1..N", "100");
   ap.addOption("folds", "K", "cross-validation folds (0: no cross-validation, use --t)", "10");
   ap.addOption("t", "N", "use this T instead of the cross-validated choice");
   ap.addOption("tolerance", "E", "choose the smallest T within E of the least total CV error", "0.002");
-  ap.addOption("r-max", "M", "feature gate r_max", "30");
-  ap.addOption("g-max-dist", "M", "feature gate g_max_dist", "2.5");
+  // Defaults chosen by tenfold CV on the Freiburg training logs over r_max ∈ {10,20,30,50},
+  // g_max_dist ∈ {1, 2.5} (share/laser_loop/README.md).
+  ap.addOption("r-max", "M", "feature gate r_max", "50");
+  ap.addOption("g-max-dist", "M", "feature gate g_max_dist", "1.0");
   ap.addOption("g-min-size", "N", "feature gate g_min_size", "3");
+  ap.addOption("beam-increment", "DEG", "decimate finer scans to this angular resolution (0: keep all beams)", "1.0");
   ap.addOption("factor", "F", "strong-classifier factor stored in the model (eq. 3.30)", "0.5");
   ap.addOption("seed", "N", "random seed for pair sampling and fold split", "1");
   ap.addFlag("quiet", "no progress bars");
@@ -59,6 +62,7 @@ int trainLaserLoopCommand(const Argv& args) {
   lo.params.r_max_m = ap.optionDouble("r-max");
   lo.params.g_max_dist_m = ap.optionDouble("g-max-dist");
   lo.params.g_min_size = static_cast<int>(ap.optionInt("g-min-size"));
+  lo.params.beam_increment_deg = ap.optionDouble("beam-increment");
   if (!(lo.params.r_max_m > 0) || !(lo.params.g_max_dist_m > 0) || lo.params.g_min_size < 0)
     throw common::InputError("--r-max and --g-max-dist must be > 0, --g-min-size >= 0");
   laser_loop::PairRules rules;

@@ -54,9 +54,24 @@ void BM_Features361(benchmark::State& st) {
     benchmark::DoNotOptimize(computeFeatures(s[i], p));
     if (++i == s.size()) i = 0;
   }
-  st.SetLabel(std::to_string(s.front().size()) + " beams");
+  st.SetLabel(std::to_string(s.front().size()) + " beams, decimated to the model's beam_increment_deg");
 }
 BENCHMARK(BM_Features361)->Unit(benchmark::kMicrosecond);
+
+// The same scans with every beam kept (beam_increment_deg = 0): all 361 beams go through every
+// feature, the "features of a 361-beam scan" without the 1° decimation of the default.
+void BM_Features361AllBeams(benchmark::State& st) {
+  const auto& s = scans();
+  FeatureParams p = model().params;
+  p.beam_increment_deg = 0;
+  size_t i = 0;
+  for (auto _ : st) {
+    benchmark::DoNotOptimize(computeFeatures(s[i], p));
+    if (++i == s.size()) i = 0;
+  }
+  st.SetLabel(std::to_string(s.front().size()) + " beams, none decimated");
+}
+BENCHMARK(BM_Features361AllBeams)->Unit(benchmark::kMicrosecond);
 
 void BM_PairScore(benchmark::State& st) {
   std::vector<FeatureVector> f;

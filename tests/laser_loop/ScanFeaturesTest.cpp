@@ -248,3 +248,22 @@ TEST(ScanFeatures, EmptyAndAllFarScansAreFinite) {
   for (const auto& f : {computeFeatures(makeScan({}, 0, kDeg), p), computeFeatures(makeScan({0, 0, 0, 50}, 0, kDeg), p)})
     for (double v : f) EXPECT_TRUE(std::isfinite(v));
 }
+
+// A 0.5° scan is compared at 1°: its features are those of every other beam.
+TEST(ScanFeatures, FinerScansAreDecimatedToTheCommonResolution) {
+  io::LaserScan fine = makeScan({}, -M_PI / 2, 0.5 * kDeg);
+  io::LaserScan coarse = makeScan({}, -M_PI / 2, kDeg);
+  const io::LaserScan room = roomScan360();
+  for (int i = 0; i < 361; ++i) {
+    fine.ranges.push_back(room.ranges[static_cast<size_t>(i / 2)] + 0.01f * static_cast<float>(i % 2));
+    fine.valid.push_back(room.valid[static_cast<size_t>(i / 2)]);
+    if (i % 2 == 0) {
+      coarse.ranges.push_back(fine.ranges.back());
+      coarse.valid.push_back(fine.valid.back());
+    }
+  }
+  auto p = params(30, 1.0, 3);
+  expectSame(computeFeatures(coarse, p), computeFeatures(fine, p), "decimated");
+  p.beam_increment_deg = 0;  // every beam: the odd beams change the features
+  EXPECT_NE(get(computeFeatures(fine, p), Feature::Size), get(computeFeatures(coarse, p), Feature::Size));
+}

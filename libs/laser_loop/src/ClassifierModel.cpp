@@ -72,6 +72,7 @@ std::string modelToText(const ClassifierModel& m) {
   os << "r_max_m " << num(m.params.r_max_m) << "\n";
   os << "g_max_dist_m " << num(m.params.g_max_dist_m) << "\n";
   os << "g_min_size " << m.params.g_min_size << "\n";
+  os << "beam_increment_deg " << num(m.params.beam_increment_deg) << "\n";
   os << "factor " << num(m.factor) << "\n";
   for (const auto& [k, v] : m.provenance) {
     std::string value = v;
@@ -111,7 +112,7 @@ ClassifierModel parseModel(const std::string& text, const std::string& source) {
   std::string line;
   size_t ln = 0;
   bool have_magic = false, have_features = false, have_end = false;
-  bool have_r = false, have_g = false, have_s = false, have_factor = false;
+  bool have_r = false, have_g = false, have_s = false, have_b = false, have_factor = false;
   long declared_stumps = -1;
   std::vector<WeightedStump> stumps;
   while (std::getline(in, line)) {
@@ -156,6 +157,11 @@ ClassifierModel parseModel(const std::string& text, const std::string& source) {
       need(2);
       m.params.g_min_size = static_cast<int>(p.integer(f[1], ln, key));
       have_s = true;
+    } else if (key == "beam_increment_deg") {
+      need(2);
+      m.params.beam_increment_deg = p.number(f[1], ln, key);
+      if (m.params.beam_increment_deg < 0) p.fail(ln, "beam_increment_deg must be >= 0");
+      have_b = true;
     } else if (key == "factor") {
       need(2);
       m.factor = p.number(f[1], ln, key);
@@ -205,6 +211,7 @@ ClassifierModel parseModel(const std::string& text, const std::string& source) {
   if (!have_r) missing += " r_max_m";
   if (!have_g) missing += " g_max_dist_m";
   if (!have_s) missing += " g_min_size";
+  if (!have_b) missing += " beam_increment_deg";
   if (!have_factor) missing += " factor";
   if (!have_features) missing += " features";
   if (declared_stumps < 0) missing += " stumps";

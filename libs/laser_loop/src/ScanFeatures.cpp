@@ -317,32 +317,42 @@ FeatureVector computeFeatures(const PolarScan& scan, const FeatureParams& params
 FeatureVector computeFeatures(const io::LaserScan& scan, const FeatureParams& params) {
   // Every feature depends on bearings only through their differences, so the beams are laid
   // out from bearing 0: the cos/sin table then depends on (N, increment) alone and is cached.
+  size_t step = 1;
+  if (params.beam_increment_deg > 0 && scan.angle_increment_rad > 0) {
+    const double k = params.beam_increment_deg * M_PI / 180.0 / scan.angle_increment_rad;
+    if (k > 1.5) step = static_cast<size_t>(std::lround(k));
+  }
+  const size_t n = (scan.size() + step - 1) / step;
+  const double inc = scan.angle_increment_rad * static_cast<double>(step);
   thread_local size_t cached_n = 0;
   thread_local double cached_inc = 0;
   thread_local std::vector<double> cos_t, sin_t, r;
   thread_local std::vector<uint8_t> valid;
-  const size_t n = scan.size();
-  if (n != cached_n || scan.angle_increment_rad != cached_inc) {
+  if (n != cached_n || inc != cached_inc) {
     cos_t.resize(n);
     sin_t.resize(n);
     for (size_t i = 0; i < n; ++i) {
-      cos_t[i] = std::cos(static_cast<double>(i) * scan.angle_increment_rad);
-      sin_t[i] = std::sin(static_cast<double>(i) * scan.angle_increment_rad);
+      cos_t[i] = std::cos(static_cast<double>(i) * inc);
+      sin_t[i] = std::sin(static_cast<double>(i) * inc);
     }
     cached_n = n;
-    cached_inc = scan.angle_increment_rad;
+    cached_inc = inc;
   }
-  r.assign(scan.ranges.begin(), scan.ranges.end());
-  valid.assign(scan.valid.begin(), scan.valid.end());
-  valid.resize(n, 0);
+  r.resize(n);
+  valid.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const size_t j = i * step;
+    r[i] = scan.ranges[j];
+    valid[i] = j < scan.valid.size() ? scan.valid[j] : 0;
+  }
   Beams b;
   b.n = n;
   b.r = r.data();
   b.valid = valid.data();
   b.c = cos_t.data();
   b.s = sin_t.data();
-  b.increment = scan.angle_increment_rad;
-  b.closed = coversCircle(n, scan.angle_increment_rad);
+  b.increment = inc;
+  b.closed = coversCircle(n, inc);
   return compute(b, params);
 }
 

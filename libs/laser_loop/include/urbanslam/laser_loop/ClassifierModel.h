@@ -9,6 +9,7 @@
 //   r_max_m 30
 //   g_max_dist_m 2.5
 //   g_min_size 3
+//   beam_increment_deg 1
 //   factor 0.5
 //   provenance <key> <value to end of line>      (any number)
 //   features 20 area average_range ...

@@ -17,6 +17,9 @@
 
 namespace urbanslam::laser_loop {
 
+// The trained default model, relative to the project home (the repo, or $URBANSLAM_HOME).
+constexpr const char* kDefaultModelPath = "share/laser_loop/default.model";
+
 class LoopDetector {
  public:
   explicit LoopDetector(ClassifierModel model);

@@ -23,9 +23,14 @@
 namespace urbanslam::laser_loop {
 
 struct FeatureParams {
-  double r_max_m = 30.0;       // ranges at or beyond this count as far (no structure seen)
-  double g_max_dist_m = 2.5;   // gate on the distance between consecutive points (3.11, groups)
+  double r_max_m = 50.0;       // ranges at or beyond this count as far (no structure seen)
+  double g_max_dist_m = 1.0;   // gate on the distance between consecutive points (3.11, groups)
   int g_min_size = 3;          // a cluster is a group when it has more than this many points
+  // Counts and sums over beams (size, distances, groups, angular difference, ...) scale with the
+  // angular resolution, so features of a 0.5° SICK and a 1° SICK are not comparable. Scans finer
+  // than this are decimated to it (every k-th beam, k = round(this / increment)) before the
+  // features are computed; 0 keeps every beam.
+  double beam_increment_deg = 1.0;
 };
 
 enum class Feature : int {
