@@ -176,6 +176,7 @@ struct Args {
   std::string datasets = "intel,csail,fr079,fr-campus,victoria";
   double range_sigma = -1, bearing_sigma_deg = -1;  // override the scan model's noise (< 0: default)
   double gate_initial = -1;                         // override IcpOptions::gate_initial_m
+  std::vector<std::string> crf;                     // CrfOptions overrides, name=value
 };
 
 }  // namespace
@@ -198,10 +199,11 @@ int main(int argc, char** argv) {
     else if (k == "--datasets") args.datasets = val();
     else if (k == "--range-sigma") args.range_sigma = std::stod(val());
     else if (k == "--gate-initial") args.gate_initial = std::stod(val());
+    else if (k == "--crf") args.crf.push_back(val());
     else if (k == "--bearing-sigma-deg") args.bearing_sigma_deg = std::stod(val());
     else {
       std::cerr << "usage: alignment_bench [--data DIR] [--pairs N] [--seed S] [--methods a,b] "
-                   "[--datasets a,b] [--range-sigma M] [--gate-initial M] [--bearing-sigma-deg D] [--no-covariance] [--verbose] [--json OUT]\n";
+                   "[--datasets a,b] [--range-sigma M] [--gate-initial M] [--crf name=value ...] [--bearing-sigma-deg D] [--no-covariance] [--verbose] [--json OUT]\n";
       return 2;
     }
   }
@@ -224,6 +226,28 @@ int main(int argc, char** argv) {
   ua::AlignerOptions base;  // library defaults
   if (args.range_sigma > 0) base.scan.range_sigma_m = args.range_sigma;
   if (args.gate_initial > 0) base.icp.gate_initial_m = args.gate_initial;
+  for (const auto& kv : args.crf) {
+    const auto eq = kv.find('=');
+    const std::string key = kv.substr(0, eq);
+    const double v = std::stod(kv.substr(eq + 1));
+    auto& c = base.crf;
+    if (key == "target_points") c.subsampling.target_points = static_cast<int>(v);
+    else if (key == "feature_sigma_rad") c.feature_sigma_rad = v;
+    else if (key == "pair_sigma_m") c.pair_sigma_m = v;
+    else if (key == "pair_direction_sigma_rad") c.pair_direction_sigma_rad = v;
+    else if (key == "pair_floor") c.pair_floor = v;
+    else if (key == "outlier_local") c.outlier_local = v;
+    else if (key == "outlier_pair") c.outlier_pair = v;
+    else if (key == "bp_iterations") c.bp_iterations = static_cast<int>(v);
+    else if (key == "bp_damping") c.bp_damping = v;
+    else if (key == "candidates_per_point") c.candidates_per_point = static_cast<int>(v);
+    else if (key == "tangent_radius_m") c.tangent_radius_m = v;
+    else if (key == "min_marginal") c.min_marginal = v;
+    else {
+      std::cerr << "--crf: unknown key " << key << "\n";
+      return 2;
+    }
+  }
   if (args.bearing_sigma_deg > 0) base.scan.bearing_sigma_rad = args.bearing_sigma_deg * M_PI / 180;
   std::vector<Method> methods;
   {
@@ -237,8 +261,20 @@ int main(int argc, char** argv) {
       Method m;
       m.name = n;
       m.options = base;
-      if (n == "mrpt") m.mrpt = true;
-      else m.options.method = ua::parseMethod(n);
+      // "method:kernel" (e.g. plicp:none) selects the robust kernel of the ICP stages.
+      const std::string mname = n.substr(0, n.find(':'));
+      if (n.find(':') != std::string::npos) {
+        const std::string kern = n.substr(n.find(':') + 1);
+        if (kern == "none") m.options.icp.kernel = ua::RobustKernel::None;
+        else if (kern == "huber") m.options.icp.kernel = ua::RobustKernel::Huber;
+        else if (kern == "cauchy") m.options.icp.kernel = ua::RobustKernel::Cauchy;
+        else {
+          std::cerr << "unknown kernel " << kern << "\n";
+          return 2;
+        }
+      }
+      if (mname == "mrpt") m.mrpt = true;
+      else m.options.method = ua::parseMethod(mname);
       m.options.covariance.method = ua::CovarianceMethod::LineVariance;
       methods.push_back(m);
     }

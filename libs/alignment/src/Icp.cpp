@@ -105,8 +105,11 @@ RegistrationResult icpWithIndex(const PointSet& reference, const NearestNeighbou
     ref_index.clear();
     mov_index.clear();
     const Rigid2 T = Rigid2::fromPose(at);
-    // The kernel scale follows the gate so that early, coarse iterations are not starved.
-    const double k = std::max(options.kernel_scale_m, g / 3.0);
+    // The kernel acts once the gate has shrunk to its final size: in the coarse iterations it
+    // only slowed the pull towards the right basin (bench), near the answer it keeps occluded
+    // and cluttered pairs from biasing the estimate.
+    const bool robust = g <= gate_final * (1 + 1e-9);
+    const double k = options.kernel_scale_m;
     for (size_t i = 0; i < moving.size(); ++i) {
       const ScanPoint& q = moving[i];
       const Eigen::Vector2d m = T * q.p;
@@ -117,7 +120,7 @@ RegistrationResult icpWithIndex(const PointSet& reference, const NearestNeighbou
       if (point_to_line && normals[j].valid) e = std::abs(normals[j].n.dot(m - reference[j].p));
       src.push_back(q.p);
       dst.push_back(reference[j].p);
-      w.push_back(kernelWeight(options.kernel, e, k));
+      w.push_back(robust ? kernelWeight(options.kernel, e, k) : 1.0);
       ref_index.push_back(j);
       mov_index.push_back(static_cast<int>(i));
     }

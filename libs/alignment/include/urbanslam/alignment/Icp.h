@@ -26,8 +26,10 @@ struct IcpOptions {
   int max_iterations = 60;
   double tolerance_m = 1e-4;       // an update smaller than this (and tolerance_rad) has settled
   double tolerance_rad = 1e-4;
+  // The kernel weights pairs only at the final gate (see Icp.cpp). Applied at every gate it
+  // cost success on the Freiburg pairs (PL-ICP from 1 m / 30 deg: none 84 %, Cauchy 73 %).
   RobustKernel kernel = RobustKernel::Cauchy;
-  double kernel_scale_m = 0.1;     // residual at which the kernel starts to discount a pair
+  double kernel_scale_m = 0.05;    // residual at which the kernel starts to discount a pair
   int min_matches = 8;             // fewer pairs than this: no solution
   double min_overlap = 0.25;       // fraction of moving points matched at the final gate
   LineNormalOptions normals;       // point-to-line only
