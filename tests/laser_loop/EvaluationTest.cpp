@@ -144,3 +144,33 @@ TEST(NearestNeighbourBaseline, UnitScaledDistance) {
   EXPECT_NEAR(nn.score(a, b), -2 / std::sqrt(2.0), 1e-12);
   EXPECT_EQ(nn.score(a, a), 0.0);
 }
+
+// The whole chain on the shipped corrected-log excerpt: labelled pairs → cross-validation →
+// AdaBoost → model file → detector. Training pairs must be separated better than chance and a
+// reloaded model must score exactly as the trained one.
+TEST(EndToEnd, TrainSaveLoadDetectOnShippedExcerpt) {
+  ScanLoadOptions lo;
+  std::vector<ScanSet> sets = {loadLabelledScans(test::repoPath("rawlogs/intel-corrected-excerpt.log.gz"), lo)};
+  PairRules r;
+  r.min_travel_m = 0;
+  const auto pairs = samplePairs(sets[0], 0, r);
+  const PairTable table = makePairTable(sets, pairs);
+  CvOptions co;
+  co.t_max = 30;
+  const CvCurve cv = crossValidate(table, co);
+  EXPECT_LT(cv.total_rate[static_cast<size_t>(cv.chosen_T - 1)], 0.5);
+  ClassifierModel m;
+  m.params = lo.params;
+  m.classifier = trainAdaBoost(table, {}, cv.chosen_T);
+  const auto dir = test::scratchDir("laser_end_to_end");
+  saveModel(m, (dir / "m.model").string());
+  LoopDetector det = LoopDetector::fromFile((dir / "m.model").string());
+  for (const auto& s : sets[0].scans) det.addKeyframe(s.features);
+  size_t correct = 0;
+  for (const auto& p : pairs) {
+    const double s = det.score(sets[0].scans[p.a].features, p.b);
+    EXPECT_EQ(s, m.classifier.score(sets[0].scans[p.a].features, sets[0].scans[p.b].features));
+    correct += (s >= 0.5) == p.match;
+  }
+  EXPECT_GT(correct, pairs.size() * 3 / 4);  // training pairs
+}
