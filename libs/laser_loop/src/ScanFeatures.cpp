@@ -258,7 +258,7 @@ PolarScan toPolar(const io::LaserScan& scan) {
   return p;
 }
 
-PolarScan mergeScans(const std::vector<io::LaserScan>& scans) {
+PolarScan mergeScans(const std::vector<io::LaserScan>& scans, double beam_increment_deg) {
   struct B {
     double bearing, range;
     uint8_t valid;
@@ -266,9 +266,15 @@ PolarScan mergeScans(const std::vector<io::LaserScan>& scans) {
   std::vector<B> beams;
   double inc = 0;
   for (const auto& s : scans) {
-    if (s.angle_increment_rad > 0) inc = inc > 0 ? std::min(inc, s.angle_increment_rad) : s.angle_increment_rad;
+    size_t step = 1;
+    if (beam_increment_deg > 0 && s.angle_increment_rad > 0) {
+      const double k = beam_increment_deg * M_PI / 180.0 / s.angle_increment_rad;
+      if (k > 1.5) step = static_cast<size_t>(std::lround(k));
+    }
+    const double s_inc = s.angle_increment_rad * static_cast<double>(step);
+    if (s_inc > 0) inc = inc > 0 ? std::min(inc, s_inc) : s_inc;
     const double c = std::cos(s.sensor_pose.phi), sn = std::sin(s.sensor_pose.phi);
-    for (size_t i = 0; i < s.size(); ++i) {
+    for (size_t i = 0; i < s.size(); i += step) {
       const double a = s.bearing(i);
       if (i < s.valid.size() && s.valid[i]) {
         const double lx = s.ranges[i] * std::cos(a), ly = s.ranges[i] * std::sin(a);

@@ -38,10 +38,27 @@ ScanSet loadLabelledScans(const std::string& path, const ScanLoadOptions& opt) {
   io::Measurement m;
   size_t count = 0;
   long since_last_scan = -1;
+  // Scans of several lasers taken at the same instant (front + rear, distinct labels) are one
+  // observation of the place: they are merged about the vehicle origin before the features.
+  std::vector<io::LaserScan> group;
+  long group_ref = -1;
+  auto flush = [&] {
+    if (group.empty()) return;
+    const FeatureVector f = group.size() == 1 ? computeFeatures(group[0], opt.params)
+                                              : computeFeatures(mergeScans(group, opt.params.beam_increment_deg), opt.params);
+    scans.push_back({group[0].timestamp, f, group_ref});
+    group.clear();
+  };
   while (source->next(m)) {
-    if (const auto* s = std::get_if<io::LaserScan>(&m)) {
-      scans.push_back({s->timestamp, computeFeatures(*s, opt.params), since_last_scan});
-      since_last_scan = -1;
+    if (auto* s = std::get_if<io::LaserScan>(&m)) {
+      bool same_instant = !group.empty() && s->timestamp == group[0].timestamp;
+      for (const auto& g : group) same_instant = same_instant && g.label != s->label;
+      if (!same_instant) {
+        flush();
+        group_ref = since_last_scan;
+        since_last_scan = -1;
+      }
+      group.push_back(std::move(*s));
     } else if (const auto* r = std::get_if<io::ReferencePose>(&m)) {
       since_last_scan = static_cast<long>(refs.size());
       refs.push_back({r->timestamp, r->pose});
@@ -50,6 +67,7 @@ ScanSet loadLabelledScans(const std::string& path, const ScanLoadOptions& opt) {
     }
     if (opt.progress && (++count & 1023) == 0) opt.progress(source->progress());
   }
+  flush();
   set.scans_read = scans.size();
   if (refs.empty() && gps.empty())
     throw common::InputError(path + ": no reference trajectory (neither reference poses nor GPS) to label scan pairs");

@@ -32,6 +32,10 @@ class LoopDetector {
   void setFactor(double factor) { factor_ = factor; }
 
   FeatureVector features(const io::LaserScan& scan) const { return computeFeatures(scan, model_.params); }
+  // Several lasers of one instant (front + rear): merged about the vehicle origin first.
+  FeatureVector features(const std::vector<io::LaserScan>& scans) const {
+    return scans.size() == 1 ? features(scans[0]) : computeFeatures(mergeScans(scans, model_.params.beam_increment_deg), model_.params);
+  }
   // Stores a keyframe; ids are 0, 1, 2, ... in insertion order.
   size_t addKeyframe(const io::LaserScan& scan) { return addKeyframe(features(scan)); }
   size_t addKeyframe(const FeatureVector& f);

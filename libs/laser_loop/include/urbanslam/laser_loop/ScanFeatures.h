@@ -82,8 +82,9 @@ PolarScan toPolar(const io::LaserScan& scan);
 // Several lasers of one vehicle (e.g. front + back) merged into one polar scan about the vehicle
 // origin: every return is moved into the vehicle frame, re-expressed as (range, bearing) and the
 // beams sorted by bearing. The merged scan is closed when the bearings cover the full circle
-// without a gap larger than 4 beam increments.
-PolarScan mergeScans(const std::vector<io::LaserScan>& scans);
+// without a gap larger than 4 beam increments. Each scan finer than beam_increment_deg (> 0) is
+// decimated first, as computeFeatures(LaserScan) does.
+PolarScan mergeScans(const std::vector<io::LaserScan>& scans, double beam_increment_deg = 0);
 
 FeatureVector computeFeatures(const PolarScan& scan, const FeatureParams& params);
 FeatureVector computeFeatures(const io::LaserScan& scan, const FeatureParams& params);

@@ -12,7 +12,8 @@
 //    and after the scan when both are within gps_max_gap_s of it (the heading is the direction
 //    between those fixes when they are ≥ 0.5 m apart). Victoria Park's GPS jumps by metres at
 //    times (ACFR's own warning), so those labels are noisier than the corrected logs'.
-// Scans with neither are dropped (counted).
+// Scans with neither are dropped (counted). Scans of different lasers with the same timestamp
+// (front + rear) are merged into one (mergeScans) before their features are computed.
 //
 // A positive pair must also be a revisit: the reference trajectory between the two scans must be
 // at least min_travel_m long. Otherwise consecutive scans of a slowly moving robot — the same
