@@ -79,6 +79,10 @@ RegistrationResult icpWithIndex(const PointSet& reference, const NearestNeighbou
     result.failure_reason = os.str();
     return result;
   }
+  if (!normals.empty() && normals.size() != reference.size()) {
+    result.failure_reason = "line normals do not belong to the reference scan";
+    return result;
+  }
   if (!finitePose(guess)) {
     result.failure_reason = "initial guess is not finite";
     return result;

@@ -46,7 +46,8 @@ RegistrationResult plIcp(const PointSet& reference, const PointSet& moving,
                          const common::Pose2& guess, const IcpOptions& options);
 
 // The shared loop, for callers that run many alignments against one reference (sampling
-// covariance): a prebuilt index and normals (empty normals = point-to-point).
+// covariance): a prebuilt index of the reference and its normals (one per reference point;
+// empty = point-to-point).
 RegistrationResult icpWithIndex(const PointSet& reference, const NearestNeighbours& index,
                                 const std::vector<LineNormal>& normals, const PointSet& moving,
                                 const common::Pose2& guess, const IcpOptions& options);
