@@ -35,6 +35,7 @@ int evalImageLoopCommand(const Argv& args) {
   ap.addOption("exclude-recent", "N", "the last N frames are never loop candidates", "10");
   ap.addOption("consistency", "K", "earlier consecutive queries whose islands must agree (DBoW2 k)", "1");
   ap.addOption("min-inliers", "N", "geometric verification: minimum fundamental-matrix inliers", "20");
+  ap.addOption("ransac-px", "PX", "geometric verification: max distance to the epipolar line", "3");
   ap.addFlag("no-verification", "skip geometric verification");
   ap.addFlag("quiet", "no progress bar");
   ap.addFlag("json", "print the results as one JSON object");
@@ -55,6 +56,7 @@ int evalImageLoopCommand(const Argv& args) {
   lo.exclude_recent_frames = static_cast<int>(ap.optionInt("exclude-recent"));
   lo.temporal_consistency = static_cast<int>(ap.optionInt("consistency"));
   lo.verification.min_inliers = static_cast<int>(ap.optionInt("min-inliers"));
+  lo.verification.ransac_threshold_px = ap.optionDouble("ransac-px");
   lo.geometric_verification = !ap.flag("no-verification");
 
   // Features and words once (they do not depend on α); timed per frame.

@@ -6,6 +6,7 @@
 
 #include "TestPaths.h"
 #include "urbanslam/common/Error.h"
+#include "urbanslam/io/RawlogWriter.h"
 #include "urbanslam/vision_loop/ImageSequence.h"
 #include "urbanslam/vision_loop/LoopEvaluation.h"
 #include "urbanslam/vision_loop/VocabularyFile.h"
@@ -54,6 +55,40 @@ TEST(ImageSequence, FolderInNaturalOrder) {
   EXPECT_EQ(names[0], "1");
   EXPECT_EQ(names[9], "10");
   EXPECT_EQ(names[16], "41");
+}
+
+TEST(ImageSequence, RawlogImagesInFileOrder) {
+  // Embedded images (CObservationImage) of a rawlog are named by their 1-based position.
+  const auto dir = urbanslam::test::scratchDir("image_rawlog");
+  const std::string rawlog = (dir / "images.rawlog").string();
+  std::vector<cv::Mat> written;
+  {
+    urbanslam::io::RawlogWriter w(rawlog, urbanslam::io::RawlogLayout::Observations);
+    auto seq = openImageSequence(repoPath(kExcerpt));
+    NamedImage img;
+    for (int i = 0; i < 3 && seq->next(img); ++i) {
+      urbanslam::io::CameraImage c;
+      c.timestamp = 100 + i;
+      c.label = "CAMERA";
+      c.width = img.gray.cols;
+      c.height = img.gray.rows;
+      c.pixels = std::make_shared<const std::vector<uint8_t>>(img.gray.datastart, img.gray.dataend);
+      w.write(c);
+      written.push_back(img.gray.clone());
+    }
+    w.close();
+  }
+  auto seq = openImageSequence(rawlog);
+  NamedImage img;
+  size_t n = 0;
+  while (seq->next(img)) {
+    ASSERT_LT(n, written.size());
+    EXPECT_EQ(img.name, std::to_string(n + 1));
+    EXPECT_DOUBLE_EQ(img.timestamp, 100.0 + n);
+    EXPECT_EQ(cv::norm(img.gray, written[n], cv::NORM_INF), 0.0);
+    ++n;
+  }
+  EXPECT_EQ(n, written.size());
 }
 
 TEST(GroundTruthLoops, ParsesNamesAndRejectsLonelyNames) {
