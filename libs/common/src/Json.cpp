@@ -83,7 +83,7 @@ void Json::dumpTo(std::string& out, int indent, int depth) const {
     case Type::Number: {
       if (!std::isfinite(number_)) { out += "null"; break; }
       char buf[32];
-      std::snprintf(buf, sizeof buf, "%.10g", number_);
+      std::snprintf(buf, sizeof buf, "%.15g", number_);
       out += buf;
       break;
     }

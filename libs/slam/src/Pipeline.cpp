@@ -1,13 +1,25 @@
 #include "urbanslam/slam/Pipeline.h"
 
+#include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
+#include "urbanslam/alignment/Aligner.h"
 #include "urbanslam/common/Timing.h"
+#include "urbanslam/esdf/Esdf.h"
+#include "urbanslam/esdf/PoseOps.h"
 
 namespace urbanslam::slam {
 
-Pipeline::Pipeline(PipelineOptions options) : options_(std::move(options)) {
+namespace {
+constexpr size_t kNone = std::numeric_limits<size_t>::max();
+constexpr double kDeg = M_PI / 180.0;
+}  // namespace
+
+Pipeline::Pipeline(PipelineOptions options)
+    : options_(std::move(options)), motion_(options_.motion, options_.vehicle), closer_(options_.loop_closure) {
   std::stringstream ss(options_.input.laser_labels);
   std::string label;
   while (std::getline(ss, label, ',')) {
@@ -15,11 +27,18 @@ Pipeline::Pipeline(PipelineOptions options) : options_(std::move(options)) {
     label.erase(label.find_last_not_of(" \t") + 1);
     if (!label.empty()) labels_.push_back(label);
   }
+  esdf::EsdfOptions eo;
+  eo.relinearise = options_.estimator.relinearise;
+  eo.chi2_gate_probability = options_.loop_closure.chi2_gate_probability;
+  eo.gate_covariance = esdf::CovarianceMode::Exact;
+  esdf_ = std::make_unique<esdf::Esdf>(eo);
 }
 
 Pipeline::~Pipeline() = default;
 
 void Pipeline::addObserver(PipelineObserver* observer) { observers_.push_back(observer); }
+
+void Pipeline::setCandidateScorer(CandidateScorer scorer, std::string name) { closer_.setScorer(std::move(scorer), std::move(name)); }
 
 bool Pipeline::acceptLabel(const std::string& label) const {
   if (labels_.empty()) return true;
@@ -54,15 +73,22 @@ bool Pipeline::stepOnce(io::DataSource& source) {
     have_first_ts_ = true;
   }
   stats_.last_timestamp = t;
+  const size_t last_kf = keyframes_.empty() ? kNone : keyframes_.size() - 1;
   if (auto* scan = std::get_if<io::LaserScan>(&m)) {
     ++stats_.scans;
     onScan(std::move(*scan), source.progress());
   } else if (const auto* od = std::get_if<io::OdometryReading>(&m)) {
     ++stats_.odometry;
-    onOdometry(*od);
+    if (options_.motion.model != "steering") {
+      motion_.addOdometry(*od);
+      odometry_.push_back({od->timestamp, motion_.odometryPose(), last_kf});
+    }
   } else if (const auto* dr = std::get_if<io::DriveReading>(&m)) {
     ++stats_.drive;
-    onDrive(*dr);
+    if (options_.motion.model != "odometry") {
+      motion_.addDrive(*dr);
+      odometry_.push_back({dr->timestamp, motion_.odometryPose(), last_kf});
+    }
   } else if (const auto* ref = std::get_if<io::ReferencePose>(&m)) {
     ++stats_.reference;
     reference_.push_back({ref->timestamp, ref->pose});
@@ -82,33 +108,18 @@ void Pipeline::run(io::DataSource& source) {
 }
 
 void Pipeline::finish() {
+  if (dirty_since_recovery_) {
+    common::Stopwatch sw;
+    recoverAll();
+    stats_.wall_s += sw.seconds();
+  }
   stats_.keyframes = keyframes_.size();
   for (auto* o : observers_) o->onFinished();
 }
 
-void Pipeline::onOdometry(const io::OdometryReading& m) {
-  odom_ = m.pose;
-  have_odom_ = true;
-  odometry_trajectory_.push_back({m.timestamp, odom_});
-}
-
-// Dead reckoning of a car-like vehicle from speed and steering (kinematic bicycle model about
-// the rear axle), integrated with the previous reading held over the interval.
-void Pipeline::onDrive(const io::DriveReading& m) {
-  if (have_drive_) {
-    const double dt = m.timestamp - last_drive_.timestamp;
-    if (dt > 0 && dt < 1.0) {
-      const double v = last_drive_.speed_mps;
-      const double w = v * std::tan(last_drive_.steering_rad) / options_.vehicle.wheelbase_m;
-      odom_.x += v * dt * std::cos(odom_.phi);
-      odom_.y += v * dt * std::sin(odom_.phi);
-      odom_.phi = common::wrapToPi(odom_.phi + w * dt);
-    }
-  }
-  last_drive_ = m;
-  have_drive_ = true;
-  have_odom_ = true;
-  odometry_trajectory_.push_back({m.timestamp, odom_});
+common::Pose2 Pipeline::currentPose() const {
+  if (keyframes_.empty()) return motion_.increment();
+  return common::compose(keyframes_.back().pose, motion_.increment());
 }
 
 void Pipeline::onScan(io::LaserScan scan, double progress) {
@@ -116,24 +127,153 @@ void Pipeline::onScan(io::LaserScan scan, double progress) {
   if (!acceptLabel(scan.label)) return;
   ++stats_.scans_used;
   applyRangeLimits(scan);
-  // Dead reckoning: the scan sits at the latest odometry pose (the origin before any odometry).
-  const common::Pose2 pose = have_odom_ ? odom_ : common::Pose2{};
-  bool make_keyframe = keyframes_.empty();
-  if (!make_keyframe) {
-    const common::Pose2 d = common::between(keyframes_.back().pose, pose);
-    make_keyframe = std::hypot(d.x, d.y) >= options_.keyframes.min_translation_m ||
-                    std::abs(d.phi) >= options_.keyframes.min_rotation_deg * M_PI / 180.0;
-  }
+  // Keyframe decision: has the vehicle moved or turned enough since the last keyframe?
+  const common::Pose2& d = motion_.increment();
+  const bool make_keyframe = keyframes_.empty() || std::hypot(d.x, d.y) >= options_.keyframes.min_translation_m ||
+                             std::abs(d.phi) >= options_.keyframes.min_rotation_deg * kDeg;
   if (make_keyframe) {
-    Keyframe kf{keyframes_.size(), scan.timestamp, pose, std::move(scan)};
-    keyframes_.push_back(std::move(kf));
-    const Keyframe& k = keyframes_.back();
-    for (auto* o : observers_) o->onKeyframe({k.index, k.timestamp, k.pose, {}, &k.scan});
+    common::Stopwatch kw;
+    addKeyframe(std::move(scan));
+    stats_.keyframe_ms.push_back(kw.milliseconds());
   }
   const double ms = sw.milliseconds();
   stats_.step_ms.push_back(ms);
   StepEvent ev{stats_.scans_used, keyframes_.size(), stats_.last_timestamp, ms, progress};
   for (auto* o : observers_) o->onStep(ev);
+}
+
+void Pipeline::addKeyframe(io::LaserScan scan) {
+  const size_t k = keyframes_.size();
+  const bool filter = options_.estimator.type == "esdf";
+  // 1. Motion since the previous keyframe (odometry or steering model) and its covariance.
+  common::Pose2 z = motion_.increment();
+  Eigen::Matrix3d cov = motion_.covariance();
+  cov.diagonal() += Eigen::Vector3d(1e-8, 1e-8, 1e-10);  // no motion at all is still a valid constraint
+  Keyframe kf{k, scan.timestamp, {}, std::move(scan)};
+  if (k == 0) {
+    // 2. The first keyframe anchors the map at the origin.
+    if (filter) esdf_->initialise(esdf::Vec3::Zero(), esdf::Mat3::Identity() * 1e-9);
+  } else {
+    // 3. Local SLAM: refine the increment by aligning with the previous keyframe's scan.
+    if (options_.local.scan_matching) localScanMatching(kf.scan, z, cov);
+    const Eigen::Matrix3d info = cov.inverse();
+    edges_.push_back({k - 1, k, z, info, false});
+    if (filter) {
+      // 4. ESDF prediction with augmentation: the keyframe becomes a delayed pose, O(1).
+      esdf_->augmentRelative(static_cast<int>(k - 1), esdf::toVec(z), info);
+      // 5. Recover the recent poses (bounded window, constant time between closures).
+      esdf_->recoverRecent(std::max(0, static_cast<int>(k) - options_.estimator.recent_window));
+      dirty_since_recovery_ = true;
+    }
+  }
+  kf.pose = filter ? esdf::toPose(esdf_->mean(static_cast<int>(k)))
+                   : (k == 0 ? common::Pose2{} : common::compose(keyframes_.back().pose, z));
+  if (filter && k > 0) {
+    // Window recovery moved the last `recent_window` keyframes too.
+    for (size_t i = k > static_cast<size_t>(options_.estimator.recent_window) ? k - options_.estimator.recent_window : 0; i < k; ++i)
+      keyframes_[i].pose = esdf::toPose(esdf_->mean(static_cast<int>(i)));
+  }
+  // Odometry readings taken at this scan's time belong to the new keyframe: the trajectory at
+  // the scan time is the keyframe's estimate, not the odometry prediction from the last one.
+  for (auto it = odometry_.rbegin(); it != odometry_.rend() && it->timestamp == kf.timestamp; ++it) it->keyframe = k;
+  keyframes_.push_back(std::move(kf));
+  keyframe_odom_.push_back(motion_.odometryPose());
+  motion_.reset();
+  const Keyframe& added = keyframes_.back();
+  closer_.addToIndex(added);
+  std::array<double, 9> c{};
+  if (filter && k > 0) {
+    const esdf::Mat3 m = esdf_->marginalCovariance(static_cast<int>(k), esdf::CovarianceMode::Conservative);
+    for (int i = 0; i < 9; ++i) c[static_cast<size_t>(i)] = m(i / 3, i % 3);
+  }
+  for (auto* o : observers_) o->onKeyframe({added.index, added.timestamp, added.pose, c, &added.scan});
+  // 6-10. Global SLAM: loop closures against earlier keyframes.
+  if (filter && options_.loop_closure.enabled && k % static_cast<size_t>(options_.loop_closure.every_n_keyframes) == 0)
+    searchLoopClosures(k);
+}
+
+void Pipeline::localScanMatching(const io::LaserScan& scan, common::Pose2& z, Eigen::Matrix3d& cov) {
+  alignment::AlignerOptions ao;
+  ao.method = alignment::parseMethod(options_.local.method);
+  const auto a = alignment::align(keyframes_.back().scan, scan, z, ao);
+  const common::Pose2 correction = common::between(z, a.transform);
+  if (!a.converged || std::hypot(correction.x, correction.y) > options_.local.max_correction_m ||
+      std::abs(correction.phi) > options_.local.max_correction_deg * kDeg) {
+    ++stats_.scan_matches_rejected;
+    return;
+  }
+  ++stats_.scan_matches_used;
+  z = a.transform;
+  cov = options_.local.covariance_scale * a.cov;
+  const double sxy = options_.local.min_sigma_xy_m, sphi = options_.local.min_sigma_phi_deg * kDeg;
+  cov(0, 0) = std::max(cov(0, 0), sxy * sxy);
+  cov(1, 1) = std::max(cov(1, 1), sxy * sxy);
+  cov(2, 2) = std::max(cov(2, 2), sphi * sphi);
+}
+
+void Pipeline::searchLoopClosures(size_t current) {
+  common::Stopwatch sw;
+  // 6. Candidates: initial set near the estimate, final set by Mahalanobis distance.
+  std::vector<size_t> cands = closer_.candidates(*esdf_, keyframes_, current);
+  if (cands.size() > static_cast<size_t>(options_.loop_closure.max_candidates))
+    cands.resize(static_cast<size_t>(options_.loop_closure.max_candidates));
+  for (auto* o : observers_) o->onCandidates({current, &cands});
+  bool accepted = false;
+  for (size_t i : cands) {
+    // 7-9. Detection, alignment, gating and the ESDF update.
+    LoopClosureRecord r = closer_.tryClose(*esdf_, keyframes_, i, current);
+    ++stats_.closures_tried;
+    ++(r.accepted ? stats_.closures_accepted : stats_.closures_rejected);
+    if (r.accepted) {
+      accepted = true;
+      edges_.push_back({i, current, r.measurement, r.information, true});
+    }
+    closures_.push_back(r);
+    LoopClosureEvent e{r.from, r.to, r.to_time, r.detector, r.score, r.accepted, r.reason};
+    for (auto* o : observers_) o->onLoopClosure(e);
+    if (accepted) break;  // one closure per keyframe; the next keyframe sees the corrected map
+  }
+  // 10. Full recovery after a closure (with relinearisation), then the corrected poses.
+  if (accepted) recoverAll();
+  stats_.closure_ms.push_back(sw.milliseconds());
+}
+
+void Pipeline::recoverAll() {
+  esdf_->recover();
+  std::vector<common::Pose2> poses(keyframes_.size());
+  for (size_t i = 0; i < keyframes_.size(); ++i) {
+    keyframes_[i].pose = esdf::toPose(esdf_->mean(static_cast<int>(i)));
+    poses[i] = keyframes_[i].pose;
+  }
+  closer_.rebuildIndex(keyframes_);
+  dirty_since_recovery_ = false;
+  for (auto* o : observers_) o->onPosesUpdated({&poses});
+}
+
+std::vector<io::StampedPose> Pipeline::odometryTrajectory() const {
+  std::vector<io::StampedPose> out;
+  out.reserve(odometry_.size());
+  const auto via = [&](size_t k, const common::Pose2& odom) {
+    return common::compose(keyframes_[k].pose, common::between(keyframe_odom_[k], odom));
+  };
+  for (const auto& s : odometry_) {
+    if (keyframes_.empty()) break;
+    // Before the first keyframe the map frame is the odometry frame of that keyframe.
+    const size_t a = s.keyframe == kNone || s.keyframe >= keyframes_.size() ? 0 : s.keyframe;
+    common::Pose2 p = via(a, s.odom);
+    // Between two keyframes, the odometry drift is spread over the interval: the pose from the
+    // earlier keyframe forwards and from the later one backwards, blended by time.
+    const size_t b = a + 1;
+    if (s.keyframe != kNone && b < keyframes_.size()) {
+      const double ta = keyframes_[a].timestamp, tb = keyframes_[b].timestamp;
+      if (tb > ta) {
+        const double f = std::clamp((s.timestamp - ta) / (tb - ta), 0.0, 1.0);
+        p = common::interpolate(p, via(b, s.odom), f);
+      }
+    }
+    out.push_back({s.timestamp, p});
+  }
+  return out;
 }
 
 std::vector<io::PosedScan> Pipeline::posedKeyframes() const {

@@ -17,6 +17,48 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.section("vehicle", "Vehicle geometry");
   s.add("wheelbase_m", o.vehicle.wheelbase_m, 0.1, 20.0, "m", "wheelbase L for speed + steering logs");
 
+  s.section("motion", "Motion between keyframes: model and noise");
+  s.add("model", o.motion.model, {"auto", "odometry", "steering"}, "auto: steering model for speed+steering logs (Victoria Park), else odometry");
+  s.add("odometry_sigma_xy_per_m", o.motion.odometry_sigma_xy_per_m, 0.0, 1.0, "m/m", "odometry position noise per metre travelled");
+  s.add("odometry_sigma_xy_min_m", o.motion.odometry_sigma_xy_min_m, 1e-6, 1.0, "m", "odometry position noise floor per increment");
+  s.add("odometry_sigma_phi_per_rad", o.motion.odometry_sigma_phi_per_rad, 0.0, 1.0, "rad/rad", "heading noise per radian turned");
+  s.add("odometry_sigma_phi_per_m_rad", o.motion.odometry_sigma_phi_per_m_rad, 0.0, 1.0, "rad/m", "heading noise per metre travelled");
+  s.add("odometry_sigma_phi_min_rad", o.motion.odometry_sigma_phi_min_rad, 1e-7, 1.0, "rad", "heading noise floor per increment");
+  s.add("speed_sigma_mps", o.motion.speed_sigma_mps, 1e-4, 10.0, "m/s", "steering model: speed noise (Q_v)");
+  s.add("steering_sigma_deg", o.motion.steering_sigma_deg, 1e-3, 45.0, "deg", "steering model: steering angle noise (Q_v)");
+
+  s.section("local", "Local SLAM: odometry between keyframes refined by scan matching");
+  s.add("scan_matching", o.local.scan_matching, "align each keyframe's scan with the previous keyframe's");
+  s.add("method", o.local.method, {"icp", "plicp", "crf", "crf+icp"}, "alignment method");
+  s.add("max_correction_m", o.local.max_correction_m, 0.0, 10.0, "m", "reject a scan match that moves the odometry more than this");
+  s.add("max_correction_deg", o.local.max_correction_deg, 0.0, 180.0, "deg", "reject a scan match that turns the odometry more than this");
+  s.add("covariance_scale", o.local.covariance_scale, 0.1, 1000.0, "", "inflation of the alignment covariance");
+  s.add("min_sigma_xy_m", o.local.min_sigma_xy_m, 0.0, 1.0, "m", "floor on the scan-matching position sigma");
+  s.add("min_sigma_phi_deg", o.local.min_sigma_phi_deg, 0.0, 10.0, "deg", "floor on the scan-matching heading sigma");
+
+  s.section("loop_closure", "Global SLAM: loop-closure candidates, detection, alignment, gating");
+  s.add("enabled", o.loop_closure.enabled, "search for loop closures");
+  s.add("detector", o.loop_closure.detector, {"none", "laser"}, "none: alignment + gating verify every candidate; laser: AdaBoost classifier first");
+  s.add("laser_model", o.loop_closure.laser_model, {}, "laser classifier model; empty: share/laser_loop/default.model");
+  s.add("laser_threshold", o.loop_closure.laser_threshold, -100.0, 100.0, "", "classifier decision offset (higher: fewer false alarms)");
+  s.add("min_keyframe_gap", o.loop_closure.min_keyframe_gap, 1, 100000, "keyframes", "only keyframes at least this much older are candidates");
+  s.add("search_radius_m", o.loop_closure.search_radius_m, 0.1, 1000.0, "m", "initial candidate set: within this distance (plus 3 sigma)");
+  s.add("mahalanobis_probability", o.loop_closure.mahalanobis_probability, 0.5, 0.999999, "", "final candidate set: chi2 (2 dof) probability");
+  s.add("max_candidates", o.loop_closure.max_candidates, 1, 1000, "", "candidates aligned per keyframe");
+  s.add("every_n_keyframes", o.loop_closure.every_n_keyframes, 1, 1000, "keyframes", "search at every n-th keyframe");
+  s.add("method", o.loop_closure.method, {"auto", "icp", "plicp", "crf", "crf+icp"}, "alignment of a candidate pair; auto: PL-ICP when the relative pose is well known, CRF-match + ICP otherwise");
+  s.add("auto_local_max_m", o.loop_closure.auto_local_max_m, 0.0, 100.0, "m", "auto: PL-ICP when 3 sigma of the relative position is below this");
+  s.add("auto_local_max_deg", o.loop_closure.auto_local_max_deg, 0.0, 180.0, "deg", "auto: ... and 3 sigma of the relative heading below this");
+  s.add("max_rms_m", o.loop_closure.max_rms_m, 0.001, 10.0, "m", "alignment accepted only below this RMS residual");
+  s.add("min_matched_fraction", o.loop_closure.min_matched_fraction, 0.0, 1.0, "", "alignment accepted only with this share of points matched");
+  s.add("covariance_scale", o.loop_closure.covariance_scale, 0.1, 1000.0, "", "inflation of the alignment covariance");
+  s.add("chi2_gate_probability", o.loop_closure.chi2_gate_probability, 0.5, 0.9999999, "", "innovation gate (chi2, 3 dof)");
+
+  s.section("estimator", "The estimator behind the map");
+  s.add("type", o.estimator.type, {"esdf", "dead_reckoning"}, "esdf: the delayed-state information filter; dead_reckoning: odometry only");
+  s.add("relinearise", o.estimator.relinearise, "relinearise moved factors after a loop closure (reaches the batch optimum)");
+  s.add("recent_window", o.estimator.recent_window, 1, 100000, "poses", "poses recovered after each keyframe");
+
   s.section("map", "Map products");
   s.add("grid_resolution_m", o.map.grid_resolution_m, 0.01, 2.0, "m", "occupancy grid cell size");
   s.add("point_decimation", o.map.point_decimation, 1, 1000, "", "keep every n-th point in the point clouds");

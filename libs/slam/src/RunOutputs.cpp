@@ -1,11 +1,13 @@
 #include "urbanslam/slam/RunOutputs.h"
 
+#include <cstdio>
 #include <filesystem>
 
 #include "urbanslam/common/AtomicFile.h"
 #include "urbanslam/common/Error.h"
 #include "urbanslam/common/OptionsSchema.h"
 #include "urbanslam/common/Timing.h"
+#include "urbanslam/esdf/PoseGraphIO.h"
 #include "urbanslam/io/MapOutputs.h"
 
 namespace urbanslam::slam {
@@ -56,6 +58,29 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
     files.push("reference.tum");
   }
 
+  // The pose graph the filter holds: keyframe estimates, motion and loop-closure constraints.
+  {
+    esdf::PoseGraph g;
+    for (const auto& k : p.keyframes()) g.vertices.push_back({static_cast<long>(k.index), esdf::toVec(k.pose)});
+    for (const auto& e : p.graphEdges())
+      g.edges.push_back({static_cast<long>(e.from), static_cast<long>(e.to), esdf::toVec(e.measurement), e.information});
+    esdf::writePoseGraph(g, path("pose_graph.g2o"), esdf::PoseGraphFormat::G2o);
+    files.push("pose_graph.g2o");
+  }
+  {
+    common::AtomicFile f(path("loop_closures.csv"));
+    f.stream() << "from_keyframe,to_keyframe,from_time,to_time,detector,score,accepted,reason,x,y,phi,rms_m,mahalanobis2,gate_threshold\n";
+    char buf[512];
+    for (const auto& c : p.loopClosures()) {
+      std::snprintf(buf, sizeof buf, "%zu,%zu,%.6f,%.6f,%s,%.6g,%d,%s,%.6f,%.6f,%.6f,%.6g,%.6g,%.6g\n", c.from, c.to, c.from_time,
+                    c.to_time, c.detector.c_str(), c.score, c.accepted ? 1 : 0, c.reason.c_str(), c.measurement.x,
+                    c.measurement.y, c.measurement.phi, c.rms_m, c.mahalanobis2, c.gate_threshold);
+      f.stream() << buf;
+    }
+    f.commit();
+    files.push("loop_closures.csv");
+  }
+
   const auto posed = p.posedKeyframes();
   const auto pts = io::mapPoints(posed, o.map.point_decimation);
   if (o.output.write_ply_binary) { io::writePly(path("map.ply"), pts, io::PlyEncoding::BinaryLittleEndian); files.push("map.ply"); }
@@ -80,7 +105,7 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   j["input"] = info.input_path;
   j["input_format"] = info.input_format;
   j["ini"] = info.ini_path;
-  j["estimator"] = "dead_reckoning";
+  j["estimator"] = p.estimatorName();
   Json& c = j["counts"];
   c["measurements"] = s.measurements;
   c["scans"] = s.scans;
@@ -92,6 +117,11 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   c["reference_poses"] = s.reference;
   c["keyframes"] = p.keyframes().size();
   c["map_points"] = pts.size();
+  c["scan_matches_used"] = s.scan_matches_used;
+  c["scan_matches_rejected"] = s.scan_matches_rejected;
+  c["loop_closures_tried"] = s.closures_tried;
+  c["loop_closures_accepted"] = s.closures_accepted;
+  c["loop_closures_rejected"] = s.closures_rejected;
   Json& t = j["timing"];
   const double duration = s.last_timestamp - s.first_timestamp;
   t["wall_s"] = s.wall_s;
@@ -100,6 +130,10 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   t["step_ms_p50"] = common::percentile(s.step_ms, 50);
   t["step_ms_p99"] = common::percentile(s.step_ms, 99);
   t["step_ms_max"] = common::percentile(s.step_ms, 100);
+  t["keyframe_ms_p50"] = common::percentile(s.keyframe_ms, 50);
+  t["keyframe_ms_p99"] = common::percentile(s.keyframe_ms, 99);
+  t["loop_search_ms_p50"] = common::percentile(s.closure_ms, 50);
+  t["loop_search_ms_p99"] = common::percentile(s.closure_ms, 99);
   t["outputs_s"] = sw.seconds();
   t["peak_rss_mb"] = static_cast<double>(common::peakResidentBytes()) / (1024.0 * 1024.0);
   if (grid.size() > 0) j["grid"] = grid;

@@ -1,14 +1,23 @@
 #pragma once
-// The main job: measurements in, keyframes (delayed poses with their scans) and trajectory out.
-// For now the estimator is dead reckoning: each scan is placed at the odometry pose of its time.
-// The ESDF and loop closures replace the estimator behind this same interface.
+// The main job (thesis §5.5), one scan at a time: motion since the last keyframe → keyframe
+// decision → local scan matching → ESDF prediction with augmentation → recovery of the recent
+// poses → loop-closure candidates → detection → alignment → innovation gating → ESDF update →
+// full recovery after a closure. Observers see every step; the map is rebuilt from the current
+// keyframe estimates on demand.
+#include <Eigen/Core>
 #include <memory>
 #include <vector>
 
 #include "urbanslam/io/DataSource.h"
 #include "urbanslam/io/MapOutputs.h"
+#include "urbanslam/slam/LoopCloser.h"
+#include "urbanslam/slam/MotionIntegrator.h"
 #include "urbanslam/slam/Observer.h"
 #include "urbanslam/slam/PipelineOptions.h"
+
+namespace urbanslam::esdf {
+class Esdf;
+}
 
 namespace urbanslam::slam {
 
@@ -19,12 +28,23 @@ struct Keyframe {
   io::LaserScan scan;   // kept so the map can be rebuilt from the current estimates
 };
 
+// A constraint between two keyframes as it went into the filter (for the g2o output).
+struct GraphEdge {
+  size_t from = 0, to = 0;
+  common::Pose2 measurement;
+  Eigen::Matrix3d information = Eigen::Matrix3d::Identity();
+  bool loop_closure = false;
+};
+
 struct PipelineStats {
   size_t measurements = 0, scans = 0, scans_used = 0, odometry = 0, drive = 0, images = 0, gps = 0,
          reference = 0, keyframes = 0;
+  size_t scan_matches_used = 0, scan_matches_rejected = 0;
+  size_t closures_tried = 0, closures_accepted = 0, closures_rejected = 0;
   double first_timestamp = 0, last_timestamp = 0;
   double wall_s = 0;             // processing time, reading included
-  std::vector<double> step_ms;  // per processed scan
+  std::vector<double> step_ms;   // per processed scan
+  std::vector<double> keyframe_ms, closure_ms;
 };
 
 class Pipeline {
@@ -33,44 +53,60 @@ class Pipeline {
   ~Pipeline();
 
   void addObserver(PipelineObserver* observer);
+  // An appearance test for loop-closure candidates (the laser classifier); without one every
+  // candidate goes to alignment and gating.
+  void setCandidateScorer(CandidateScorer scorer, std::string name);
   // Processes one measurement. Returns false when the input is exhausted.
   bool step(io::DataSource& source);
   // Runs to the end of the input, then finish().
   void run(io::DataSource& source);
-  // Tells observers the run is complete (call once after the last step()).
+  // Final full recovery; tells observers the run is complete.
   void finish();
 
   const std::vector<Keyframe>& keyframes() const { return keyframes_; }
-  // Estimated pose at every odometry (or drive) reading's time.
-  const std::vector<io::StampedPose>& odometryTrajectory() const { return odometry_trajectory_; }
+  // Estimated pose at every odometry (or drive) reading's time, from the current keyframe
+  // estimates and the odometry since each keyframe.
+  std::vector<io::StampedPose> odometryTrajectory() const;
   // The log's reference trajectory, when it has one (e.g. a corrected CARMEN log).
   const std::vector<io::StampedPose>& referenceTrajectory() const { return reference_; }
+  const std::vector<LoopClosureRecord>& loopClosures() const { return closures_; }
+  const std::vector<GraphEdge>& graphEdges() const { return edges_; }
   const PipelineStats& stats() const { return stats_; }
   const PipelineOptions& options() const { return options_; }
-
+  std::string estimatorName() const { return options_.estimator.type; }
   std::vector<io::PosedScan> posedKeyframes() const;
 
  private:
+  struct OdometrySample {
+    double timestamp;
+    common::Pose2 odom;   // odometry pose at the reading
+    size_t keyframe;      // last keyframe before it (npos: none yet)
+  };
   bool stepOnce(io::DataSource& source);
   void onScan(io::LaserScan scan, double progress);
-  void onOdometry(const io::OdometryReading& m);
-  void onDrive(const io::DriveReading& m);
+  void addKeyframe(io::LaserScan scan);
+  void localScanMatching(const io::LaserScan& scan, common::Pose2& z, Eigen::Matrix3d& cov);
+  void searchLoopClosures(size_t current);
+  void recoverAll();
   bool acceptLabel(const std::string& label) const;
   void applyRangeLimits(io::LaserScan& scan) const;
+  common::Pose2 currentPose() const;
 
   PipelineOptions options_;
   std::vector<PipelineObserver*> observers_;
   std::vector<Keyframe> keyframes_;
-  std::vector<io::StampedPose> odometry_trajectory_, reference_;
+  std::vector<common::Pose2> keyframe_odom_;  // odometry pose at each keyframe
+  std::vector<OdometrySample> odometry_;
+  std::vector<io::StampedPose> reference_;
+  std::vector<LoopClosureRecord> closures_;
+  std::vector<GraphEdge> edges_;
   std::vector<std::string> labels_;
   PipelineStats stats_;
-
-  // Dead reckoning state.
-  bool have_odom_ = false;
-  common::Pose2 odom_;            // latest odometry pose
-  bool have_drive_ = false;
-  io::DriveReading last_drive_;
+  MotionIntegrator motion_;
+  std::unique_ptr<esdf::Esdf> esdf_;
+  LoopCloser closer_;
   bool have_first_ts_ = false;
+  bool dirty_since_recovery_ = false;
 };
 
 }  // namespace urbanslam::slam

@@ -23,6 +23,57 @@ struct VehicleOptions {
   double wheelbase_m = 2.83;  // L: used when the log carries speed + steering (car-like vehicle)
 };
 
+// How the motion between two keyframes is predicted, and how uncertain it is.
+struct MotionOptions {
+  std::string model = "auto";  // auto | odometry | steering: auto = steering for speed+steering logs
+  // Odometry noise per increment (sigma grows with distance and turning).
+  double odometry_sigma_xy_per_m = 0.05;
+  double odometry_sigma_xy_min_m = 0.002;
+  double odometry_sigma_phi_per_rad = 0.05;
+  double odometry_sigma_phi_per_m_rad = 0.01;
+  double odometry_sigma_phi_min_rad = 0.0005;
+  // Speed + steering noise (Q_v of the steering model, thesis eq. 2.19).
+  double speed_sigma_mps = 0.1;
+  double steering_sigma_deg = 2.0;
+};
+
+// Local SLAM: the odometry increment between keyframes refined by aligning their scans.
+struct LocalOptions {
+  bool scan_matching = true;
+  std::string method = "plicp";        // icp | plicp | crf | crf+icp
+  double max_correction_m = 0.5;       // larger disagreements with odometry: keep the odometry
+  double max_correction_deg = 10.0;
+  double covariance_scale = 4.0;       // alignment covariance inflation (matched scans are correlated)
+  double min_sigma_xy_m = 0.01;        // floors on the scan-matching uncertainty
+  double min_sigma_phi_deg = 0.25;
+};
+
+// Global SLAM: loop-closure search, verification and the ESDF update.
+struct LoopClosureOptions {
+  bool enabled = true;
+  std::string detector = "none";       // none (alignment + gating only) | laser (AdaBoost classifier)
+  std::string laser_model;             // classifier model file; empty = share/laser_loop/default.model
+  double laser_threshold = 0.0;        // strong-classifier margin offset (higher: fewer false alarms)
+  int min_keyframe_gap = 30;           // closures only with keyframes at least this much older
+  double search_radius_m = 4.0;        // initial set: earlier keyframes this close (+ 3 sigma)
+  double mahalanobis_probability = 0.99;  // final set: chi2 (2 dof) gate on the relative position
+  int max_candidates = 3;              // aligned per keyframe, nearest (Mahalanobis) first
+  int every_n_keyframes = 1;           // search at every n-th keyframe
+  std::string method = "auto";         // alignment of a candidate pair: auto | icp | plicp | crf | crf+icp
+  double auto_local_max_m = 1.0;       // auto: PL-ICP when the relative pose is known to 3 sigma within this ...
+  double auto_local_max_deg = 15.0;    // ... and this; CRF-match + ICP otherwise
+  double max_rms_m = 0.08;             // alignment accepted only below this residual ...
+  double min_matched_fraction = 0.5;   // ... and with this share of points matched
+  double covariance_scale = 4.0;
+  double chi2_gate_probability = 0.999;  // innovation gate (3 dof)
+};
+
+struct EstimatorOptions {
+  std::string type = "esdf";           // esdf | dead_reckoning
+  bool relinearise = true;             // relinearise moved factors after a loop closure
+  int recent_window = 30;              // poses recovered after each keyframe (constant time)
+};
+
 struct MapOptions {
   double grid_resolution_m = 0.05;  // occupancy grid cell size
   int point_decimation = 1;         // keep every n-th map point in the point clouds
@@ -41,6 +92,10 @@ struct PipelineOptions {
   InputOptions input;
   KeyframeOptions keyframes;
   VehicleOptions vehicle;
+  MotionOptions motion;
+  LocalOptions local;
+  LoopClosureOptions loop_closure;
+  EstimatorOptions estimator;
   MapOptions map;
   OutputOptions output;
 };

@@ -1,0 +1,152 @@
+// `urbanslam eval`: accuracy of a run folder against relations (Kümmerle et al.) and/or a
+// reference trajectory, and loop closures classified true/false.
+#include <filesystem>
+#include <iostream>
+
+#include "ArgParser.h"
+#include "Commands.h"
+#include "urbanslam/common/Error.h"
+#include "urbanslam/common/Json.h"
+#include "urbanslam/io/DataSource.h"
+#include "urbanslam/laser_loop/LinePlot.h"
+#include "urbanslam/slam/Evaluation.h"
+
+namespace urbanslam::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// A reference trajectory from a TUM file or from any log that carries one (reference poses of a
+// corrected CARMEN log, or GPS fixes: positions only).
+std::vector<io::StampedPose> loadReference(const std::string& path, bool& positions_only) {
+  positions_only = false;
+  const auto ext = fs::path(path).extension().string();
+  if (ext == ".tum" || ext == ".txt") return io::readTum(path);
+  auto src = io::openDataSource(path);
+  std::vector<io::StampedPose> ref, gps;
+  io::Measurement m;
+  while (src->next(m)) {
+    if (auto* r = std::get_if<io::ReferencePose>(&m)) ref.push_back({r->timestamp, r->pose});
+    if (auto* g = std::get_if<io::GpsFix>(&m)) gps.push_back({g->timestamp, {g->x_m, g->y_m, 0}});
+  }
+  if (!ref.empty()) return ref;
+  if (!gps.empty()) {
+    positions_only = true;
+    return gps;
+  }
+  throw common::InputError(path + ": carries no reference trajectory (no reference poses, no GPS)");
+}
+
+common::Json meanStd(const slam::MeanStd& m) {
+  common::Json j = common::Json::object();
+  j["mean"] = m.mean;
+  j["std"] = m.std;
+  return j;
+}
+
+}  // namespace
+
+int evalCommand(const Argv& args) {
+  ArgParser ap("urbanslam eval RUN_DIR (--relations FILE | --reference FILE) [--json]",
+               "Evaluates the output folder of `urbanslam run`:\n"
+               "  --relations: the relation metric of Kümmerle et al. 2009 as Cartographer computes it\n"
+               "    (error = (p1^-1 p2) expected^-1; abs/squared translational and rotational error, mean +/- std);\n"
+               "    the time offset between the run and the relations is found from the reference trajectory\n"
+               "    (--reference, or reference.tum in RUN_DIR) when their time bases differ;\n"
+               "  --reference: ATE/RPE against a TUM trajectory or a log with a reference (corrected CARMEN log,\n"
+               "    or GPS: positions only), and loop closures classified true/false.\n"
+               "Plots: RUN_DIR/eval_trajectory.png, RUN_DIR/eval_error.png.");
+  ap.addPositional("RUN_DIR", "output folder of urbanslam run");
+  ap.addOption("relations", "FILE", "Freiburg relations file (t1 t2 x y z roll pitch yaw)");
+  ap.addOption("reference", "FILE", "reference trajectory: TUM file or a log that carries one");
+  ap.addOption("time-offset", "S", "seconds added to the run's timestamps for --relations (default: found)");
+  ap.addOption("loop-tolerance-m", "M", "a closure is true when its measurement agrees with the reference within this", "0.5");
+  ap.addOption("loop-tolerance-deg", "DEG", "... and this", "5");
+  ap.addFlag("json", "print the figures as one JSON object");
+  if (!ap.parse(args)) return 0;
+  if (!ap.has("relations") && !ap.has("reference")) throw common::InputError("give --relations FILE and/or --reference FILE");
+  const fs::path dir = ap.positional("RUN_DIR");
+  const fs::path traj_path = dir / "trajectory_odometry.tum";
+  if (!fs::exists(traj_path)) throw common::InputError(traj_path.string() + ": missing (not a run folder?)");
+  const auto estimate = io::readTum(traj_path.string());
+
+  common::Json j = common::Json::object();
+  j["run"] = dir.string();
+  bool positions_only = false;
+  std::vector<io::StampedPose> reference;
+  if (ap.has("reference")) reference = loadReference(ap.option("reference"), positions_only);
+  else if (fs::exists(dir / "reference.tum")) reference = io::readTum((dir / "reference.tum").string());
+
+  if (ap.has("relations")) {
+    const auto rel = slam::readRelations(ap.option("relations"));
+    double offset = 0;
+    if (ap.has("time-offset")) offset = ap.optionDouble("time-offset");
+    else {
+      std::vector<double> log_times;  // the log's own timestamps (not estimated values)
+      for (const auto& p : estimate) log_times.push_back(p.timestamp);
+      offset = slam::findRelationTimeOffset(reference.empty() ? estimate : reference, rel, log_times);
+    }
+    const auto m = slam::relationMetrics(estimate, rel, offset);
+    common::Json& r = j["relations"];
+    r["file"] = ap.option("relations");
+    r["used"] = m.used;
+    r["skipped"] = m.skipped;
+    r["time_offset_s"] = offset;
+    r["abs_trans_mean_m"] = m.abs_trans_m.mean;
+    r["abs_trans_std_m"] = m.abs_trans_m.std;
+    r["sqr_trans_mean_m2"] = m.sqr_trans_m2.mean;
+    r["sqr_trans_std_m2"] = m.sqr_trans_m2.std;
+    r["abs_rot_mean_deg"] = m.abs_rot_deg.mean;
+    r["abs_rot_std_deg"] = m.abs_rot_deg.std;
+    r["sqr_rot_mean_deg2"] = m.sqr_rot_deg2.mean;
+    r["sqr_rot_std_deg2"] = m.sqr_rot_deg2.std;
+    if (!reference.empty()) {
+      const auto mr = slam::relationMetrics(reference, rel, offset, 5.0);  // reference poses are sparse
+      r["reference_abs_trans_mean_m"] = mr.abs_trans_m.mean;
+      r["reference_abs_rot_mean_deg"] = mr.abs_rot_deg.mean;
+    }
+    if (m.used == 0) throw common::InputError(ap.option("relations") + ": no relation falls inside the run's time span (wrong dataset or offset?)");
+  }
+  if (ap.has("reference")) {
+    const auto tm = slam::trajectoryMetrics(estimate, reference, positions_only, positions_only ? 2.0 : 1.0);
+    j["reference"] = ap.option("reference");
+    j["positions_only"] = positions_only;
+    j["matched"] = tm.matched;
+    j["ate_rmse_m"] = tm.ate_rmse_m;
+    j["ate_max_m"] = tm.ate_max_m;
+    j["rpe_trans_rmse_m"] = tm.rpe_trans_rmse_m;
+    j["rpe_rot_rmse_deg"] = tm.rpe_rot_rmse_deg;
+    if (fs::exists(dir / "loop_closures.csv")) {
+      const auto lm = slam::classifyLoopClosures(slam::readLoopClosuresCsv((dir / "loop_closures.csv").string()), reference,
+                                                 positions_only, ap.optionDouble("loop-tolerance-m"),
+                                                 ap.optionDouble("loop-tolerance-deg"));
+      j["loops_accepted"] = lm.accepted;
+      j["loops_true"] = lm.true_positive;
+      j["loops_false"] = lm.false_positive;
+      j["loops_unverifiable"] = lm.unverifiable;
+    }
+    // Plots: the aligned estimate over the reference, and the position error over time.
+    laser_loop::PlotSeries ref{"reference", {}, {}, 0x808080}, est{"estimate (aligned)", {}, {}, 0x2060e0};
+    for (const auto& p : reference) {
+      ref.x.push_back(p.pose.x);
+      ref.y.push_back(p.pose.y);
+    }
+    for (const auto& p : tm.aligned) {
+      est.x.push_back(p.pose.x);
+      est.y.push_back(p.pose.y);
+    }
+    laser_loop::writePlotPng((dir / "eval_trajectory.png").string(), {{"trajectory vs reference", "x [m]", "y [m]", {ref, est}}});
+    laser_loop::PlotSeries err{"position error", {}, tm.errors_m, 0x2020c0};
+    for (double t : tm.times) err.x.push_back(t - (tm.times.empty() ? 0 : tm.times.front()));
+    laser_loop::writePlotPng((dir / "eval_error.png").string(), {{"position error after alignment", "time [s]", "error [m]", {err}}});
+  }
+  if (ap.flag("json")) {
+    std::cout << j.dump() << "\n";
+  } else {
+    std::cout << j.dump(2) << "\n";
+  }
+  return 0;
+}
+
+}  // namespace urbanslam::cli

@@ -1,0 +1,80 @@
+#pragma once
+// Accuracy of a run against ground truth:
+//  * the relation metric of Kümmerle et al. 2009 exactly as Cartographer computes it:
+//    error = (p1⁻¹·p2)·expected⁻¹, absolute and squared translational [m, m²] and rotational
+//    [deg, deg²] error, each mean ± std (n−1);
+//  * ATE (RMSE of positions after the best rigid alignment) and RPE against a reference
+//    trajectory;
+//  * loop closures classified true/false against the reference (thesis §5.6).
+#include <string>
+#include <vector>
+
+#include "urbanslam/common/Json.h"
+#include "urbanslam/io/MapOutputs.h"
+
+namespace urbanslam::slam {
+
+struct Relation {
+  double t1 = 0, t2 = 0;
+  common::Pose2 expected;  // pose at t2 in the frame of the pose at t1
+};
+
+// Freiburg relation file: "t1 t2 x y z roll pitch yaw" per line. Throws common::InputError.
+std::vector<Relation> readRelations(const std::string& path);
+
+struct MeanStd {
+  double mean = 0, std = 0;
+};
+
+struct RelationMetrics {
+  size_t used = 0, skipped = 0;   // relations whose times fall outside the trajectory are skipped
+  MeanStd abs_trans_m, sqr_trans_m2, abs_rot_deg, sqr_rot_deg2;
+  double time_offset_s = 0;       // added to the trajectory's timestamps
+};
+
+// Pose of a time-sorted trajectory at time t by linear interpolation; false outside its span
+// or across a gap longer than max_gap_s.
+bool interpolatePose(const std::vector<io::StampedPose>& traj, double t, double max_gap_s, common::Pose2& out);
+
+RelationMetrics relationMetrics(const std::vector<io::StampedPose>& traj, const std::vector<Relation>& rel,
+                                double time_offset_s, double max_gap_s = 1.0);
+
+// The offset to add to the trajectory's timestamps so that it matches the relations' time base.
+// Coarse: the one that minimises the relation error of `reference` (e.g. the corrected log's
+// own poses). Fine: relation times are sensor times of the original log, so the exact offset is
+// the most frequent difference between a relation time and a timestamp of the log
+// (`log_times`, e.g. its odometry times), within a second of the coarse value.
+// Returns 0 when the time bases already overlap.
+double findRelationTimeOffset(const std::vector<io::StampedPose>& reference, const std::vector<Relation>& rel,
+                              const std::vector<double>& log_times = {});
+
+struct TrajectoryMetrics {
+  size_t matched = 0;
+  double ate_rmse_m = 0, ate_max_m = 0;
+  double rpe_trans_rmse_m = 0, rpe_rot_rmse_deg = 0;  // between consecutive matched poses
+  bool positions_only = false;     // reference without headings (GPS)
+  std::vector<double> times, errors_m;  // per matched pose, after alignment (for plots)
+  std::vector<io::StampedPose> aligned;  // the estimate, rigidly aligned onto the reference
+};
+
+// Matches every reference pose to the estimate at the same time (interpolated), aligns the
+// estimate with the closed-form 2D rigid transform (Horn / Umeyama without scale), reports errors.
+TrajectoryMetrics trajectoryMetrics(const std::vector<io::StampedPose>& estimate, const std::vector<io::StampedPose>& reference,
+                                    bool positions_only, double max_gap_s = 1.0);
+
+struct LoopRow {
+  double from_time = 0, to_time = 0;
+  bool accepted = false;
+  common::Pose2 measurement;
+};
+std::vector<LoopRow> readLoopClosuresCsv(const std::string& path);
+
+struct LoopMetrics {
+  size_t accepted = 0, true_positive = 0, false_positive = 0, unverifiable = 0;
+};
+// An accepted closure is true when its measured relative pose agrees with the reference's
+// relative pose of the two times within the tolerances (§5.6), false otherwise.
+LoopMetrics classifyLoopClosures(const std::vector<LoopRow>& loops, const std::vector<io::StampedPose>& reference,
+                                 bool positions_only, double tol_m = 0.5, double tol_deg = 5.0);
+
+}  // namespace urbanslam::slam

@@ -1,0 +1,74 @@
+#pragma once
+// Global SLAM (thesis ch. 5): for a new keyframe, the loop-closure candidates — an initial set of
+// earlier keyframes near the current estimate, a final set by Mahalanobis distance with the
+// recovered covariances (§5.2) — then detection, alignment for the relative pose and its
+// covariance (§5.3) and the innovation gate (§5.4) before the ESDF update.
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "urbanslam/esdf/Esdf.h"
+#include "urbanslam/io/LaserScan.h"
+#include "urbanslam/slam/PipelineOptions.h"
+
+namespace urbanslam::slam {
+
+struct Keyframe;
+
+// One loop-closure hypothesis and what became of it (a row of loop_closures.csv).
+struct LoopClosureRecord {
+  size_t from = 0, to = 0;           // earlier keyframe, current keyframe
+  double from_time = 0, to_time = 0;
+  std::string detector;              // "laser" or "geometric" (alignment + gating only)
+  double score = 0;                  // classifier margin, or alignment matched fraction
+  bool accepted = false;
+  std::string reason;                // classifier | alignment | gating (when rejected)
+  common::Pose2 measurement;         // aligned relative pose (from -> to)
+  Eigen::Matrix3d information = Eigen::Matrix3d::Identity();  // as added to the filter
+  double rms_m = 0, mahalanobis2 = 0, gate_threshold = 0;
+};
+
+// Optional appearance test of a candidate pair before alignment (the laser classifier).
+// Returns the score; the pair proceeds when score >= threshold.
+using CandidateScorer = std::function<double(size_t earlier, size_t current)>;
+
+// A uniform grid over keyframe positions: the initial candidate set in constant time.
+class KeyframeGrid {
+ public:
+  explicit KeyframeGrid(double cell_m) : cell_m_(cell_m) {}
+  void clear() { cells_.clear(); }
+  void insert(size_t index, double x, double y);
+  // Indices of keyframes whose cell lies within `radius` of (x, y) (a superset of the disk).
+  void query(double x, double y, double radius, std::vector<size_t>& out) const;
+
+ private:
+  long long key(long cx, long cy) const { return (static_cast<long long>(cx) << 32) ^ (cy & 0xffffffffLL); }
+  double cell_m_;
+  std::unordered_map<long long, std::vector<size_t>> cells_;
+};
+
+class LoopCloser {
+ public:
+  explicit LoopCloser(const LoopClosureOptions& options);
+
+  void setScorer(CandidateScorer scorer, std::string name);
+  // Keyframe positions changed (after a full recovery): rebuild the grid.
+  void rebuildIndex(const std::vector<Keyframe>& keyframes);
+  void addToIndex(const Keyframe& kf);
+
+  // The final candidate set for keyframe `current`, nearest (Mahalanobis) first.
+  std::vector<size_t> candidates(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t current);
+  // Detection, alignment and gating of one candidate; adds an accepted closure to the filter.
+  LoopClosureRecord tryClose(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current);
+
+ private:
+  LoopClosureOptions options_;
+  KeyframeGrid grid_;
+  CandidateScorer scorer_;
+  std::string detector_ = "geometric";
+  double chi2_2dof_;
+};
+
+}  // namespace urbanslam::slam

@@ -1,0 +1,280 @@
+#include "urbanslam/slam/Evaluation.h"
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "urbanslam/common/Error.h"
+
+namespace urbanslam::slam {
+
+using common::Pose2;
+
+namespace {
+
+constexpr double kRad2Deg = 180.0 / M_PI;
+
+MeanStd meanStd(const std::vector<double>& v) {
+  MeanStd r;
+  if (v.empty()) return r;
+  double s = 0;
+  for (double x : v) s += x;
+  r.mean = s / static_cast<double>(v.size());
+  if (v.size() > 1) {
+    double q = 0;
+    for (double x : v) q += (x - r.mean) * (x - r.mean);
+    r.std = std::sqrt(q / static_cast<double>(v.size() - 1));
+  }
+  return r;
+}
+
+std::vector<io::StampedPose> shifted(const std::vector<io::StampedPose>& t, double offset) {
+  std::vector<io::StampedPose> out = t;
+  for (auto& p : out) p.timestamp += offset;
+  std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.timestamp < b.timestamp; });
+  return out;
+}
+
+}  // namespace
+
+std::vector<Relation> readRelations(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw common::InputError(path + ": cannot open the relations file");
+  std::vector<Relation> out;
+  std::string line;
+  int n = 0;
+  while (std::getline(in, line)) {
+    ++n;
+    if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
+    std::istringstream is(line);
+    double v[8];
+    for (double& x : v)
+      if (!(is >> x) || !std::isfinite(x))
+        throw common::InputError(path + ":" + std::to_string(n) + ": expected 't1 t2 x y z roll pitch yaw'");
+    out.push_back({v[0], v[1], {v[2], v[3], v[7]}});
+  }
+  if (out.empty()) throw common::InputError(path + ": no relations");
+  return out;
+}
+
+bool interpolatePose(const std::vector<io::StampedPose>& traj, double t, double max_gap_s, Pose2& out) {
+  if (traj.empty() || t < traj.front().timestamp || t > traj.back().timestamp) return false;
+  const auto it = std::lower_bound(traj.begin(), traj.end(), t, [](const io::StampedPose& p, double x) { return p.timestamp < x; });
+  if (it->timestamp == t) {
+    out = it->pose;
+    return true;
+  }
+  const auto& b = *it;
+  const auto& a = *(it - 1);
+  if (b.timestamp - a.timestamp > max_gap_s) return false;
+  out = common::interpolate(a.pose, b.pose, (t - a.timestamp) / (b.timestamp - a.timestamp));
+  return true;
+}
+
+RelationMetrics relationMetrics(const std::vector<io::StampedPose>& traj, const std::vector<Relation>& rel,
+                                double time_offset_s, double max_gap_s) {
+  const auto t = shifted(traj, time_offset_s);
+  std::vector<double> tr, tr2, rot, rot2;
+  RelationMetrics m;
+  m.time_offset_s = time_offset_s;
+  for (const auto& r : rel) {
+    Pose2 p1, p2;
+    if (!interpolatePose(t, r.t1, max_gap_s, p1) || !interpolatePose(t, r.t2, max_gap_s, p2)) {
+      ++m.skipped;
+      continue;
+    }
+    // Cartographer: error = (pose1⁻¹ · pose2) · expected⁻¹.
+    const Pose2 e = common::compose(common::between(p1, p2), common::inverse(r.expected));
+    const double et = std::hypot(e.x, e.y), er = std::abs(e.phi) * kRad2Deg;
+    tr.push_back(et);
+    tr2.push_back(et * et);
+    rot.push_back(er);
+    rot2.push_back(er * er);
+  }
+  m.used = tr.size();
+  m.abs_trans_m = meanStd(tr);
+  m.sqr_trans_m2 = meanStd(tr2);
+  m.abs_rot_deg = meanStd(rot);
+  m.sqr_rot_deg2 = meanStd(rot2);
+  return m;
+}
+
+double findRelationTimeOffset(const std::vector<io::StampedPose>& reference, const std::vector<Relation>& rel,
+                              const std::vector<double>& log_times) {
+  if (reference.empty() || rel.empty()) return 0;
+  const auto sorted = shifted(reference, 0);
+  const double r0 = rel.front().t1;
+  if (r0 >= sorted.front().timestamp && r0 <= sorted.back().timestamp) {
+    // Same time base already when most relations fall inside the trajectory.
+    if (relationMetrics(sorted, rel, 0).used > rel.size() / 2) return 0;
+  }
+  // Relation times are scan times: try aligning the first relation with every reference time,
+  // keep the offset with the smallest mean error among those that cover most relations.
+  double best = 0, best_err = 1e300;
+  std::vector<Relation> sample;
+  for (size_t i = 0; i < rel.size(); i += std::max<size_t>(1, rel.size() / 200)) sample.push_back(rel[i]);
+  for (const auto& p : sorted) {
+    const double off = r0 - p.timestamp;
+    const auto m = relationMetrics(sorted, sample, off, 5.0);
+    if (m.used < sample.size() * 8 / 10) continue;
+    const double err = m.abs_trans_m.mean + m.abs_rot_deg.mean / 10;
+    if (err < best_err) {
+      best_err = err;
+      best = off;
+    }
+  }
+  // Fine: the mode of (relation time - log time) differences near the coarse offset, in 1 ms bins.
+  std::vector<double> times = log_times;
+  for (const auto& p : sorted) times.push_back(p.timestamp);
+  std::sort(times.begin(), times.end());
+  std::map<long long, int> votes;
+  for (const auto& r : rel)
+    for (double tr : {r.t1, r.t2}) {
+      const double lo = tr - best - 1.0, hi = tr - best + 1.0;
+      for (auto it = std::lower_bound(times.begin(), times.end(), lo); it != times.end() && *it <= hi; ++it)
+        ++votes[std::llround((tr - *it) * 1000.0)];
+    }
+  // Most votes wins; among equals (regularly sampled logs) the one nearest the coarse value.
+  int top = 0;
+  const double coarse = best;
+  for (const auto& [bin, n] : votes) {
+    const double off = static_cast<double>(bin) / 1000.0;
+    if (n > top || (n == top && std::abs(off - coarse) < std::abs(best - coarse))) {
+      top = n;
+      best = off;
+    }
+  }
+  if (top >= 10) return best;
+  // Too few exact matches (no shared timestamps): refine the coarse value by the error itself.
+  double step = 0.05;
+  for (int round = 0; round < 3; ++round, step /= 10) {
+    const double centre = best;
+    for (int k = -10; k <= 10; ++k) {
+      const double off = centre + k * step;
+      const auto m = relationMetrics(sorted, sample, off, 5.0);
+      if (m.used < sample.size() * 8 / 10) continue;
+      const double err = m.abs_trans_m.mean + m.abs_rot_deg.mean / 10;
+      if (err < best_err) {
+        best_err = err;
+        best = off;
+      }
+    }
+  }
+  return best;
+}
+
+TrajectoryMetrics trajectoryMetrics(const std::vector<io::StampedPose>& estimate, const std::vector<io::StampedPose>& reference,
+                                    bool positions_only, double max_gap_s) {
+  TrajectoryMetrics m;
+  m.positions_only = positions_only;
+  const auto est = shifted(estimate, 0);
+  std::vector<Pose2> e, r;
+  std::vector<double> times;
+  for (const auto& ref : reference) {
+    Pose2 p;
+    if (!interpolatePose(est, ref.timestamp, max_gap_s, p)) continue;
+    e.push_back(p);
+    r.push_back(ref.pose);
+    times.push_back(ref.timestamp);
+  }
+  m.matched = e.size();
+  if (e.size() < 2) return m;
+  // Closed-form 2D rigid alignment (Horn): rotation from the cross-covariance of centred points.
+  Eigen::Vector2d ce(0, 0), cr(0, 0);
+  for (size_t i = 0; i < e.size(); ++i) {
+    ce += Eigen::Vector2d(e[i].x, e[i].y);
+    cr += Eigen::Vector2d(r[i].x, r[i].y);
+  }
+  ce /= static_cast<double>(e.size());
+  cr /= static_cast<double>(e.size());
+  double sxx = 0, sxy = 0;
+  for (size_t i = 0; i < e.size(); ++i) {
+    const Eigen::Vector2d a = Eigen::Vector2d(e[i].x, e[i].y) - ce, b = Eigen::Vector2d(r[i].x, r[i].y) - cr;
+    sxx += a.x() * b.x() + a.y() * b.y();
+    sxy += a.x() * b.y() - a.y() * b.x();
+  }
+  const double th = std::atan2(sxy, sxx), c = std::cos(th), s = std::sin(th);
+  const Eigen::Vector2d t = cr - Eigen::Vector2d(c * ce.x() - s * ce.y(), s * ce.x() + c * ce.y());
+  const Pose2 align{t.x(), t.y(), th};
+  double sum2 = 0;
+  for (size_t i = 0; i < e.size(); ++i) {
+    const Pose2 a = common::compose(align, e[i]);
+    const double d = std::hypot(a.x - r[i].x, a.y - r[i].y);
+    sum2 += d * d;
+    m.ate_max_m = std::max(m.ate_max_m, d);
+    m.times.push_back(times[i]);
+    m.errors_m.push_back(d);
+    m.aligned.push_back({times[i], a});
+  }
+  m.ate_rmse_m = std::sqrt(sum2 / static_cast<double>(e.size()));
+  double rt = 0, rr = 0;
+  for (size_t i = 1; i < e.size(); ++i) {
+    const Pose2 de = common::between(e[i - 1], e[i]), dr = common::between(r[i - 1], r[i]);
+    if (positions_only) {
+      const double d = std::hypot(de.x, de.y) - std::hypot(dr.x, dr.y);
+      rt += d * d;
+    } else {
+      const Pose2 err = common::between(dr, de);
+      rt += err.x * err.x + err.y * err.y;
+      rr += err.phi * err.phi * kRad2Deg * kRad2Deg;
+    }
+  }
+  m.rpe_trans_rmse_m = std::sqrt(rt / static_cast<double>(e.size() - 1));
+  m.rpe_rot_rmse_deg = positions_only ? 0 : std::sqrt(rr / static_cast<double>(e.size() - 1));
+  return m;
+}
+
+std::vector<LoopRow> readLoopClosuresCsv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw common::InputError(path + ": cannot open");
+  std::vector<LoopRow> out;
+  std::string line;
+  std::getline(in, line);  // header
+  int n = 1;
+  while (std::getline(in, line)) {
+    ++n;
+    if (line.empty()) continue;
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) f.push_back(cell);
+    if (f.size() < 11) throw common::InputError(path + ":" + std::to_string(n) + ": expected 14 columns");
+    try {
+      out.push_back({std::stod(f[2]), std::stod(f[3]), f[6] == "1", {std::stod(f[8]), std::stod(f[9]), std::stod(f[10])}});
+    } catch (const std::exception&) {
+      throw common::InputError(path + ":" + std::to_string(n) + ": malformed number");
+    }
+  }
+  return out;
+}
+
+LoopMetrics classifyLoopClosures(const std::vector<LoopRow>& loops, const std::vector<io::StampedPose>& reference,
+                                 bool positions_only, double tol_m, double tol_deg) {
+  LoopMetrics m;
+  const auto ref = shifted(reference, 0);
+  for (const auto& l : loops) {
+    if (!l.accepted) continue;
+    ++m.accepted;
+    Pose2 a, b;
+    // GPS drops out: allow longer gaps for a position-only reference.
+    const double gap = positions_only ? 5.0 : 1.0;
+    if (!interpolatePose(ref, l.from_time, gap, a) || !interpolatePose(ref, l.to_time, gap, b)) {
+      ++m.unverifiable;
+      continue;
+    }
+    bool ok;
+    if (positions_only) {
+      ok = std::abs(std::hypot(b.x - a.x, b.y - a.y) - std::hypot(l.measurement.x, l.measurement.y)) <= tol_m + 2.0;
+    } else {
+      const Pose2 err = common::between(common::between(a, b), l.measurement);
+      ok = std::hypot(err.x, err.y) <= tol_m && std::abs(err.phi) * kRad2Deg <= tol_deg;
+    }
+    ++(ok ? m.true_positive : m.false_positive);
+  }
+  return m;
+}
+
+}  // namespace urbanslam::slam

@@ -1,0 +1,151 @@
+#include "urbanslam/slam/LoopCloser.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+
+#include "urbanslam/alignment/Aligner.h"
+#include "urbanslam/esdf/Gating.h"
+#include "urbanslam/esdf/PoseOps.h"
+#include "urbanslam/slam/Pipeline.h"
+
+namespace urbanslam::slam {
+
+void KeyframeGrid::insert(size_t index, double x, double y) {
+  cells_[key(static_cast<long>(std::floor(x / cell_m_)), static_cast<long>(std::floor(y / cell_m_)))].push_back(index);
+}
+
+void KeyframeGrid::query(double x, double y, double radius, std::vector<size_t>& out) const {
+  const long x0 = static_cast<long>(std::floor((x - radius) / cell_m_)), x1 = static_cast<long>(std::floor((x + radius) / cell_m_));
+  const long y0 = static_cast<long>(std::floor((y - radius) / cell_m_)), y1 = static_cast<long>(std::floor((y + radius) / cell_m_));
+  for (long cx = x0; cx <= x1; ++cx)
+    for (long cy = y0; cy <= y1; ++cy) {
+      const auto it = cells_.find(key(cx, cy));
+      if (it != cells_.end()) out.insert(out.end(), it->second.begin(), it->second.end());
+    }
+}
+
+LoopCloser::LoopCloser(const LoopClosureOptions& options)
+    : options_(options), grid_(std::max(1.0, options.search_radius_m)),
+      chi2_2dof_(esdf::chi2Quantile(options.mahalanobis_probability, 2)) {}
+
+void LoopCloser::setScorer(CandidateScorer scorer, std::string name) {
+  scorer_ = std::move(scorer);
+  detector_ = std::move(name);
+}
+
+void LoopCloser::rebuildIndex(const std::vector<Keyframe>& keyframes) {
+  grid_.clear();
+  for (const auto& k : keyframes) addToIndex(k);
+}
+
+void LoopCloser::addToIndex(const Keyframe& kf) { grid_.insert(kf.index, kf.pose.x, kf.pose.y); }
+
+std::vector<size_t> LoopCloser::candidates(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t current) {
+  const auto& cur = keyframes[current];
+  if (current < static_cast<size_t>(options_.min_keyframe_gap)) return {};
+  const size_t newest_allowed = current - static_cast<size_t>(options_.min_keyframe_gap);
+  // Initial set: earlier keyframes within the search radius, widened by the current pose's own
+  // 3-sigma position uncertainty (conservative covariance: no refactorisation).
+  const esdf::Mat3 c = filter.marginalCovariance(static_cast<int>(current), esdf::CovarianceMode::Conservative);
+  const double sigma = std::sqrt(std::max(0.0, c.topLeftCorner<2, 2>().eigenvalues().real().maxCoeff()));
+  const double radius = options_.search_radius_m + 3 * sigma;
+  std::vector<size_t> near;
+  grid_.query(cur.pose.x, cur.pose.y, radius, near);
+  std::vector<std::pair<double, size_t>> initial;
+  for (size_t i : near) {
+    if (i > newest_allowed) continue;
+    const double d = std::hypot(keyframes[i].pose.x - cur.pose.x, keyframes[i].pose.y - cur.pose.y);
+    if (d <= radius) initial.emplace_back(d, i);
+  }
+  std::sort(initial.begin(), initial.end());
+  if (initial.size() > 30) initial.resize(30);  // bound the covariance work per keyframe
+  // Final set: could the two poses be within the sensor's overlap distance, given their joint
+  // uncertainty? d^2 = t' (J Σ J' + (R/2)^2 I)^-1 t for the relative position t.
+  std::vector<std::pair<double, size_t>> final_set;
+  const double r2 = 0.25 * options_.search_radius_m * options_.search_radius_m;
+  for (const auto& [d, i] : initial) {
+    const esdf::Mat6 joint = filter.jointCovariance(static_cast<int>(i), static_cast<int>(current), esdf::CovarianceMode::Conservative);
+    const esdf::Vec3 xi = filter.mean(static_cast<int>(i)), xk = filter.mean(static_cast<int>(current));
+    esdf::Mat3 ja, jb;
+    esdf::betweenJacobians(xi, xk, &ja, &jb);
+    Eigen::Matrix<double, 3, 6> j;
+    j << ja, jb;
+    const Eigen::Matrix3d s = j * joint * j.transpose();
+    const Eigen::Matrix2d st = s.topLeftCorner<2, 2>() + r2 * Eigen::Matrix2d::Identity();
+    const Eigen::Vector2d t = esdf::between(xi, xk).head<2>();
+    const double d2 = t.dot(st.inverse() * t);
+    if (d2 <= chi2_2dof_) final_set.emplace_back(d2, i);
+  }
+  std::sort(final_set.begin(), final_set.end());
+  std::vector<size_t> out;
+  for (const auto& [d2, i] : final_set) out.push_back(i);
+  return out;
+}
+
+LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current) {
+  LoopClosureRecord r;
+  r.from = earlier;
+  r.to = current;
+  r.from_time = keyframes[earlier].timestamp;
+  r.to_time = keyframes[current].timestamp;
+  r.detector = detector_;
+  // Detection: the appearance test, when a detector is configured.
+  if (scorer_) {
+    r.score = scorer_(earlier, current);
+    if (r.score < options_.laser_threshold) {
+      r.reason = "classifier";
+      return r;
+    }
+  }
+  // Alignment from the current estimate of the relative pose.
+  const esdf::Vec3 xi = filter.mean(static_cast<int>(earlier)), xk = filter.mean(static_cast<int>(current));
+  alignment::AlignerOptions ao;
+  if (options_.method == "auto") {
+    // A well-known relative pose needs only the fast local refinement (PL-ICP); a poorly known
+    // one the global coarse alignment first (CRF-match, then ICP), as in the thesis.
+    const esdf::Mat6 joint = filter.jointCovariance(static_cast<int>(earlier), static_cast<int>(current), esdf::CovarianceMode::Conservative);
+    esdf::Mat3 ja, jb;
+    esdf::betweenJacobians(xi, xk, &ja, &jb);
+    Eigen::Matrix<double, 3, 6> j;
+    j << ja, jb;
+    const Eigen::Matrix3d s = j * joint * j.transpose();
+    const double sxy = std::sqrt(std::max(s(0, 0), s(1, 1))), sphi = std::sqrt(s(2, 2));
+    ao.method = 3 * sxy < options_.auto_local_max_m && 3 * sphi < options_.auto_local_max_deg * M_PI / 180
+                    ? alignment::Method::PlIcp
+                    : alignment::Method::CrfIcp;
+  } else {
+    ao.method = alignment::parseMethod(options_.method);
+  }
+  const common::Pose2 guess = esdf::toPose(esdf::between(xi, xk));
+  const auto matchedFraction = [](const alignment::AlignmentResult& a) {
+    return a.points_b > 0 ? static_cast<double>(a.matches) / a.points_b : 0.0;
+  };
+  const auto good = [&](const alignment::AlignmentResult& a) {
+    return a.converged && a.rms_residual_m <= options_.max_rms_m && matchedFraction(a) >= options_.min_matched_fraction;
+  };
+  // (Trying PL-ICP first on an uncertain guess was measured worse: it lands in wrong local
+  // minima that pass the residual test — ATE 2.96 m vs 0.26 m on Intel.)
+  const alignment::AlignmentResult a = alignment::align(keyframes[earlier].scan, keyframes[current].scan, guess, ao);
+  r.measurement = a.transform;
+  r.rms_m = a.rms_residual_m;
+  const double matched = matchedFraction(a);
+  if (!scorer_) r.score = matched;
+  if (!good(a)) {
+    r.reason = "alignment";
+    return r;
+  }
+  // Innovation gate, then the information-form update.
+  const esdf::Mat3 cov = options_.covariance_scale * a.cov;
+  r.information = cov.inverse();
+  const auto res = filter.observeRelative(static_cast<int>(earlier), static_cast<int>(current), esdf::toVec(a.transform),
+                                          r.information, true);
+  r.mahalanobis2 = res.gate.mahalanobis2;
+  r.gate_threshold = res.gate.threshold;
+  r.accepted = res.accepted;
+  if (!r.accepted) r.reason = "gating";
+  return r;
+}
+
+}  // namespace urbanslam::slam

@@ -1,0 +1,103 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "TestPaths.h"
+#include "urbanslam/esdf/Esdf.h"
+#include "urbanslam/esdf/PoseOps.h"
+#include "urbanslam/slam/Evaluation.h"
+#include "urbanslam/slam/Pipeline.h"
+
+using namespace urbanslam;
+
+namespace {
+
+std::unique_ptr<slam::Pipeline> runOn(const std::string& log, slam::PipelineOptions o) {
+  auto p = std::make_unique<slam::Pipeline>(o);
+  auto src = io::openDataSource(log);
+  p->run(*src);
+  return p;
+}
+
+double ateAgainstReference(const slam::Pipeline& p) {
+  std::vector<io::StampedPose> kf;
+  for (const auto& k : p.keyframes()) kf.push_back({k.timestamp, k.pose});
+  return slam::trajectoryMetrics(kf, p.referenceTrajectory(), false).ate_rmse_m;
+}
+
+// Rebuilds the filter from the constraints the pipeline reported (independent of its internals).
+std::unique_ptr<esdf::Esdf> rebuild(const slam::Pipeline& p) {
+  auto out = std::make_unique<esdf::Esdf>();
+  esdf::Esdf& f = *out;
+  f.initialise(esdf::Vec3::Zero(), esdf::Mat3::Identity() * 1e-9);
+  for (const auto& e : p.graphEdges())
+    if (!e.loop_closure) f.augmentRelative(static_cast<int>(e.from), esdf::toVec(e.measurement), e.information);
+  for (const auto& e : p.graphEdges())
+    if (e.loop_closure) f.observeRelative(static_cast<int>(e.from), static_cast<int>(e.to), esdf::toVec(e.measurement), e.information);
+  f.recover();
+  return out;
+}
+
+}  // namespace
+
+// The shipped Intel rawlog: the ESDF with scan matching and loop closures must beat dead
+// reckoning by a wide margin against the log's reference trajectory.
+TEST(EsdfPipeline, BeatsDeadReckoningOnTheShippedRawlog) {
+  const std::string log = test::repoPath("rawlogs/intel.rawlog");
+  slam::PipelineOptions dr;
+  dr.estimator.type = "dead_reckoning";
+  dr.local.scan_matching = false;
+  const double ate_dr = ateAgainstReference(*runOn(log, dr));
+  const auto slam_run = runOn(log, slam::PipelineOptions{});
+  const double ate = ateAgainstReference(*slam_run);
+  RecordProperty("ate_dead_reckoning_m", std::to_string(ate_dr));
+  RecordProperty("ate_esdf_m", std::to_string(ate));
+  EXPECT_GT(ate_dr, 15.0);
+  EXPECT_LT(ate, 0.5 * ate_dr);
+  EXPECT_GT(slam_run->stats().closures_accepted, 10u);
+  // The pipeline's keyframe poses are the optimum of the constraints it reports.
+  const auto f = rebuild(*slam_run);
+  for (size_t i = 0; i < slam_run->keyframes().size(); i += 50) {
+    EXPECT_NEAR(f->mean(static_cast<int>(i)).x(), slam_run->keyframes()[i].pose.x, 1e-3) << i;
+    EXPECT_NEAR(f->mean(static_cast<int>(i)).y(), slam_run->keyframes()[i].pose.y, 1e-3) << i;
+  }
+}
+
+TEST(EsdfPipeline, SameInputSameOutput) {
+  const std::string log = test::repoPath("rawlogs/intel-corrected-excerpt.log.gz");
+  const auto a = runOn(log, {}), b = runOn(log, {});
+  ASSERT_EQ(a->keyframes().size(), b->keyframes().size());
+  for (size_t i = 0; i < a->keyframes().size(); ++i) {
+    EXPECT_EQ(a->keyframes()[i].pose.x, b->keyframes()[i].pose.x);
+    EXPECT_EQ(a->keyframes()[i].pose.phi, b->keyframes()[i].pose.phi);
+  }
+  EXPECT_EQ(a->loopClosures().size(), b->loopClosures().size());
+}
+
+// A deliberately corrupted candidate: keyframe k's scan replaced by keyframe i's, although the
+// filter knows they are metres apart. Alignment then "succeeds" perfectly (identical scans), so
+// only the innovation gate stands between it and the map — and it must reject it.
+TEST(EsdfPipeline, WrongPlaceClosureIsGatedOut) {
+  const std::string log = test::repoPath("rawlogs/intel-corrected-excerpt.log.gz");
+  slam::PipelineOptions o;
+  o.loop_closure.enabled = false;
+  const auto p = runOn(log, o);
+  auto filter = rebuild(*p);
+  esdf::Esdf& f = *filter;
+  auto keyframes = p->keyframes();
+  const size_t k = keyframes.size() - 1;
+  size_t i = 0;
+  while (i < k && std::hypot(keyframes[i].pose.x - keyframes[k].pose.x, keyframes[i].pose.y - keyframes[k].pose.y) < 3.0) ++i;
+  ASSERT_LT(i, k) << "the excerpt has no keyframe 3 m away from the last one";
+  keyframes[k].scan = keyframes[i].scan;
+  slam::LoopClosureOptions lo;
+  lo.method = "crf+icp";  // finds the (wrong) perfect match from metres away
+  slam::LoopCloser closer(lo);
+  const size_t factors_before = f.factorCount();
+  const slam::LoopClosureRecord r = closer.tryClose(f, keyframes, i, k);
+  EXPECT_FALSE(r.accepted);
+  EXPECT_EQ(r.reason, "gating") << "rms " << r.rms_m;
+  EXPECT_GT(r.mahalanobis2, r.gate_threshold);
+  EXPECT_EQ(f.factorCount(), factors_before);  // nothing touched the filter
+  // The genuine pair (the real scan) would not be rejected by the gate for being inconsistent.
+}

@@ -1,0 +1,122 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <random>
+
+#include "TestPaths.h"
+#include "urbanslam/common/Error.h"
+#include "urbanslam/io/DataSource.h"
+#include "urbanslam/slam/Evaluation.h"
+
+using namespace urbanslam;
+
+namespace {
+// A circle driven at varying speed (so that a time shift changes the relative motions).
+std::vector<io::StampedPose> circle(double offset_t = 0) {
+  std::vector<io::StampedPose> t;
+  double a = 0;
+  for (int i = 0; i < 200; ++i) {
+    a += 0.03 + 0.02 * std::sin(i * 0.3);
+    t.push_back({offset_t + i * 0.1, {5 * std::cos(a), 5 * std::sin(a), a + M_PI / 2}});
+  }
+  return t;
+}
+}  // namespace
+
+// Relation metric by hand: a trajectory with a known constant error in each relation.
+TEST(Evaluation, RelationMetricMatchesHandComputedErrors) {
+  const auto traj = circle();
+  std::vector<slam::Relation> rel;
+  for (int i = 0; i + 10 < 200; i += 10) {
+    const auto expected = common::between(traj[static_cast<size_t>(i)].pose, traj[static_cast<size_t>(i + 10)].pose);
+    // Expected perturbed on the left by d = (0.1 m, 0, 2°): error = between ⋅ (d ⋅ between)^-1 = d^-1.
+    rel.push_back({traj[static_cast<size_t>(i)].timestamp, traj[static_cast<size_t>(i + 10)].timestamp,
+                   common::compose({0.1, 0, 2 * M_PI / 180}, expected)});
+  }
+  const auto m = slam::relationMetrics(traj, rel, 0);
+  ASSERT_EQ(m.used, rel.size());
+  EXPECT_NEAR(m.abs_rot_deg.mean, 2.0, 1e-9);
+  EXPECT_NEAR(m.abs_rot_deg.std, 0.0, 1e-9);
+  // |d^-1| translation: 0.1 m.
+  EXPECT_NEAR(m.abs_trans_m.mean, 0.1, 1e-9);
+  EXPECT_NEAR(m.sqr_trans_m2.mean, 0.01, 1e-9);
+  EXPECT_NEAR(m.sqr_rot_deg2.mean, 4.0, 1e-9);
+}
+
+TEST(Evaluation, TimeOffsetIsRecoveredFromTheReference) {
+  const auto ref = circle();
+  std::vector<slam::Relation> rel;
+  const double base = 976052896.8;
+  for (int i = 0; i + 5 < 200; i += 3)
+    rel.push_back({base + ref[static_cast<size_t>(i)].timestamp, base + ref[static_cast<size_t>(i + 5)].timestamp,
+                   common::between(ref[static_cast<size_t>(i)].pose, ref[static_cast<size_t>(i + 5)].pose)});
+  EXPECT_NEAR(slam::findRelationTimeOffset(ref, rel), base, 1e-3);
+  EXPECT_EQ(slam::findRelationTimeOffset(ref, std::vector<slam::Relation>(rel.begin(), rel.begin() + 1)) != 0, true);
+}
+
+TEST(Evaluation, AteIsZeroAfterARigidMotionAndSeesNoise) {
+  const auto ref = circle();
+  auto est = ref;
+  for (auto& p : est) p.pose = common::compose({3, -2, 0.7}, p.pose);
+  const auto m = slam::trajectoryMetrics(est, ref, false);
+  EXPECT_EQ(m.matched, ref.size());
+  EXPECT_NEAR(m.ate_rmse_m, 0, 1e-9);
+  EXPECT_NEAR(m.rpe_rot_rmse_deg, 0, 1e-9);
+  std::mt19937 rng(1);
+  std::normal_distribution<double> n(0, 0.1);
+  for (auto& p : est) {
+    p.pose.x += n(rng);
+    p.pose.y += n(rng);
+  }
+  const auto noisy = slam::trajectoryMetrics(est, ref, false);
+  EXPECT_NEAR(noisy.ate_rmse_m, 0.1 * std::sqrt(2.0), 0.03);
+}
+
+TEST(Evaluation, LoopClosuresAreClassifiedAgainstTheReference) {
+  const auto ref = circle();
+  std::vector<slam::LoopRow> loops;
+  const auto truth = common::between(ref[10].pose, ref[150].pose);
+  loops.push_back({ref[10].timestamp, ref[150].timestamp, true, truth});
+  loops.push_back({ref[10].timestamp, ref[150].timestamp, true, common::compose(truth, {2.0, 0, 0})});
+  loops.push_back({ref[10].timestamp, ref[150].timestamp, false, truth});
+  loops.push_back({-50, ref[150].timestamp, true, truth});
+  const auto m = slam::classifyLoopClosures(loops, ref, false);
+  EXPECT_EQ(m.accepted, 3u);
+  EXPECT_EQ(m.true_positive, 1u);
+  EXPECT_EQ(m.false_positive, 1u);
+  EXPECT_EQ(m.unverifiable, 1u);
+}
+
+TEST(Evaluation, MalformedRelationsFileIsAnError) {
+  const auto d = test::scratchDir("relations_bad");
+  std::ofstream(d / "r.relations") << "1 2 3\n";
+  EXPECT_THROW(slam::readRelations((d / "r.relations").string()), common::InputError);
+  EXPECT_THROW(slam::readRelations((d / "none").string()), common::InputError);
+}
+
+// The real thing: the relation file of Intel against the corrected log's own poses.
+TEST(Evaluation, IntelRelationsAgainstTheCorrectedLog) {
+  const std::string rel = test::sharedDataPath("freiburg_slam_benchmark/relations/intel.relations");
+  if (rel.empty()) GTEST_SKIP() << "../shared/data (Freiburg relations) not present";
+  auto src = io::openDataSource(test::repoPath("rawlogs/intel.rawlog"));
+  std::vector<io::StampedPose> ref;
+  io::Measurement m;
+  while (src->next(m))
+    if (auto* r = std::get_if<io::ReferencePose>(&m)) ref.push_back({r->timestamp, r->pose});
+  const auto relations = slam::readRelations(rel);
+  EXPECT_EQ(relations.size(), 2984u);
+  std::vector<double> odometry_times;
+  {
+    auto s2 = io::openDataSource(test::repoPath("rawlogs/intel.rawlog"));
+    while (s2->next(m))
+      if (auto* o = std::get_if<io::OdometryReading>(&m)) odometry_times.push_back(o->timestamp);
+  }
+  const double off = slam::findRelationTimeOffset(ref, relations, odometry_times);
+  const auto metrics = slam::relationMetrics(ref, relations, off, 5.0);  // scans ~3 s apart
+  EXPECT_GT(metrics.used, 2500u);
+  // Relation times are odometry/scan times of the raw log: the offset is exact to the ms.
+  EXPECT_NEAR(off, 976052857.337, 0.002);
+  // GMapping's corrected poses, linearly interpolated between scans ~3 s apart.
+  EXPECT_LT(metrics.abs_trans_m.mean, 0.2);
+}
