@@ -18,6 +18,9 @@ struct Command {
 int runCommand(const Argv& args);
 int convertCommand(const Argv& args);
 int checkIniCommand(const Argv& args);
+int evalCommand(const Argv& args);
+int graphCommand(const Argv& args);
+int alignCommand(const Argv& args);
 int trainLaserLoopCommand(const Argv& args);
 int evalLaserLoopCommand(const Argv& args);
 int buildVocabularyCommand(const Argv& args);
