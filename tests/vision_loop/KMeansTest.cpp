@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
 #include <random>
 #include <set>
@@ -144,4 +145,29 @@ TEST(VocabularyTree, IdfIsLnNOverNi) {
   EXPECT_NEAR(v.idf(w1), std::log(2.0), 1e-6);
   EXPECT_NEAR(v.idf(w2), std::log(2.0), 1e-6);
   EXPECT_EQ(v.data().training_images, 2u);
+}
+
+TEST(VocabularyTree, AtMostKChildrenAndLLevelsSoQuantisationIsAtMostKLComparisons) {
+  std::mt19937_64 rng(12);
+  std::vector<uint8_t> data(5000 * 32);
+  for (auto& b : data) b = static_cast<uint8_t>(rng());
+  DescriptorSet set{data.data(), 5000, 32};
+  KMeansOptions o;
+  o.branching = 5;
+  o.depth = 4;
+  o.max_iterations = 5;
+  const Vocabulary v(buildVocabularyTree(set, DescriptorType::Orb, o));
+  const auto& d = v.data();
+  std::vector<uint32_t> depth(d.nodeCount(), 0);
+  uint32_t max_depth = 0;
+  for (uint32_t n = 0; n < d.nodeCount(); ++n) {
+    EXPECT_LE(d.child_count[n], 5u);
+    for (uint32_t c = d.first_child[n]; c < d.first_child[n] + d.child_count[n]; ++c) {
+      depth[c] = depth[n] + 1;
+      max_depth = std::max(max_depth, depth[c]);
+    }
+  }
+  EXPECT_EQ(max_depth, 4u);
+  EXPECT_GT(v.wordCount(), 500u);  // 5^4 = 625 possible
+  EXPECT_LE(v.wordCount(), 625u);
 }
