@@ -66,11 +66,9 @@ int evalImageLoopCommand(const Argv& args) {
   {
     common::ProgressBar bar("features", sequence->sizeHint(), !ap.flag("quiet"));
     NamedImage img;
-    cv::Size size;
     while (sequence->next(img)) {
       EvaluationFrame f;
       f.name = img.name;
-      size = img.gray.size();
       sw.restart();
       f.features = extractor.extract(img.gray);
       f.extraction_ms = sw.milliseconds();
