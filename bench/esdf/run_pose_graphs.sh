@@ -13,6 +13,9 @@
 #  * MRPT 2.5's graph-slam app loads the graph as CNetworkOfPoses2D, which drops the edges'
 #    information matrices (its output file has identity information): it minimises the
 #    unweighted error, so its chi2 here is of its unweighted optimum under the weighted metric.
+#    For an apples-to-apples comparison with MRPT's own optimum, the last two columns run
+#    urbanslam on MRPT's output file (same edges, identity information) and give both chi2
+#    values of that unweighted problem (uw_*).
 #
 # Usage: bench/esdf/run_pose_graphs.sh [BUILD_DIR]   (default build dir: build)
 #   env URBANSLAM=path/to/urbanslam  ESDF_TOOL=path/to/esdf_pose_graph  DATA=dir  GRAPH_SLAM=...
@@ -47,8 +50,8 @@ datasets=(
 )
 
 now() { date +%s.%N; }
-printf "%-42s %6s %6s | %14s %8s | %14s %8s %6s | %9s %7s | %14s\n" dataset poses edges urbanslam_chi2 time_s \
-  mrpt_chi2 time_s rc chi2_ratio speedup chi2_no_relin
+printf "%-42s %6s %6s | %14s %8s | %14s %8s %6s | %9s %7s | %14s | %12s %12s %9s\n" dataset poses edges \
+  urbanslam_chi2 time_s mrpt_chi2 time_s rc chi2_ratio speedup chi2_no_relin uw_urbanslam uw_mrpt uw_ratio
 for d in "${datasets[@]}"; do
   f="$DATA/$d"
   [[ -f "$f" ]] || { printf "%-42s absent\n" "$d"; continue; }
@@ -68,12 +71,15 @@ for d in "${datasets[@]}"; do
   t3=$(now)
   if [[ $rc -eq 0 && -f "$work/$name.mrpt.g2o" ]]; then
     chi2_m=$("$ESDF_TOOL" --eval "$f" "$work/$name.mrpt.g2o")
+    uw_m=$("$ESDF_TOOL" --eval "$work/$name.mrpt.g2o" "$work/$name.mrpt.g2o")
+    uw_u=$("$URBANSLAM" graph "$work/$name.mrpt.g2o" --json | sed -E 's/.*"chi2":([^,]*).*/\1/')
   else
-    chi2_m=nan
+    chi2_m=nan; uw_m=nan; uw_u=nan
   fi
   tu=$(echo "$t1 - $t0" | bc -l); tm=$(echo "$t3 - $t2" | bc -l)
   ratio=$(awk -v a="$chi2_u" -v b="$chi2_m" 'BEGIN{ if (b == "nan" || b + 0 == 0) print "n/a"; else printf "%.4f", a / b }')
   speed=$(awk -v a="$tu" -v b="$tm" 'BEGIN{ printf "%.1fx", b / a }')
-  printf "%-42s %6s %6s | %14.4f %8.3f | %14s %8.3f %6s | %9s %7s | %14.4f\n" "$d" "$poses" "$edges" "$chi2_u" "$tu" \
-    "$chi2_m" "$tm" "$rc" "$ratio" "$speed" "$chi2_once"
+  uw_ratio=$(awk -v a="$uw_u" -v b="$uw_m" 'BEGIN{ if (b == "nan" || b + 0 == 0) print "n/a"; else printf "%.4f", a / b }')
+  printf "%-42s %6s %6s | %14.4f %8.3f | %14s %8.3f %6s | %9s %7s | %14.4f | %12.6g %12.6g %9s\n" "$d" "$poses" "$edges" \
+    "$chi2_u" "$tu" "$chi2_m" "$tm" "$rc" "$ratio" "$speed" "$chi2_once" "$uw_u" "$uw_m" "$uw_ratio"
 done

@@ -241,22 +241,73 @@ RecoveryStats Esdf::recover(int max_passes) {
   common::Stopwatch sw;
   RecoveryStats st;
   if (max_passes < 0) max_passes = options_.relinearise_max_passes;
+  const int n = size();
+  Eigen::VectorXd old(3 * n);
   for (int pass = 0;; ++pass) {
     ensureFactor();
-    Eigen::VectorXd eta = state_.denseEta();
-    const Eigen::VectorXd mu = full_factor_.solve(eta);
-    for (int p = 0; p < size(); ++p) state_.setMean(p, mu.segment<3>(3 * p));
-    if (!options_.relinearise || pass >= max_passes) break;
-    const long long n = relineariseMoved();
-    if (n == 0) {
+    const Eigen::VectorXd mu = full_factor_.solve(state_.denseEta());
+    if (!options_.relinearise) {
+      // The thesis filter: the mean is whatever the (once-linearised) information says.
+      for (int p = 0; p < n; ++p) state_.setMean(p, mu.segment<3>(3 * p));
+      break;
+    }
+    // Gauss-Newton with backtracking: a full step on a badly conditioned or strongly nonlinear
+    // graph can increase the cost (and oscillate); halve it until the cost does not increase.
+    for (int p = 0; p < n; ++p) old.segment<3>(3 * p) = state_.mean(p);
+    const double c_old = cost();
+    double alpha = 1.0, c_new = 0;
+    for (;;) {
+      for (int p = 0; p < n; ++p) state_.setMean(p, old.segment<3>(3 * p) + alpha * (mu.segment<3>(3 * p) - old.segment<3>(3 * p)));
+      c_new = cost();
+      if (c_new <= c_old * (1 + 1e-12) || alpha < 1.0 / 256) break;
+      alpha *= 0.5;
+      ++st.step_halvings;
+    }
+    if (c_new > c_old * (1 + 1e-12))
+      for (int p = 0; p < n; ++p) state_.setMean(p, old.segment<3>(3 * p));
+    if (pass >= max_passes) break;
+    const long long moved = relineariseMoved();
+    if (moved == 0) {
       st.converged = true;
       break;
     }
     st.relinearise_passes = pass + 1;
-    st.factors_relinearised += n;
+    st.factors_relinearised += moved;
   }
   st.seconds = sw.seconds();
   return st;
+}
+
+Vec3 Esdf::factorError(const Factor& f, Mat3* w) const {
+  const Vec3& xa = state_.mean(f.a);
+  switch (f.kind) {
+    case Factor::Kind::Prior:
+      *w = f.weight;
+      return poseDifference(xa, f.z);
+    case Factor::Kind::Motion: {
+      // The weight Q^-1 is the one of the factor's linearisation (it depends on F_u there).
+      const int dim = f.model->inputDimension();
+      Mat3 fx;
+      MatU fu;
+      f.model->predict(f.lin_a, f.z.head(dim), f.dt, &fx, &fu);
+      *w = processInformation(fu, f.weight.topLeftCorner(dim, dim), stabilisingNoise(*f.model));
+      return poseDifference(state_.mean(f.b), f.model->predict(xa, f.z.head(dim), f.dt, nullptr, nullptr));
+    }
+    case Factor::Kind::Relative:
+      *w = f.weight;
+      return relativePoseError(xa, state_.mean(f.b), f.z);
+  }
+  return Vec3::Zero();
+}
+
+double Esdf::cost() const {
+  double c = 0;
+  Mat3 w;
+  for (const Factor& f : factors_) {
+    const Vec3 e = factorError(f, &w);
+    c += e.dot(w * e);
+  }
+  return c;
 }
 
 long long Esdf::relineariseMoved() {

@@ -66,6 +66,7 @@ struct RecoveryStats {
   int relinearise_passes = 0;
   long long factors_relinearised = 0;
   bool converged = false;  // the last relinearisation pass found nothing to relinearise
+  int step_halvings = 0;   // backtracking steps taken (see recover())
   double seconds = 0;
 };
 
@@ -102,6 +103,8 @@ class Esdf {
 
   // Full recovery: factorise Lambda (CHOLMOD), mu = Lambda^-1 eta, then (if enabled) up to
   // max_relinearise_passes rounds of relinearise + re-solve (-1: options().relinearise_max_passes).
+  // With relinearisation each solve is a Gauss-Newton step from the current mean, shortened
+  // (halved) while it would increase cost().
   RecoveryStats recover(int max_relinearise_passes = -1);
   // Partial recovery of poses [first, size()) with the older poses held at their current mean.
   void recoverRecent(int first);
@@ -117,6 +120,10 @@ class Esdf {
   size_t factorCount() const { return factors_.size(); }
   long long factorNonZeros() const { return full_factor_.factorNonZeros(); }
   size_t memoryBytes() const;
+
+  // Total cost sum e' W e of the kept factors at the current mean (marginalised information
+  // excluded): what relinearisation minimises.
+  double cost() const;
 
   // Re-linearises every factor whose poses moved beyond the thresholds; returns their number.
   // recover() calls it; exposed for tests and experiments.
@@ -138,6 +145,8 @@ class Esdf {
     Vec3 e0;
   };
   Linearisation linearise(const Factor& f, const Vec3& xa, const Vec3& xb) const;
+  // Error of a factor at the current mean and its weight.
+  Vec3 factorError(const Factor& f, Mat3* w) const;
   // Adds (sign = +1) or removes (sign = -1) a factor's contribution at its linearisation point.
   void apply(const Factor& f, double sign);
   void addFactor(Factor f);
