@@ -191,3 +191,21 @@ TEST(Vocabulary, ShippedTreesSendWordCentresToTheirWords) {
     std::printf("%s: %zu of %zu word centres land in their own word\n", name, self, v->wordCount());
   }
 }
+
+#include "urbanslam/common/IniFile.h"
+#include "urbanslam/vision_loop/ImageLoopOptions.h"
+
+TEST(ImageLoopOptions, IniKeysReachTheDetector) {
+  urbanslam::common::OptionsSchema schema;
+  ImageLoopOptions o;
+  schema.section("image_loop", "Tree of Words");
+  declareImageLoopOptions(schema, o);
+  schema.load(urbanslam::common::IniFile::parse(
+      "[image_loop]\nmin_normalized_score = 0.5\nmin_inliers = 15\nmax_features = 300\n", "test.ini"));
+  const LoopDetectorOptions d = detectorOptions(o);
+  EXPECT_FLOAT_EQ(d.min_normalized_score, 0.5f);
+  EXPECT_EQ(d.verification.min_inliers, 15);
+  EXPECT_EQ(featureOptions(o, DescriptorType::Orb).max_features, 300);
+  EXPECT_THROW(schema.load(urbanslam::common::IniFile::parse("[image_loop]\nmin_inlier = 3\n", "bad.ini")),
+               urbanslam::common::ConfigError);
+}
