@@ -103,6 +103,7 @@ TEST(PoseGraphIO, MalformedInputNamesFileAndLine) {
   EXPECT_THROW(parsePoseGraph("VERTEX_SE2 0 0 zero 0\n", "x"), common::InputError);
   EXPECT_THROW(parsePoseGraph("EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1 7\n", "x"), common::InputError);
   EXPECT_THROW(parsePoseGraph("EDGE_SE2 0 1 1 0 0 -1 0 0 1 0 1\n", "x"), common::InputError);
+  EXPECT_THROW(parsePoseGraph("EDGE_SE2 0 1 1 0 0 1 2 0 1 0 1\n", "x"), common::InputError);  // indefinite
   EXPECT_THROW(parsePoseGraph("just text\n", "x"), common::InputError);
   EXPECT_THROW(readPoseGraph("/nonexistent/graph.g2o"), common::InputError);
 }

@@ -2,6 +2,8 @@
 
 #include <zlib.h>
 
+#include <Eigen/Cholesky>
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -98,7 +100,9 @@ PoseGraph parsePoseGraph(const std::string& text, const std::string& name) {
         xx = p[3]; xy = p[4]; xt = p[5]; yy = p[6]; yt = p[7]; tt = p[8];
       }
       e.information << xx, xy, xt, xy, yy, yt, xt, yt, tt;
-      if (!(xx > 0 && yy > 0 && tt > 0)) fail("information matrix is not positive definite");
+      // A singular or indefinite information matrix would make Lambda singular far from here.
+      if (!(xx > 0 && yy > 0 && tt > 0) || Eigen::LLT<Mat3>(e.information).info() != Eigen::Success)
+        fail("information matrix is not positive definite");
       g.edges.push_back(e);
     } else {
       // Other tags (FIX, VERTEX_XY landmarks, parameters) carry nothing for a pose graph.
