@@ -12,7 +12,9 @@
 //     recovery of the 50 most recent poses, and the joint covariance of a pair 20 poses after
 //     that factorisation: exact (refactorise + column solves) / conservative (old factor + dead
 //     reckoning, no refactorisation).
-// Usage: esdf_bench [--no-full-above N] [--ordering amd|metis|auto|natural] SIZE...   (default sizes 1000 10000 100000 1000000)
+// Usage: esdf_bench [--no-full-above N] [--ordering amd|metis|auto|natural] [--backend N]... SIZE...
+//   (default sizes 1000 10000 100000 1000000; each --backend N also runs the pose-graph back end,
+//   with its recovery policy, on the same drive of N poses)
 #include <Eigen/Core>
 #include <cstdio>
 #include <cstdlib>
@@ -24,6 +26,7 @@
 
 #include "urbanslam/common/Timing.h"
 #include "urbanslam/esdf/Esdf.h"
+#include "urbanslam/esdf/PoseGraphBackend.h"
 
 using namespace urbanslam;
 using esdf::Mat3;
@@ -131,13 +134,70 @@ Row runSize(long n, long no_full_above) {
   return r;
 }
 
+// The same drive as a pose graph (odometry + loop-closure edges), for the back end's policy.
+esdf::PoseGraph cityGraph(long n) {
+  std::mt19937 rng(static_cast<unsigned>(n) + 7);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  esdf::PoseGraph graph;
+  const Mat3 odo = Vec3(400.0, 400.0, 10000.0).asDiagonal();
+  const Mat3 loop = Vec3(100.0, 100.0, 1000.0).asDiagonal();
+  const int half_blocks = std::max(2, static_cast<int>(std::sqrt(static_cast<double>(n)) / 6));
+  std::unordered_map<long long, std::pair<int, Vec3>> last_visit;
+  Vec3 truth = Vec3::Zero();
+  int dir = 0;
+  for (long k = 1; k < n; ++k) {
+    double dphi = 0;
+    const long ix = std::lround(truth.x()), iy = std::lround(truth.y());
+    if (ix % 10 == 0 && iy % 10 == 0) {
+      const double r = u(rng);
+      int turn = r < 0.3 ? 1 : (r < 0.6 ? -1 : 0);
+      const int lim = 10 * half_blocks;
+      auto outward = [&](int d) {
+        return (d == 0 && ix >= lim) || (d == 2 && ix <= -lim) || (d == 1 && iy >= lim) || (d == 3 && iy <= -lim);
+      };
+      for (int tries = 0; tries < 4 && outward((dir + turn + 4) % 4); ++tries) turn = (turn == 1) ? -1 : turn + 1;
+      dir = (dir + turn + 4) % 4;
+      dphi = turn * M_PI / 2;
+    }
+    const Vec3 step(std::cos(dphi), std::sin(dphi), dphi);
+    truth = esdf::compose(truth, step);
+    graph.edges.push_back({k - 1, k, step + Vec3(0.05 * g(rng), 0.05 * g(rng), 0.01 * g(rng)), odo});
+    const long long key = (static_cast<long long>(std::lround(truth.x())) << 32) ^ (std::lround(truth.y()) & 0xffffffff);
+    auto it = last_visit.find(key);
+    if (it != last_visit.end() && k - it->second.first > 50 && u(rng) < 0.3) {
+      const Vec3 zl = esdf::between(it->second.second, truth) + Vec3(0.05 * g(rng), 0.05 * g(rng), 0.01 * g(rng));
+      graph.edges.push_back({it->second.first, k, zl, loop});
+    }
+    last_visit[key] = {static_cast<int>(k), truth};
+  }
+  return graph;
+}
+
+void runBackend(const std::vector<long>& sizes) {
+  std::printf("\nback end (urbanslam graph's policy: partial recovery after closures, amortised full recoveries,\n"
+              "relinearisation; the last recovery iterates to convergence):\n");
+  std::printf("%9s %8s | %9s %9s %9s | %8s %8s | %9s %9s | %12s %s\n", "poses", "edges", "step_p50", "step_p99", "step_max",
+              "full", "partial", "time_s", "recov_s", "chi2", "");
+  for (long n : sizes) {
+    const esdf::PoseGraph graph = cityGraph(n);
+    const auto r = esdf::runPoseGraphBackend(graph);
+    std::printf("%9ld %8d | %9.4f %9.4f %9.1f | %8d %8d | %9.3f %9.3f | %12.3f %s\n", n, r.edges,
+                common::percentile(r.step_ms, 50), common::percentile(r.step_ms, 99), common::percentile(r.step_ms, 100),
+                r.full_recoveries, r.partial_recoveries, r.time_s, r.recovery_s, r.chi2,
+                r.converged ? "(converged)" : "(not converged)");
+    std::fflush(stdout);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<long> sizes;
+  std::vector<long> sizes, backend_sizes;
   long no_full_above = 100000000;
   for (int a = 1; a < argc; ++a) {
     if (!std::strcmp(argv[a], "--no-full-above") && a + 1 < argc) no_full_above = std::atol(argv[++a]);
+    else if (!std::strcmp(argv[a], "--backend") && a + 1 < argc) backend_sizes.push_back(std::atol(argv[++a]));
     else if (!std::strcmp(argv[a], "--ordering") && a + 1 < argc) {
       const std::string o = argv[++a];
       g_ordering = o == "metis" ? esdf::FillReducingOrdering::Metis
@@ -146,7 +206,7 @@ int main(int argc, char** argv) {
     }
     else sizes.push_back(std::atol(argv[a]));
   }
-  if (sizes.empty()) sizes = {1000, 10000, 100000, 1000000};
+  if (sizes.empty() && backend_sizes.empty()) sizes = {1000, 10000, 100000, 1000000};
   std::printf("%9s %8s | %8s %8s %9s | %8s %8s %9s | %9s | %10s %12s %10s %10s %10s\n", "poses", "closures",
               "aug_p50", "aug_p99", "aug_max", "upd_p50", "upd_p99", "upd_max", "B/pose", "full_rec_s", "factor_nnz",
               "part_ms", "cov_ex_ms", "cov_cons_ms");
@@ -158,6 +218,7 @@ int main(int argc, char** argv) {
                 r.full_s, r.factor_nnz, r.partial_ms, r.cov_exact_ms, r.cov_cons_ms);
     std::fflush(stdout);
   }
+  if (!backend_sizes.empty()) runBackend(backend_sizes);
   std::printf("peak RSS %.1f MB\n", static_cast<double>(common::peakResidentBytes()) / 1e6);
   return 0;
 }
