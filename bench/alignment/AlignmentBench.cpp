@@ -6,7 +6,8 @@
 //    apart in the log whose reference poses are within 2 m and 45 deg (loop-closure-like).
 //  * Victoria Park has no reference trajectory (GPS only): its "near" pairs (scans 1-3 apart)
 //    use a pseudo-truth, the answer on which ICP and PL-ICP started from the identity agree
-//    (within 2 cm / 0.2 deg; pairs where they disagree are skipped). It measures the basin of
+//    (within 2 cm / 0.2 deg; pairs where they disagree are skipped); its "far(chained)" pairs
+//    (4-8 scans apart) chain such agreeing consecutive alignments. It measures the basin of
 //    convergence on outdoor scans, not absolute accuracy.
 // For each pair and initial-error level, every method starts from the same perturbed guess
 // (uniform in +-E metres on x and y, +-R degrees on phi). Success: final error < 0.1 m and < 1 deg.
@@ -232,6 +233,8 @@ int main(int argc, char** argv) {
     const double v = std::stod(kv.substr(eq + 1));
     auto& c = base.crf;
     if (key == "target_points") c.subsampling.target_points = static_cast<int>(v);
+    else if (key == "min_segment_points") c.subsampling.min_segment_points = static_cast<int>(v);
+    else if (key == "segment_gap_m") c.subsampling.segment_gap_m = v;
     else if (key == "feature_sigma_rad") c.feature_sigma_rad = v;
     else if (key == "pair_sigma_m") c.pair_sigma_m = v;
     else if (key == "pair_direction_sigma_rad") c.pair_direction_sigma_rad = v;
@@ -356,6 +359,39 @@ int main(int argc, char** argv) {
         if (std::hypot(t.x, t.y) > 2.0 || std::abs(t.phi) > M_PI / 4) continue;
         PairCase pc{ds.name + "/far", a, b, t};
         verify(pc, samples[a].scan, samples[b].scan, base);
+        cases.push_back(pc);
+        ++found;
+      }
+    } else {
+      // Victoria Park "far" pairs: 4-8 scans apart (metres apart at driving speed), pseudo-truth
+      // chained from agreeing consecutive alignments. Revisits have no truth there (GPS only).
+      std::map<int, std::pair<bool, uc::Pose2>> link;  // i -> (agreed, pose of i+1 in i)
+      auto linkOf = [&](int i) {
+        auto it = link.find(i);
+        if (it != link.end()) return it->second;
+        ua::AlignerOptions o = base;
+        o.method = ua::Method::Icp;
+        const auto r1 = ua::align(samples[i].scan, samples[i + 1].scan, {}, o);
+        o.method = ua::Method::PlIcp;
+        const auto r2 = ua::align(samples[i].scan, samples[i + 1].scan, {}, o);
+        const bool ok = r1.converged && r2.converged && within(r1.transform, r2.transform, 0.02, 0.2);
+        return link[i] = {ok, r2.transform};
+      };
+      int found = 0;
+      for (int tries = 0; found < args.pairs && tries < args.pairs * 50; ++tries) {
+        const int k = 4 + static_cast<int>(uniform(rng, 0, 5));
+        const int a = static_cast<int>(uniform(rng, 0, samples.size() - k - 1));
+        uc::Pose2 t;
+        bool ok = true;
+        for (int i = a; i < a + k && ok; ++i) {
+          const auto [agreed, step] = linkOf(i);
+          ok = agreed;
+          t = uc::compose(t, step);
+        }
+        if (!ok) continue;
+        PairCase pc{ds.name + "/far(chained)", a, a + k, t};
+        pc.verified = true;
+        pc.truth_verified = t;
         cases.push_back(pc);
         ++found;
       }

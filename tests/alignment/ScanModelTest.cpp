@@ -118,3 +118,23 @@ TEST(Subsampling, NoDecimationNearTarget) {
   EXPECT_EQ(s.count_after_decimation, 120);
   EXPECT_TRUE(ua::subsample(ua::PointSet{}, o).points.empty());
 }
+
+// An outdoor scan of tree trunks (3 returns each) is the scene, not clutter: step 3 lowers its
+// minimum segment size rather than dropping nearly every point.
+TEST(Subsampling, SparseSceneKeepsSmallSegments) {
+  std::vector<double> ranges, bearings;
+  for (int t = 0; t < 40; ++t)
+    for (int k = 0; k < 3; ++k) {
+      bearings.push_back(0.5 * M_PI / 180.0 * static_cast<double>(ranges.size()));
+      ranges.push_back(t % 2 ? 8.0 : 12.0);  // alternate ranges: 4 m jumps split the trunks
+    }
+  const auto pts = ua::makePointSet(ranges, bearings, ua::ScanModelOptions{});
+  ua::SubsamplingOptions o;
+  o.min_segment_points = 5;
+  o.target_points = 1000;
+  const auto s = ua::subsample(pts, o);
+  EXPECT_EQ(s.min_segment_points_used, 3);
+  EXPECT_EQ(s.count_after_segments, 120);
+  o.min_kept_fraction = 0;  // the thesis's rule alone removes every trunk
+  EXPECT_EQ(ua::subsample(pts, o).count_after_segments, 0);
+}

@@ -32,9 +32,20 @@ SubsamplingResult subsample(const PointSet& points, int raw_count, const Subsamp
     i = j;
   }
   // 3. small-segment removal.
+  int min_size = std::max(1, options.min_segment_points);
+  auto keptWith = [&](int m) {
+    size_t kept = 0;
+    for (const auto& [b, e] : segments)
+      if (static_cast<int>(e - b) >= m) kept += e - b;
+    return kept;
+  };
+  while (min_size > 2 && static_cast<double>(keptWith(min_size)) <
+                             options.min_kept_fraction * static_cast<double>(in_range.size()))
+    --min_size;
+  out.min_segment_points_used = min_size;
   int id = 0;
   for (const auto& [b, e] : segments) {
-    if (static_cast<int>(e - b) < options.min_segment_points) continue;
+    if (static_cast<int>(e - b) < min_size) continue;
     for (size_t k = b; k < e; ++k) {
       out.segmented.push_back(in_range[k]);
       out.segment.push_back(id);

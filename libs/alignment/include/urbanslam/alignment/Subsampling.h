@@ -16,6 +16,10 @@ struct SubsamplingOptions {
   double max_range_m = 0;          // step 1; 0 = keep what the scan model's r_max gate let through
   double segment_gap_m = 0.5;      // step 2; consecutive points farther apart start a new segment
   int min_segment_points = 5;      // step 3
+  // Step 3 is meant to drop clutter, not the scene: where it would keep less than this fraction
+  // of the points (an outdoor scan of tree trunks, 2-4 returns each) the minimum size is lowered
+  // step by step, down to 2, until it keeps that much.
+  double min_kept_fraction = 0.75;
   int target_points = 100;         // step 4
   double decimation_slack = 0.5;   // step 4 runs when remaining > target * (1 + slack)
 };
@@ -30,6 +34,7 @@ struct SubsamplingResult {
   // after decimation}.
   int count_input = 0, count_after_range = 0, count_after_segments = 0, count_after_decimation = 0;
   int decimation_step = 1;
+  int min_segment_points_used = 0;  // step 3's minimum after the min_kept_fraction rule
 };
 
 SubsamplingResult subsample(const PointSet& points, const SubsamplingOptions& options);
