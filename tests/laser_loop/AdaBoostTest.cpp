@@ -153,3 +153,30 @@ TEST(StrongClassifier, FactorTradesDetectionForFalseAlarm) {
   EXPECT_EQ(s.prefix(1).size(), 1u);
   EXPECT_DOUBLE_EQ(s.prefix(1).score(a, b), 1.0);
 }
+
+// score() uses sorted thresholds and α sums per feature; it must equal the plain vote of 3.30.
+TEST(StrongClassifier, FastScoreEqualsPlainVote) {
+  std::mt19937 rng(9);
+  std::uniform_int_distribution<int> feat(0, kFeatureCount - 1);
+  std::uniform_real_distribution<double> u(0, 2);
+  std::vector<WeightedStump> stumps;
+  for (int t = 0; t < 120; ++t) {
+    // A few thresholds repeat exactly, to exercise ties with c.
+    const double thr = t % 10 == 0 ? 1.0 : u(rng);
+    stumps.push_back({{feat(rng), thr, rng() % 2 ? 1 : -1}, u(rng)});
+  }
+  const StrongClassifier s(stumps);
+  for (int k = 0; k < 500; ++k) {
+    FeatureVector a{}, b{};
+    for (int f = 0; f < kFeatureCount; ++f) {
+      a[f] = u(rng);
+      b[f] = k % 7 == 0 ? a[f] + 1.0 : u(rng);  // c exactly at the repeated threshold
+    }
+    double vote = 0, total = 0;
+    for (const auto& w : stumps) {
+      total += w.alpha;
+      if (w.stump.match(a, b)) vote += w.alpha;
+    }
+    EXPECT_NEAR(s.score(a, b), vote / total, 1e-12) << k;
+  }
+}

@@ -6,9 +6,38 @@
 namespace urbanslam::laser_loop {
 
 StrongClassifier::StrongClassifier(std::vector<WeightedStump> stumps) : stumps_(std::move(stumps)) {
+  std::vector<int> slot(kFeatureCount, -1);
+  std::vector<std::vector<std::pair<double, double>>> plus, minus;  // (threshold, α) per feature
   for (const auto& s : stumps_) {
-    compiled_.push_back({s.stump.feature, static_cast<double>(s.stump.polarity), s.stump.threshold, s.alpha});
     alpha_total_ += s.alpha;
+    int& k = slot[s.stump.feature];
+    if (k < 0) {
+      k = static_cast<int>(votes_.size());
+      votes_.push_back({});
+      votes_.back().feature = s.stump.feature;
+      plus.emplace_back();
+      minus.emplace_back();
+    }
+    (s.stump.polarity > 0 ? plus : minus)[static_cast<size_t>(k)].emplace_back(s.stump.threshold, s.alpha);
+  }
+  for (size_t k = 0; k < votes_.size(); ++k) {
+    auto& v = votes_[k];
+    std::sort(plus[k].begin(), plus[k].end());
+    std::sort(minus[k].begin(), minus[k].end());
+    v.plus_begin = static_cast<uint32_t>(thr_.size());
+    v.plus_count = static_cast<uint32_t>(plus[k].size());
+    for (const auto& [t, a] : plus[k]) thr_.push_back(t);
+    v.minus_begin = static_cast<uint32_t>(thr_.size());
+    v.minus_count = static_cast<uint32_t>(minus[k].size());
+    for (const auto& [t, a] : minus[k]) thr_.push_back(t);
+    v.plus_alpha = static_cast<uint32_t>(alpha_.size());
+    std::vector<double> above(plus[k].size() + 1, 0.0);
+    for (size_t i = plus[k].size(); i-- > 0;) above[i] = above[i + 1] + plus[k][i].second;
+    alpha_.insert(alpha_.end(), above.begin(), above.end());
+    v.minus_alpha = static_cast<uint32_t>(alpha_.size());
+    std::vector<double> below(minus[k].size() + 1, 0.0);
+    for (size_t i = 0; i < minus[k].size(); ++i) below[i + 1] = below[i] + minus[k][i].second;
+    alpha_.insert(alpha_.end(), below.begin(), below.end());
   }
 }
 
@@ -17,24 +46,20 @@ StrongClassifier StrongClassifier::prefix(size_t T) const {
 }
 
 double StrongClassifier::score(const FeatureVector& a, const FeatureVector& b) const {
-  // polarity · (threshold − c) > 0  ⇔  c < threshold (+1) or c > threshold (−1), as Stump::match.
-  auto vote_of = [&](const Compiled& s) {
-    const double c = std::fabs(a[s.feature] - b[s.feature]);
-    return (s.signed_threshold_sign * (s.threshold - c) > 0) ? s.alpha : 0.0;
-  };
-  // Four independent sums so the additions do not wait on each other (the sum of 50 votes is
-  // otherwise one long latency chain).
-  double v0 = 0, v1 = 0, v2 = 0, v3 = 0;
-  const size_t n = compiled_.size();
-  size_t i = 0;
-  for (; i + 4 <= n; i += 4) {
-    v0 += vote_of(compiled_[i]);
-    v1 += vote_of(compiled_[i + 1]);
-    v2 += vote_of(compiled_[i + 2]);
-    v3 += vote_of(compiled_[i + 3]);
+  double vote = 0;
+  const double* thr = thr_.data();
+  const double* alpha = alpha_.data();
+  for (const auto& v : votes_) {
+    const double c = std::fabs(a[v.feature] - b[v.feature]);
+    // +1 stumps vote when c < threshold: all but the first i, i = #thresholds <= c.
+    uint32_t i = 0;
+    for (uint32_t k = 0; k < v.plus_count; ++k) i += thr[v.plus_begin + k] <= c;
+    // −1 stumps vote when c > threshold: the first j, j = #thresholds < c.
+    uint32_t j = 0;
+    for (uint32_t k = 0; k < v.minus_count; ++k) j += thr[v.minus_begin + k] < c;
+    vote += alpha[v.plus_alpha + i] + alpha[v.minus_alpha + j];
   }
-  for (; i < n; ++i) v0 += vote_of(compiled_[i]);
-  return alpha_total_ > 0 ? ((v0 + v1) + (v2 + v3)) / alpha_total_ : 0.0;
+  return alpha_total_ > 0 ? vote / alpha_total_ : 0.0;
 }
 
 }  // namespace urbanslam::laser_loop

@@ -7,6 +7,7 @@
 // (The extracted thesis text shows "≤" in 3.30; with c_t = 1 meaning "match", as eq. 3.28 |c − y|
 // requires, only "≥" makes a vote of matching stumps a match — the form of Freund & Schapire and
 // Viola & Jones that Algorithm 1 follows.)
+#include <cstdint>
 #include <vector>
 
 #include "urbanslam/laser_loop/WeakClassifier.h"
@@ -35,16 +36,21 @@ class StrongClassifier {
   }
 
  private:
-  // Compact branch-free form for score(): stump outcomes are data-dependent coin flips to the
-  // branch predictor, so each vote is computed as arithmetic instead.
-  struct Compiled {
-    int feature;
-    double signed_threshold_sign;  // polarity
-    double threshold;
-    double alpha;
+  // score() form: per feature used, its stumps' thresholds sorted, with the α sums of the stumps
+  // that vote "match" above (polarity +1) or below (polarity −1) each cut. A vote is then one
+  // |Δf| and a branch-free count of thresholds per feature (stump outcomes are coin flips to a
+  // branch predictor), with everything in flat arrays.
+  struct FeatureVotes {
+    int feature = 0;
+    uint32_t plus_begin = 0, plus_count = 0;    // into thr_; alpha_ has plus_count + 1 entries
+    uint32_t minus_begin = 0, minus_count = 0;  // into thr_; alpha_ has minus_count + 1 entries
+    uint32_t plus_alpha = 0, minus_alpha = 0;   // into alpha_
   };
   std::vector<WeightedStump> stumps_;
-  std::vector<Compiled> compiled_;
+  std::vector<FeatureVotes> votes_;
+  std::vector<double> thr_;    // sorted ascending within each run
+  std::vector<double> alpha_;  // +1: α of stumps with threshold > c, indexed by #thresholds <= c
+                               // −1: α of stumps with threshold < c, indexed by #thresholds < c
   double alpha_total_ = 0;
 };
 
