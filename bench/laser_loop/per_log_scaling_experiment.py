@@ -10,7 +10,7 @@
 #   for f in intel aces csail freiburg-campus fhw; do build-laser/apps/urbanslam/urbanslam \
 #     eval-laser-loop share/laser_loop/default.model \
 #     ../shared/data/freiburg_slam_benchmark/corrected_logs/$f-corrected.log.gz --quiet --out /tmp/ll/feat-$f; done
-#   bench/laser_loop/per_log_scaling_experiment.py intel,aces,csail freiburg-campus
+#   bench/laser_loop/per_log_scaling_experiment.py intel,aces,csail freiburg-campus [30]
 import csv, math, random, sys, bisect
 def load(name):
     rows=list(csv.DictReader(open(f'/tmp/ll/feat-{name}/features.csv')))
@@ -18,10 +18,10 @@ def load(name):
     F=[[float(r[k]) for k in keys] for r in rows]
     P=[(float(r['x']),float(r['y']),float(r['phi'])) for r in rows]
     return F,P
-def pairs(P, rng, nneg_per=1, maxpos=3000, dpos=1, dneg=3, travel=10):
+def pairs(P, rng, nneg_per=1, maxpos=3000, dpos=1, dneg=3, travel=10, maxh=math.pi):
     path=[0]
     for i in range(1,len(P)): path.append(path[-1]+math.hypot(P[i][0]-P[i-1][0],P[i][1]-P[i-1][1]))
-    pos=[(i,j,1) for i in range(len(P)) for j in range(i+1,len(P)) if math.hypot(P[i][0]-P[j][0],P[i][1]-P[j][1])<=dpos and path[j]-path[i]>=travel]
+    pos=[(i,j,1) for i in range(len(P)) for j in range(i+1,len(P)) if math.hypot(P[i][0]-P[j][0],P[i][1]-P[j][1])<=dpos and path[j]-path[i]>=travel and abs((P[i][2]-P[j][2]+math.pi)%(2*math.pi)-math.pi)<=maxh]
     rng.shuffle(pos); pos=pos[:maxpos]
     neg=set()
     want=max(int(nneg_per*len(pos)), 0)
@@ -73,10 +73,12 @@ def det_at(ps,ns,fa):
     return sum(1 for s in ps if s>bar)/len(ps)
 rng=random.Random(1)
 train=sys.argv[1].split(','); test=sys.argv[2].split(',')
+# Optional third argument: heading limit (degrees) for the training positives; tests use any heading.
+maxh=math.radians(float(sys.argv[3])) if len(sys.argv)>3 else math.pi
 for on in (False, True):
     X=[];y=[]
     for nme in train:
-        F,P=load(nme); F=scale(F,on); prs=pairs(P,rng); a,b=table(F,prs); X+=a; y+=b
+        F,P=load(nme); F=scale(F,on); prs=pairs(P,rng,maxh=maxh); a,b=table(F,prs); X+=a; y+=b
     H=adaboost(X,y,60)
     ps=[];ns=[];nps=[];nns=[]
     for nme in test:
