@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 
 #include <Eigen/LU>
 
@@ -226,4 +227,40 @@ TEST(Aligner, ParseMethodNames) {
   for (auto m : {ua::Method::Icp, ua::Method::PlIcp, ua::Method::Crf, ua::Method::CrfIcp})
     EXPECT_EQ(ua::parseMethod(ua::methodName(m)), m);
   EXPECT_THROW(ua::parseMethod("ndt"), std::invalid_argument);
+}
+
+// Hostile input: random lengths (0-400 beams), NaN / inf / negative / huge ranges, zero or
+// negative beam spacing, valid flags of the wrong length. Every method must return finite
+// numbers and never crash.
+TEST(Aligner, RandomGarbageNeverCrashes) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  const float specials[] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
+                            -1.0f, 0.0f, 1e30f, 80.0f};
+  auto randomScan = [&]() {
+    urbanslam::io::LaserScan s;
+    const int n = static_cast<int>(u(rng) * 400);
+    s.angle_min_rad = -M_PI / 2;
+    s.angle_increment_rad = u(rng) < 0.2 ? (u(rng) < 0.5 ? 0.0 : -0.01) : M_PI / std::max(1, n);
+    s.max_range_m = u(rng) < 0.1 ? 0.0 : 30.0;
+    for (int i = 0; i < n; ++i) {
+      s.ranges.push_back(u(rng) < 0.2 ? specials[static_cast<int>(u(rng) * 6)] : static_cast<float>(u(rng) * 20));
+      s.valid.push_back(u(rng) < 0.9);
+    }
+    if (u(rng) < 0.1) s.valid.resize(s.valid.size() / 2);
+    return s;
+  };
+  for (int k = 0; k < 40; ++k) {
+    const auto a = randomScan(), b = randomScan();
+    for (auto m : {ua::Method::Icp, ua::Method::PlIcp, ua::Method::Crf, ua::Method::CrfIcp}) {
+      ua::AlignerOptions o;
+      o.method = m;
+      const auto r = ua::align(a, b, {u(rng), u(rng), u(rng)}, o);
+      ASSERT_TRUE(std::isfinite(r.transform.x) && std::isfinite(r.transform.y) && std::isfinite(r.transform.phi));
+      ASSERT_TRUE(r.cov.allFinite());
+      if (!r.converged) {
+        EXPECT_FALSE(r.failure_reason.empty());
+      }
+    }
+  }
 }
