@@ -38,14 +38,17 @@ void parallelChunks(size_t n, int threads, Fn fn) {
   for (auto& th : pool) th.join();
 }
 
-// Distance used by seeding: 1 − cos for SIFT (∝ squared chord length between unit vectors),
-// Hamming bits for ORB.
+// Squared distance D² used by k-means++ seeding: for SIFT the squared chord between the unit
+// directions, 2(1 − cos) (the angle metric's Euclidean form), for ORB the squared Hamming distance.
 struct Metric {
   DescriptorType type;
   int bytes;
-  double distance(const uint8_t* x, float inv_x, const uint8_t* c, float inv_c) const {
-    if (type == DescriptorType::Orb) return hammingDistance(x, c, bytes);
-    return std::max(0.0, 1.0 - double(dotProduct(x, c, bytes)) * inv_x * inv_c);
+  double squaredDistance(const uint8_t* x, float inv_x, const uint8_t* c, float inv_c) const {
+    if (type == DescriptorType::Orb) {
+      const double h = hammingDistance(x, c, bytes);
+      return h * h;
+    }
+    return std::max(0.0, 2.0 * (1.0 - double(dotProduct(x, c, bytes)) * inv_x * inv_c));
   }
 };
 
@@ -84,8 +87,8 @@ KMeansResult kmeans(const DescriptorSet& set, const std::vector<uint32_t>& point
     const uint8_t* cp = centres.data() + c * bytes;
     parallelChunks(n, threads, [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) {
-        const double d = metric.distance(set.row(points[i]), inv_x[i], cp, inv_c[c]);
-        d2[i] = first ? d * d : std::min(d2[i], d * d);
+        const double d = metric.squaredDistance(set.row(points[i]), inv_x[i], cp, inv_c[c]);
+        d2[i] = first ? d : std::min(d2[i], d);
       }
     });
   };
