@@ -12,7 +12,8 @@
 //     recovery of the 50 most recent poses, and the joint covariance of a pair 20 poses after
 //     that factorisation: exact (refactorise + column solves) / conservative (old factor + dead
 //     reckoning, no refactorisation).
-// Usage: esdf_bench [--no-full-above N] [--ordering amd|metis|auto|natural] [--backend N]... SIZE...
+// Usage: esdf_bench [--no-full-above N] [--ordering amd|metis|auto|natural] [--backend N]...
+//                   [--final-passes P] SIZE...
 //   (default sizes 1000 10000 100000 1000000; each --backend N also runs the pose-graph back end,
 //   with its recovery policy, on the same drive of N poses)
 #include <Eigen/Core>
@@ -174,6 +175,8 @@ esdf::PoseGraph cityGraph(long n) {
   return graph;
 }
 
+int g_final_passes = -1;
+
 void runBackend(const std::vector<long>& sizes) {
   std::printf("\nback end (urbanslam graph's policy: partial recovery after closures, amortised full recoveries,\n"
               "relinearisation; the last recovery iterates to convergence):\n");
@@ -181,7 +184,9 @@ void runBackend(const std::vector<long>& sizes) {
               "full", "partial", "time_s", "recov_s", "chi2", "");
   for (long n : sizes) {
     const esdf::PoseGraph graph = cityGraph(n);
-    const auto r = esdf::runPoseGraphBackend(graph);
+    esdf::PoseGraphBackendOptions o;
+    if (g_final_passes >= 0) o.filter.relinearise_max_passes = g_final_passes;
+    const auto r = esdf::runPoseGraphBackend(graph, o);
     std::printf("%9ld %8d | %9.4f %9.4f %9.1f | %8d %8d | %9.3f %9.3f | %12.3f %s\n", n, r.edges,
                 common::percentile(r.step_ms, 50), common::percentile(r.step_ms, 99), common::percentile(r.step_ms, 100),
                 r.full_recoveries, r.partial_recoveries, r.time_s, r.recovery_s, r.chi2,
@@ -198,6 +203,7 @@ int main(int argc, char** argv) {
   for (int a = 1; a < argc; ++a) {
     if (!std::strcmp(argv[a], "--no-full-above") && a + 1 < argc) no_full_above = std::atol(argv[++a]);
     else if (!std::strcmp(argv[a], "--backend") && a + 1 < argc) backend_sizes.push_back(std::atol(argv[++a]));
+    else if (!std::strcmp(argv[a], "--final-passes") && a + 1 < argc) g_final_passes = std::atoi(argv[++a]);
     else if (!std::strcmp(argv[a], "--ordering") && a + 1 < argc) {
       const std::string o = argv[++a];
       g_ordering = o == "metis" ? esdf::FillReducingOrdering::Metis
