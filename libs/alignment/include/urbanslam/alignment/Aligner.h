@@ -4,7 +4,9 @@
 // pose_B)), with its covariance, starting from a guess in the same convention.
 //
 // Methods: "icp" (point-to-point, thesis §3.3.1), "plicp" (point-to-line), "crf" (CRF-match,
-// §3.3.2) and "crf+icp" (CRF-match for the coarse alignment, ICP to refine, as in the thesis).
+// §3.3.2) and "crf+icp" (CRF-match for the coarse alignment, ICP to refine, as in the thesis;
+// the refinement also runs from CRF-match's other hypotheses and from the guess, and the one
+// that matches most points wins).
 // Failures (too few points, NaN input, no agreement, degenerate geometry such as a corridor) come
 // back with converged = false and a failure_reason; the transform is then the best available
 // estimate (the guess when nothing could be computed) and must not be used as a measurement.

@@ -19,7 +19,9 @@ struct ScanPoint {
   int beam = 0;                                     // index of the beam in the original sweep
 };
 
-// Points in increasing beam order (the order of the sweep).
+// Points in increasing beam order (the order of the sweep). A concatenation of several scans
+// (a local submap) still works for ICP / PL-ICP and the covariance: line pieces and segments
+// break where consecutive points jump; CRF-match's features assume a single sweep.
 using PointSet = std::vector<ScanPoint>;
 
 // The rigid transform as a rotation + translation; conversions to and from Pose2.
