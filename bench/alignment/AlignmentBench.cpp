@@ -246,6 +246,7 @@ int main(int argc, char** argv) {
     else if (key == "candidates_per_point") c.candidates_per_point = static_cast<int>(v);
     else if (key == "tangent_radius_m") c.tangent_radius_m = v;
     else if (key == "min_marginal") c.min_marginal = v;
+    else if (key == "guess_sigma_m") c.guess_sigma_m = v;
     else {
       std::cerr << "--crf: unknown key " << key << "\n";
       return 2;
