@@ -2,6 +2,7 @@
 #include <wx/app.h>
 #include <wx/image.h>
 
+#include <cstdlib>
 #include <cstring>
 #include <iostream>
 
@@ -16,7 +17,8 @@ constexpr const char* kUsage =
     "  --ini FILE          configuration (default: ini/default.ini)\n"
     "  --autorun           start processing at once\n"
     "  --screenshot FILE   with --exit-when-done: save the final view as PNG\n"
-    "  --exit-when-done    quit when the log is processed; prints one JSON line with what was drawn\n";
+    "  --exit-when-done    quit when the log is processed; prints one JSON line with what was drawn\n"
+    "  --snapshot-at N:FILE  save the view as PNG once N keyframes are drawn (the run goes on)\n";
 
 class GuiApp : public wxApp {
  public:
@@ -28,6 +30,7 @@ class GuiApp : public wxApp {
       return std::string(h && *h ? h : URBANSLAM_SOURCE_DIR);
     }();
     o.ini = home + "/ini/default.ini";
+    o.home = home;
     for (int i = 1; i < argc; ++i) {
       const std::string a = argv[i].ToStdString();
       const auto value = [&]() -> std::string {
@@ -43,6 +46,18 @@ class GuiApp : public wxApp {
       } else if (a == "--ini") o.ini = value();
       else if (a == "--screenshot") o.screenshot = value();
       else if (a == "--autorun") o.autorun = true;
+      else if (a == "--snapshot-at") {
+        const std::string v = value();
+        const auto colon = v.find(':');
+        char* end = nullptr;
+        const unsigned long n = colon == std::string::npos ? 0 : std::strtoul(v.c_str(), &end, 10);
+        if (colon == std::string::npos || n == 0 || end != v.c_str() + colon) {
+          std::cerr << "urbanslam-gui: error: --snapshot-at expects N:FILE, got '" << v << "'\n";
+          std::exit(2);
+        }
+        o.snapshot_at_keyframes = n;
+        o.snapshot_path = v.substr(colon + 1);
+      }
       else if (a == "--exit-when-done") o.exit_when_done = true;
       else if (a.rfind("--", 0) == 0) {
         std::cerr << "urbanslam-gui: error: unknown option " << a << " (see --help)\n";

@@ -269,7 +269,7 @@ void MainFrame::showError(const std::string& message) {
 
 bool MainFrame::openLog(const std::string& path) {
   try {
-    auto worker = std::make_unique<PipelineWorker>(path, options_.ini);
+    auto worker = std::make_unique<PipelineWorker>(path, options_.ini, options_.home + "/share/laser_loop/default.model");
     worker_.reset();  // the previous run's thread ends first
     worker_ = std::move(worker);
   } catch (const std::exception& e) {
@@ -280,6 +280,7 @@ bool MainFrame::openLog(const std::string& path) {
   history_.AddFileToHistory(path);
   drawn_version_ = static_cast<size_t>(-1);
   auto_finished_ = false;
+  snapshot_taken_ = false;
   if (options_.autorun) worker_->play();
   updateTitle();
   return true;
@@ -330,12 +331,20 @@ void MainFrame::refreshView(bool force) {
   closures_->update(last_snapshot_);
   camera_->update(last_snapshot_);
   SetStatusText(wxString::Format("%zu keyframes, %.0f %%%s", last_snapshot_.stats.keyframes,
-                                 100 * last_snapshot_.stats.progress, last_snapshot_.finished ? " — finished" : ""), 0);
+                                 100 * last_snapshot_.stats.progress, last_snapshot_.finished ? " - finished" : ""), 0);
 }
 
 void MainFrame::onTimer(wxTimerEvent&) {
   refreshView(false);
   if (!worker_) return;
+  // --snapshot-at N:FILE: a picture of the view mid-run (the run goes on).
+  if (!snapshot_taken_ && options_.snapshot_at_keyframes > 0 && last_snapshot_.keyframes.size() >= options_.snapshot_at_keyframes) {
+    snapshot_taken_ = true;
+    canvas_->fitToMap();
+    canvas_->requestScreenshot(options_.snapshot_path, [this](bool ok) {
+      if (!ok) std::cerr << "urbanslam-gui: error: " << options_.snapshot_path << ": cannot write\n";
+    });
+  }
   const std::string err = worker_->error();
   if (!err.empty() && !auto_finished_) {
     auto_finished_ = true;

@@ -21,9 +21,12 @@ inline int g_exit_code = 0;
 
 struct GuiOptions {
   std::string log, ini;
+  std::string home;  // the project folder (shipped rawlogs, ini, share/)
   bool autorun = false;
   bool exit_when_done = false;
   std::string screenshot;
+  size_t snapshot_at_keyframes = 0;  // also save `snapshot_path` once this many keyframes are drawn
+  std::string snapshot_path;
 };
 
 class MainFrame : public wxFrame {
@@ -61,6 +64,7 @@ class MainFrame : public wxFrame {
   size_t drawn_version_ = static_cast<size_t>(-1);
   MapSnapshot last_snapshot_;
   bool auto_finished_ = false;
+  bool snapshot_taken_ = false;
 };
 
 }  // namespace urbanslam::gui

@@ -93,6 +93,8 @@ void MapCanvas::setDrawList(const DrawList& d) {
     fitted_once_ = true;
   }
   Refresh(false);
+  // Paint now: GTK delivers paint events only when idle, and a busy timer would starve them.
+  Update();
 }
 
 void MapCanvas::fitToMap() {
@@ -120,6 +122,7 @@ void MapCanvas::requestScreenshot(const std::string& path, std::function<void(bo
   screenshot_path_ = path;
   screenshot_done_ = std::move(done);
   Refresh(false);
+  Update();
 }
 
 void MapCanvas::OnPostRender() {

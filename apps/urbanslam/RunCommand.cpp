@@ -46,7 +46,9 @@ int runCommand(const Argv& args) {
   const std::string ini = ap.has("ini") ? ap.option("ini") : defaultIni();
   const bool quiet = ap.flag("quiet");
   std::string resolved;
-  const slam::PipelineOptions options = slam::loadPipelineOptions(ini, &resolved);
+  slam::PipelineOptions options = slam::loadPipelineOptions(ini, &resolved);
+  if (options.loop_closure.laser_model.empty())
+    options.loop_closure.laser_model = projectHome() + "/share/laser_loop/default.model";
 
   auto source = io::openDataSource(log);
   slam::Pipeline pipeline(options);

@@ -18,7 +18,8 @@ namespace urbanslam::gui {
 class PipelineWorker {
  public:
   // Opens the log and the ini; throws common::InputError with the CLI's message on bad input.
-  PipelineWorker(const std::string& log_path, const std::string& ini_path);
+  // `default_laser_model`: the classifier used when the ini names none ([loop_closure] laser_model).
+  PipelineWorker(const std::string& log_path, const std::string& ini_path, const std::string& default_laser_model = "");
   ~PipelineWorker();
 
   void play();
@@ -43,7 +44,7 @@ class PipelineWorker {
  private:
   void loop();
 
-  std::string log_path_, ini_path_, resolved_ini_, format_;
+  std::string log_path_, ini_path_, resolved_ini_, format_, default_laser_model_;
   std::unique_ptr<io::DataSource> source_;
   std::unique_ptr<slam::Pipeline> pipeline_;
   SnapshotCollector collector_;

@@ -84,7 +84,8 @@ std::vector<size_t> LoopCloser::candidates(esdf::Esdf& filter, const std::vector
   return out;
 }
 
-LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current) {
+LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current,
+                                       bool commit) {
   LoopClosureRecord r;
   r.from = earlier;
   r.to = current;
@@ -139,11 +140,16 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
   // Innovation gate, then the information-form update.
   const esdf::Mat3 cov = options_.covariance_scale * a.cov;
   r.information = cov.inverse();
-  const auto res = filter.observeRelative(static_cast<int>(earlier), static_cast<int>(current), esdf::toVec(a.transform),
-                                          r.information, true);
-  r.mahalanobis2 = res.gate.mahalanobis2;
-  r.gate_threshold = res.gate.threshold;
-  r.accepted = res.accepted;
+  esdf::GateResult gate;
+  if (commit) {
+    gate = filter.observeRelative(static_cast<int>(earlier), static_cast<int>(current), esdf::toVec(a.transform),
+                                  r.information, true).gate;
+  } else {
+    gate = filter.gateRelative(static_cast<int>(earlier), static_cast<int>(current), esdf::toVec(a.transform), r.information);
+  }
+  r.mahalanobis2 = gate.mahalanobis2;
+  r.gate_threshold = gate.threshold;
+  r.accepted = gate.accepted;
   if (!r.accepted) r.reason = "gating";
   return r;
 }

@@ -10,6 +10,7 @@
 #include "urbanslam/common/Timing.h"
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/esdf/PoseOps.h"
+#include "urbanslam/laser_loop/LoopDetector.h"
 
 namespace urbanslam::slam {
 
@@ -32,6 +33,18 @@ Pipeline::Pipeline(PipelineOptions options)
   eo.chi2_gate_probability = options_.loop_closure.chi2_gate_probability;
   eo.gate_covariance = esdf::CovarianceMode::Exact;
   esdf_ = std::make_unique<esdf::Esdf>(eo);
+  if (options_.loop_closure.enabled && options_.loop_closure.detector == "laser") {
+    // The AdaBoost classifier screens candidates before the (costlier) alignment. Its score is
+    // the margin above the model's decision factor (eq. 3.30), so laser_threshold = 0 is the
+    // model's own operating point.
+    const std::string model = options_.loop_closure.laser_model.empty() ? laser_loop::kDefaultModelPath : options_.loop_closure.laser_model;
+    laser_detector_ = std::make_unique<laser_loop::LoopDetector>(laser_loop::LoopDetector::fromFile(model));
+    closer_.setScorer(
+        [this](size_t earlier, size_t current) {
+          return laser_detector_->score(laser_detector_->keyframe(current), earlier) - laser_detector_->factor();
+        },
+        "laser");
+  }
 }
 
 Pipeline::~Pipeline() = default;
@@ -108,6 +121,12 @@ void Pipeline::run(io::DataSource& source) {
 }
 
 void Pipeline::finish() {
+  for (LoopClosureRecord r : pending_) {  // hypotheses still waiting for a confirmation
+    r.reason = "unconfirmed";
+    r.accepted = false;
+    reportClosure(r);
+  }
+  pending_.clear();
   if (dirty_since_recovery_) {
     common::Stopwatch sw;
     recoverAll();
@@ -176,6 +195,12 @@ void Pipeline::addKeyframe(io::LaserScan scan) {
   // Odometry readings taken at this scan's time belong to the new keyframe: the trajectory at
   // the scan time is the keyframe's estimate, not the odometry prediction from the last one.
   for (auto it = odometry_.rbegin(); it != odometry_.rend() && it->timestamp == kf.timestamp; ++it) it->keyframe = k;
+  if (options_.local.scan_matching) {
+    alignment::AlignerOptions ao;
+    recent_sets_.push_back(alignment::pointSetFromScan(kf.scan, ao.scan, ao.in_vehicle_frame));
+    while (recent_sets_.size() > static_cast<size_t>(options_.local.submap_keyframes)) recent_sets_.pop_front();
+  }
+  if (laser_detector_) laser_detector_->addKeyframe(kf.scan);  // features once per keyframe
   keyframes_.push_back(std::move(kf));
   keyframe_odom_.push_back(motion_.odometryPose());
   motion_.reset();
@@ -195,7 +220,16 @@ void Pipeline::addKeyframe(io::LaserScan scan) {
 void Pipeline::localScanMatching(const io::LaserScan& scan, common::Pose2& z, Eigen::Matrix3d& cov) {
   alignment::AlignerOptions ao;
   ao.method = alignment::parseMethod(options_.local.method);
-  const auto a = alignment::align(keyframes_.back().scan, scan, z, ao);
+  // Reference: the points of the last few keyframes in the frame of the last one (a local
+  // submap, as KISS-ICP and Cartographer match against), so one poor scan does not make the
+  // odometry jump and the drift between keyframes shrinks.
+  alignment::PointSet reference;
+  const size_t n = keyframes_.size(), first = n - std::min(n, recent_sets_.size());
+  for (size_t i = first; i < n; ++i) {
+    const auto t = alignment::transformed(recent_sets_[i - first], common::between(keyframes_.back().pose, keyframes_[i].pose));
+    reference.insert(reference.end(), t.begin(), t.end());
+  }
+  const auto a = alignment::alignPointSets(reference, alignment::pointSetFromScan(scan, ao.scan, ao.in_vehicle_frame), z, ao);
   const common::Pose2 correction = common::between(z, a.transform);
   if (!a.converged || std::hypot(correction.x, correction.y) > options_.local.max_correction_m ||
       std::abs(correction.phi) > options_.local.max_correction_deg * kDeg) {
@@ -211,27 +245,81 @@ void Pipeline::localScanMatching(const io::LaserScan& scan, common::Pose2& z, Ei
   cov(2, 2) = std::max(cov(2, 2), sphi * sphi);
 }
 
+void Pipeline::reportClosure(const LoopClosureRecord& r) {
+  ++(r.accepted ? stats_.closures_accepted : stats_.closures_rejected);
+  closures_.push_back(r);
+  const LoopClosureEvent e{r.from, r.to, r.to_time, r.detector, r.score, r.accepted, r.reason};
+  for (auto* o : observers_) o->onLoopClosure(e);
+}
+
+// Two closures confirm each other when the first, carried along the trajectory, predicts the
+// second: between(x_j, x_i) ⊕ z_ik ⊕ between(x_k, x_m) ≈ z_jm. A wrong match in a symmetric
+// building rarely repeats consistently at the next keyframe; a true one does.
+bool Pipeline::consistent(const LoopClosureRecord& a, const LoopClosureRecord& b) const {
+  const auto& kf = keyframes_;
+  const common::Pose2 predicted =
+      common::compose(common::compose(common::between(kf[b.from].pose, kf[a.from].pose), a.measurement),
+                      common::between(kf[a.to].pose, kf[b.to].pose));
+  const common::Pose2 d = common::between(predicted, b.measurement);
+  return std::hypot(d.x, d.y) <= options_.loop_closure.confirm_tolerance_m &&
+         std::abs(d.phi) <= options_.loop_closure.confirm_tolerance_deg * kDeg;
+}
+
 void Pipeline::searchLoopClosures(size_t current) {
   common::Stopwatch sw;
+  const size_t window = static_cast<size_t>(options_.loop_closure.confirm_window);
+  // Hypotheses that waited too long for a confirmation are dropped.
+  while (!pending_.empty() && current - pending_.front().to > window) {
+    LoopClosureRecord r = pending_.front();
+    pending_.pop_front();
+    r.accepted = false;
+    r.reason = "unconfirmed";
+    reportClosure(r);
+  }
   // 6. Candidates: initial set near the estimate, final set by Mahalanobis distance.
   std::vector<size_t> cands = closer_.candidates(*esdf_, keyframes_, current);
   if (cands.size() > static_cast<size_t>(options_.loop_closure.max_candidates))
     cands.resize(static_cast<size_t>(options_.loop_closure.max_candidates));
   for (auto* o : observers_) o->onCandidates({current, &cands});
+  const bool confirm = window > 0;
   bool accepted = false;
   for (size_t i : cands) {
-    // 7-9. Detection, alignment, gating and the ESDF update.
-    LoopClosureRecord r = closer_.tryClose(*esdf_, keyframes_, i, current);
+    // 7-9. Detection, alignment and gating (the update itself waits for a confirmation).
+    LoopClosureRecord r = closer_.tryClose(*esdf_, keyframes_, i, current, !confirm);
     ++stats_.closures_tried;
-    ++(r.accepted ? stats_.closures_accepted : stats_.closures_rejected);
-    if (r.accepted) {
-      accepted = true;
-      edges_.push_back({i, current, r.measurement, r.information, true});
+    if (!r.accepted) {
+      reportClosure(r);
+      continue;
     }
-    closures_.push_back(r);
-    LoopClosureEvent e{r.from, r.to, r.to_time, r.detector, r.score, r.accepted, r.reason};
-    for (auto* o : observers_) o->onLoopClosure(e);
-    if (accepted) break;  // one closure per keyframe; the next keyframe sees the corrected map
+    if (!confirm) {
+      edges_.push_back({i, current, r.measurement, r.information, true});
+      reportClosure(r);
+      accepted = true;
+      break;  // one closure per keyframe; the next keyframe sees the corrected map
+    }
+    // Confirmation by an earlier hypothesis that this one agrees with: both go in, gated again
+    // against the current state.
+    auto match = std::find_if(pending_.begin(), pending_.end(),
+                              [&](const LoopClosureRecord& p) { return p.to < current && consistent(p, r); });
+    if (match == pending_.end()) {
+      if (pending_.size() < 4 * window) pending_.push_back(r);
+      continue;
+    }
+    LoopClosureRecord first = *match;
+    pending_.erase(match);
+    for (LoopClosureRecord* c : {&first, &r}) {
+      const auto res = esdf_->observeRelative(static_cast<int>(c->from), static_cast<int>(c->to), esdf::toVec(c->measurement),
+                                              c->information, true);
+      c->accepted = res.accepted;
+      c->mahalanobis2 = res.gate.mahalanobis2;
+      if (!res.accepted) c->reason = "gating";
+      if (c->accepted) {
+        edges_.push_back({c->from, c->to, c->measurement, c->information, true});
+        accepted = true;
+      }
+      reportClosure(*c);
+    }
+    if (accepted) break;
   }
   // 10. Full recovery after a closure (with relinearisation), then the corrected poses.
   if (accepted) recoverAll();

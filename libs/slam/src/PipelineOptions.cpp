@@ -30,6 +30,7 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.section("local", "Local SLAM: odometry between keyframes refined by scan matching");
   s.add("scan_matching", o.local.scan_matching, "align each keyframe's scan with the previous keyframe's");
   s.add("method", o.local.method, {"icp", "plicp", "crf", "crf+icp"}, "alignment method");
+  s.add("submap_keyframes", o.local.submap_keyframes, 1, 100, "keyframes", "match against a local submap of the last this many keyframes");
   s.add("max_correction_m", o.local.max_correction_m, 0.0, 10.0, "m", "reject a scan match that moves the odometry more than this");
   s.add("max_correction_deg", o.local.max_correction_deg, 0.0, 180.0, "deg", "reject a scan match that turns the odometry more than this");
   s.add("covariance_scale", o.local.covariance_scale, 0.1, 1000.0, "", "inflation of the alignment covariance");
@@ -53,6 +54,9 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("min_matched_fraction", o.loop_closure.min_matched_fraction, 0.0, 1.0, "", "alignment accepted only with this share of points matched");
   s.add("covariance_scale", o.loop_closure.covariance_scale, 0.1, 1000.0, "", "inflation of the alignment covariance");
   s.add("chi2_gate_probability", o.loop_closure.chi2_gate_probability, 0.5, 0.9999999, "", "innovation gate (chi2, 3 dof)");
+  s.add("confirm_window", o.loop_closure.confirm_window, 0, 1000, "keyframes", "a closure is added once another within this many keyframes agrees with it; 0: at once");
+  s.add("confirm_tolerance_m", o.loop_closure.confirm_tolerance_m, 0.0, 100.0, "m", "agreement of two closures: position");
+  s.add("confirm_tolerance_deg", o.loop_closure.confirm_tolerance_deg, 0.0, 180.0, "deg", "agreement of two closures: heading");
 
   s.section("estimator", "The estimator behind the map");
   s.add("type", o.estimator.type, {"esdf", "dead_reckoning"}, "esdf: the delayed-state information filter; dead_reckoning: odometry only");

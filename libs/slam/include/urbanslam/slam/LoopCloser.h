@@ -24,7 +24,7 @@ struct LoopClosureRecord {
   std::string detector;              // "laser" or "geometric" (alignment + gating only)
   double score = 0;                  // classifier margin, or alignment matched fraction
   bool accepted = false;
-  std::string reason;                // classifier | alignment | gating (when rejected)
+  std::string reason;                // classifier | alignment | gating | unconfirmed (when rejected)
   common::Pose2 measurement;         // aligned relative pose (from -> to)
   Eigen::Matrix3d information = Eigen::Matrix3d::Identity();  // as added to the filter
   double rms_m = 0, mahalanobis2 = 0, gate_threshold = 0;
@@ -60,8 +60,10 @@ class LoopCloser {
 
   // The final candidate set for keyframe `current`, nearest (Mahalanobis) first.
   std::vector<size_t> candidates(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t current);
-  // Detection, alignment and gating of one candidate; adds an accepted closure to the filter.
-  LoopClosureRecord tryClose(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current);
+  // Detection, alignment and gating of one candidate. With `commit`, a closure that passes is
+  // added to the filter; without, it is only tested (accepted = passed) for later confirmation.
+  LoopClosureRecord tryClose(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current,
+                             bool commit = true);
 
  private:
   LoopClosureOptions options_;

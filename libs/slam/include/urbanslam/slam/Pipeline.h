@@ -5,9 +5,11 @@
 // full recovery after a closure. Observers see every step; the map is rebuilt from the current
 // keyframe estimates on demand.
 #include <Eigen/Core>
+#include <deque>
 #include <memory>
 #include <vector>
 
+#include "urbanslam/alignment/PointSet.h"
 #include "urbanslam/io/DataSource.h"
 #include "urbanslam/io/MapOutputs.h"
 #include "urbanslam/slam/LoopCloser.h"
@@ -17,6 +19,9 @@
 
 namespace urbanslam::esdf {
 class Esdf;
+}
+namespace urbanslam::laser_loop {
+class LoopDetector;
 }
 
 namespace urbanslam::slam {
@@ -87,6 +92,8 @@ class Pipeline {
   void addKeyframe(io::LaserScan scan);
   void localScanMatching(const io::LaserScan& scan, common::Pose2& z, Eigen::Matrix3d& cov);
   void searchLoopClosures(size_t current);
+  void reportClosure(const LoopClosureRecord& r);
+  bool consistent(const LoopClosureRecord& a, const LoopClosureRecord& b) const;
   void recoverAll();
   bool acceptLabel(const std::string& label) const;
   void applyRangeLimits(io::LaserScan& scan) const;
@@ -104,6 +111,9 @@ class Pipeline {
   PipelineStats stats_;
   MotionIntegrator motion_;
   std::unique_ptr<esdf::Esdf> esdf_;
+  std::unique_ptr<laser_loop::LoopDetector> laser_detector_;  // [loop_closure] detector = laser
+  std::deque<LoopClosureRecord> pending_;  // passed alignment + gate, awaiting confirmation
+  std::deque<alignment::PointSet> recent_sets_;  // point sets of the last keyframes (local submap)
   LoopCloser closer_;
   bool have_first_ts_ = false;
   bool dirty_since_recovery_ = false;
