@@ -13,7 +13,7 @@
 //     that factorisation: exact (refactorise + column solves) / conservative (old factor + dead
 //     reckoning, no refactorisation).
 // Usage: esdf_bench [--no-full-above N] [--ordering amd|metis|auto|natural] [--backend N]...
-//                   [--final-passes P] [--min-gap F] SIZE...
+//                   [--final-passes P] [--min-gap F] [--incremental-passes P] SIZE...
 //   (default sizes 1000 10000 100000 1000000; each --backend N also runs the pose-graph back end,
 //   with its recovery policy, on the same drive of N poses)
 #include <Eigen/Core>
@@ -177,6 +177,7 @@ esdf::PoseGraph cityGraph(long n) {
 
 int g_final_passes = -1;
 double g_min_gap = -1;
+int g_incremental_passes = -1;
 
 void runBackend(const std::vector<long>& sizes) {
   std::printf("\nback end (urbanslam graph's policy: partial recovery after closures, amortised full recoveries,\n"
@@ -188,6 +189,7 @@ void runBackend(const std::vector<long>& sizes) {
     esdf::PoseGraphBackendOptions o;
     if (g_final_passes >= 0) o.filter.relinearise_max_passes = g_final_passes;
     if (g_min_gap >= 0) o.full_recovery_min_gap_fraction = g_min_gap;
+    if (g_incremental_passes >= 0) o.incremental_relinearise_passes = g_incremental_passes;
     const auto r = esdf::runPoseGraphBackend(graph, o);
     std::printf("%9ld %8d | %9.4f %9.4f %9.1f | %8d %8d | %9.3f %9.3f | %12.3f %s\n", n, r.edges,
                 common::percentile(r.step_ms, 50), common::percentile(r.step_ms, 99), common::percentile(r.step_ms, 100),
@@ -207,6 +209,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[a], "--backend") && a + 1 < argc) backend_sizes.push_back(std::atol(argv[++a]));
     else if (!std::strcmp(argv[a], "--final-passes") && a + 1 < argc) g_final_passes = std::atoi(argv[++a]);
     else if (!std::strcmp(argv[a], "--min-gap") && a + 1 < argc) g_min_gap = std::atof(argv[++a]);
+    else if (!std::strcmp(argv[a], "--incremental-passes") && a + 1 < argc) g_incremental_passes = std::atoi(argv[++a]);
     else if (!std::strcmp(argv[a], "--ordering") && a + 1 < argc) {
       const std::string o = argv[++a];
       g_ordering = o == "metis" ? esdf::FillReducingOrdering::Metis
