@@ -27,7 +27,7 @@ enum Ids {
   kOpen = wxID_HIGHEST + 1, kLoadIni, kPlay, kPause, kStep, kRestart, kSpeedMax, kSpeedReal, kSpeed10, kFit, kTop, kOrbit,
   kLayerPoints, kLayerTrajectory, kLayerScan, kLayerUncertainty, kLayerAccepted, kLayerRejected, kLayerCandidates,
   kColourAge, kColourHeight, kExportPly, kExportPcd, kExportXyz, kExportTum, kExportGrid, kExportSimplemap,
-  kExportAll, kExportScreenshot
+  kExportAll, kExportScreenshot, kExportGraph
 };
 
 // Dropping a file on the window opens it (the first one).
@@ -76,6 +76,8 @@ MainFrame::MainFrame(const GuiOptions& options)
     if (const auto k = pickKeyframe(last_snapshot_, x, y, tolerance)) {
       keyframe_->show(last_snapshot_, *k);
       notebook_->SetSelection(3);
+      layers_.selected_keyframe = *k;
+      refreshView(true);
     }
   };
 
@@ -111,6 +113,7 @@ void MainFrame::buildMenus() {
   exp->Append(kExportTum, "Trajectory (TUM)...");
   exp->Append(kExportGrid, "Occupancy grid (PNG + YAML)...");
   exp->Append(kExportSimplemap, "MRPT simplemap...");
+  exp->Append(kExportGraph, "Pose graph (g2o)...");
   exp->Append(kExportScreenshot, "Screenshot of the view (PNG)...\tCtrl+P");
   file->AppendSubMenu(exp, "&Export");
   file->AppendSeparator();
@@ -219,6 +222,10 @@ void MainFrame::buildMenus() {
     exportWith("Export simplemap", "MRPT simplemap (*.simplemap)|*.simplemap", "map.simplemap",
                [](const slam::Pipeline& p, const std::string& f) { io::writeSimpleMap(f, p.posedKeyframes()); });
   }, kExportSimplemap);
+  Bind(wxEVT_MENU, [this](wxCommandEvent&) {
+    exportWith("Export pose graph", "g2o (*.g2o)|*.g2o", "pose_graph.g2o",
+               [](const slam::Pipeline& p, const std::string& f) { slam::writePoseGraphG2o(p, f); });
+  }, kExportGraph);
   Bind(wxEVT_MENU, [this](wxCommandEvent&) {
     if (!worker_) return;
     wxDirDialog dlg(this, "Export every output into a folder");

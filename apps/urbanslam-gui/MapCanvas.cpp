@@ -34,6 +34,8 @@ MapCanvas::MapCanvas(wxWindow* parent) : CWxGLCanvasBase(parent, wxID_ANY, wxDef
   points_->setPointSize(2.0f);
   scan_ = mrpt::opengl::CPointCloudColoured::Create();
   scan_->setPointSize(4.0f);
+  selected_ = mrpt::opengl::CPointCloudColoured::Create();
+  selected_->setPointSize(4.0f);
   trajectory_ = makeLines(palette::kTrajectory, 2);
   accepted_ = makeLines(palette::kClosureAccepted, 2);
   rejected_ = makeLines(palette::kClosureRejected, 1);
@@ -41,7 +43,7 @@ MapCanvas::MapCanvas(wxWindow* parent) : CWxGLCanvasBase(parent, wxID_ANY, wxDef
   robot_ = makeLines(palette::kCurrentScan, 2);
   ellipse_ = makeLines(palette::kCurrentScan, 1);
   for (const auto& o : std::initializer_list<mrpt::opengl::CRenderizable::Ptr>{
-           points_, trajectory_, rejected_, accepted_, candidates_, scan_, ellipse_, robot_})
+           points_, trajectory_, rejected_, accepted_, candidates_, scan_, selected_, ellipse_, robot_})
     scene->insert(o);
   setTopView(true);
   Bind(wxEVT_LEFT_DOWN, &MapCanvas::onLeftDown, this);
@@ -53,6 +55,8 @@ void MapCanvas::setDrawList(const DrawList& d) {
   for (const auto& p : d.map_points) points_->push_back(p.x, p.y, p.z, p.colour.r / 255.f, p.colour.g / 255.f, p.colour.b / 255.f);
   scan_->clear();
   for (const auto& p : d.current_scan) scan_->push_back(p.x, p.y, p.z, p.colour.r / 255.f, p.colour.g / 255.f, p.colour.b / 255.f);
+  selected_->clear();
+  for (const auto& p : d.selected_scan) selected_->push_back(p.x, p.y, p.z, p.colour.r / 255.f, p.colour.g / 255.f, p.colour.b / 255.f);
   const auto fill = [](mrpt::opengl::CSetOfLines& l, const std::vector<Segment>& segs, float z) {
     l.clear();
     for (const auto& s : segs) l.appendLine(s.x0, s.y0, z, s.x1, s.y1, z);

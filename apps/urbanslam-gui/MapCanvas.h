@@ -34,7 +34,7 @@ class MapCanvas : public mrpt::gui::CWxGLCanvasBase {
   void onLeftDown(wxMouseEvent& e);
   void onLeftUp(wxMouseEvent& e);
 
-  mrpt::opengl::CPointCloudColoured::Ptr points_, scan_;
+  mrpt::opengl::CPointCloudColoured::Ptr points_, scan_, selected_;
   mrpt::opengl::CSetOfLines::Ptr trajectory_, accepted_, rejected_, candidates_, robot_, ellipse_;
   Bounds bounds_;
   bool top_view_ = true;

@@ -91,6 +91,17 @@ TEST(DrawList, UncertaintyEllipseFromCovariance) {
   EXPECT_FALSE(uncertaintyEllipse({0, 0, 0}, {}));
 }
 
+TEST(DrawList, SelectedKeyframeScanIsHighlighted) {
+  Layers l;
+  l.selected_keyframe = 1;
+  const DrawList d = buildDrawList(threeKeyframes(), l);
+  ASSERT_EQ(d.selected_scan.size(), 2u);
+  EXPECT_EQ(d.selected_scan[0].colour, palette::kSelected);
+  EXPECT_NEAR(d.selected_scan[0].x, 2, 1e-6);  // keyframe 1's (1, 0) lands at (2, 1)
+  EXPECT_NEAR(d.selected_scan[0].y, 1, 1e-6);
+  EXPECT_TRUE(buildDrawList(threeKeyframes(), {}).selected_scan.empty());
+}
+
 TEST(DrawList, PickingFindsTheNearestKeyframeWithinTolerance) {
   const MapSnapshot s = threeKeyframes();
   EXPECT_EQ(pickKeyframe(s, 2.2, 2.7, 1.0), std::optional<size_t>(2));

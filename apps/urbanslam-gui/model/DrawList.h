@@ -27,6 +27,7 @@ struct Layers {
   bool closures_rejected = true;
   bool candidates = true;
   PointColouring colouring = PointColouring::KeyframeAge;
+  std::optional<size_t> selected_keyframe;  // its scan is highlighted (click to inspect)
 };
 
 struct ColouredPoint {
@@ -57,6 +58,7 @@ constexpr Rgb kClosureAccepted{60, 230, 90};
 constexpr Rgb kClosureRejected{235, 70, 200};
 constexpr Rgb kCandidate{90, 200, 255};
 constexpr Rgb kHeight{200, 200, 210};
+constexpr Rgb kSelected{255, 255, 255};
 }  // namespace palette
 
 // Colour of keyframe `i` of `n` for age colouring: old = blue, new = warm (a perceptual ramp).
@@ -66,6 +68,7 @@ struct DrawList {
   std::vector<ColouredPoint> map_points;
   std::vector<Segment> trajectory;
   std::vector<ColouredPoint> current_scan;
+  std::vector<ColouredPoint> selected_scan;
   std::optional<common::Pose2> current_pose;
   std::optional<Ellipse> uncertainty;
   std::vector<Segment> closures_accepted, closures_rejected;

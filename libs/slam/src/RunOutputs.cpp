@@ -30,6 +30,14 @@ void ensureWritableDir(const std::string& dir) {
 
 }  // namespace
 
+void writePoseGraphG2o(const Pipeline& p, const std::string& path) {
+  esdf::PoseGraph g;
+  for (const auto& k : p.keyframes()) g.vertices.push_back({static_cast<long>(k.index), esdf::toVec(k.pose)});
+  for (const auto& e : p.graphEdges())
+    g.edges.push_back({static_cast<long>(e.from), static_cast<long>(e.to), esdf::toVec(e.measurement), e.information});
+  esdf::writePoseGraph(g, path, esdf::PoseGraphFormat::G2o);
+}
+
 common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const RunInfo& info) {
   using common::Json;
   ensureWritableDir(dir);
@@ -58,15 +66,8 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
     files.push("reference.tum");
   }
 
-  // The pose graph the filter holds: keyframe estimates, motion and loop-closure constraints.
-  {
-    esdf::PoseGraph g;
-    for (const auto& k : p.keyframes()) g.vertices.push_back({static_cast<long>(k.index), esdf::toVec(k.pose)});
-    for (const auto& e : p.graphEdges())
-      g.edges.push_back({static_cast<long>(e.from), static_cast<long>(e.to), esdf::toVec(e.measurement), e.information});
-    esdf::writePoseGraph(g, path("pose_graph.g2o"), esdf::PoseGraphFormat::G2o);
-    files.push("pose_graph.g2o");
-  }
+  writePoseGraphG2o(p, path("pose_graph.g2o"));
+  files.push("pose_graph.g2o");
   {
     common::AtomicFile f(path("loop_closures.csv"));
     f.stream() << "from_keyframe,to_keyframe,from_time,to_time,detector,score,accepted,reason,x,y,phi,rms_m,mahalanobis2,gate_threshold\n";

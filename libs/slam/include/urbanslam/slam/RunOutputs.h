@@ -13,6 +13,9 @@ struct RunInfo {
   std::string input_path, input_format, ini_path, resolved_ini;
 };
 
+// The keyframe pose graph (estimates, motion and loop-closure constraints) as g2o.
+void writePoseGraphG2o(const Pipeline& pipeline, const std::string& path);
+
 // Returns the stats.json content that was written.
 common::Json writeRunOutputs(const Pipeline& pipeline, const std::string& dir, const RunInfo& info);
 
