@@ -203,3 +203,16 @@ TEST(CarmenReader, FrontAndRearLasersByLabel) {
   const auto& f = r.scans[0];
   EXPECT_NEAR(common::wrapToPi(f.sensor_pose.phi + f.bearing(0) + M_PI / 2), 0, 1e-12);
 }
+
+// Timestamps printed with too few digits (MIT CSAIL: "1.13486e+09") repeat; the scan index
+// orders the log instead.
+TEST(CarmenReader, RepeatedTimestampsFallBackToTheScanIndex) {
+  std::string text;
+  for (int i = 0; i < 10; ++i) text += "ODOM " + std::to_string(0.1 * i) + " 0 0 0 0 0 1.13486e+09 h 1.13486e+09\n" + flaser(3, "1.0", 1.13486e+09);
+  io::CarmenReader reader(writeText("repeated", text));
+  EXPECT_FALSE(reader.info().has_timestamps);
+  const ReadBack r = readAll(reader);
+  ASSERT_EQ(r.scans.size(), 10u);
+  for (size_t i = 0; i < r.scans.size(); ++i) EXPECT_DOUBLE_EQ(r.scans[i].timestamp, static_cast<double>(i + 1));
+  EXPECT_NE(reader.format().find("scan index"), std::string::npos);
+}

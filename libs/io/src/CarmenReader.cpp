@@ -75,6 +75,8 @@ void CarmenReader::prescan() {
   std::string line;
   std::vector<std::string> f;
   bool after_scan = false, any_ts = false, any_scan = false;
+  long scans_seen = 0, repeated_ts = 0;
+  double last_scan_ts = -1;
   Pose2 scan_pose, prev_odom;
   bool have_prev_odom = false;
   for (int k = 0; k < 50000 && t.nextLine(line); ++k) {
@@ -101,11 +103,17 @@ void CarmenReader::prescan() {
                      parseNumber(f[static_cast<size_t>(n) + 3], where, "y"),
                      parseNumber(f[static_cast<size_t>(n) + 4], where, "theta")};
         after_scan = f[0] == "FLASER";
-        if (parseNumber(f[static_cast<size_t>(n) + 8], where, "timestamp") != 0) any_ts = true;
+        const double ts = parseNumber(f[static_cast<size_t>(n) + 8], where, "timestamp");
+        if (ts != 0) any_ts = true;
+        repeated_ts += ts == last_scan_ts ? 1 : 0;
+        last_scan_ts = ts;
+        ++scans_seen;
       }
     }
   }
-  info_.has_timestamps = any_ts || !any_scan;
+  // Some logs print timestamps with 6 significant digits (csail: 1.13486e+09), so most scans
+  // share one: such timestamps cannot order anything, and the scan index is used instead.
+  info_.has_timestamps = (any_ts || !any_scan) && repeated_ts * 5 < scans_seen;
 }
 
 void CarmenReader::handleParam(const std::vector<std::string>& f) {
@@ -125,7 +133,7 @@ double CarmenReader::progress() const { return text_ ? text_->progress() : 0.0; 
 
 std::string CarmenReader::format() const {
   std::string s = info_.corrected ? "CARMEN log (corrected: FLASER poses are the reference)" : "CARMEN log";
-  if (!info_.has_timestamps) s += ", no timestamps: scan index used as time";
+  if (!info_.has_timestamps) s += ", no usable timestamps: scan index used as time";
   return s;
 }
 

@@ -19,7 +19,7 @@ class TextScanner;
 
 struct CarmenInfo {
   bool corrected = false;       // Freiburg corrected log: FLASER poses are a reference trajectory
-  bool has_timestamps = true;   // false: the log's timestamps are all 0; scan index used instead
+  bool has_timestamps = true;   // false: timestamps all 0 or mostly repeated; scan index used instead
   double front_max_range_m = 80;
   double rear_max_range_m = 80;
   double front_offset_m = 0, rear_offset_m = 0;
