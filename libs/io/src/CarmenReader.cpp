@@ -105,9 +105,11 @@ void CarmenReader::prescan() {
         after_scan = f[0] == "FLASER";
         const double ts = parseNumber(f[static_cast<size_t>(n) + 8], where, "timestamp");
         if (ts != 0) any_ts = true;
-        repeated_ts += ts == last_scan_ts ? 1 : 0;
-        last_scan_ts = ts;
-        ++scans_seen;
+        if (f[0] == "FLASER") {  // front and rear scans of one instant legitimately share a time
+          repeated_ts += ts == last_scan_ts ? 1 : 0;
+          last_scan_ts = ts;
+          ++scans_seen;
+        }
       }
     }
   }
