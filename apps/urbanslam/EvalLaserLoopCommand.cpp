@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "ArgParser.h"
+#include "PairRuleOptions.h"
 #include "Commands.h"
 #include "urbanslam/common/AtomicFile.h"
 #include "urbanslam/common/Error.h"
@@ -46,11 +47,7 @@ int evalLaserLoopCommand(const Argv& args) {
   ap.addPositional("MODEL", "model file (share/laser_loop/default.model, or from train-laser-loop)");
   ap.addPositional("DATA", "logs with a reference trajectory", true, true);
   ap.addOption("out", "DIR", "write roc.csv, roc.png, features.csv (and cv.csv, cv.png with --cv-t-max) here");
-  ap.addOption("d-pos", "M", "positive pair: reference positions within this distance", "1.0");
-  ap.addOption("d-neg", "M", "negative pair: reference positions farther apart than this", "3.0");
-  ap.addOption("min-travel", "M", "positive pair: at least this much reference trajectory between the scans", "10");
-  ap.addOption("max-heading-diff", "DEG", "positive pair: heading difference at most this (180: any heading)", "180");
-  ap.addOption("max-positives", "N", "positives per log (random subset beyond)", "20000");
+  addPairRuleOptions(ap, "180", "20000", "positives per log (random subset beyond)");
   ap.addOption("negatives-per-positive", "R", "negatives drawn per positive", "10");
   ap.addOption("min-negatives", "N", "at least this many negatives per log (false-alarm resolution)", "20000");
   ap.addOption("factor", "F", "report the operating point at this factor (default: the model's)");
@@ -66,15 +63,9 @@ int evalLaserLoopCommand(const Argv& args) {
 
   laser_loop::ScanLoadOptions lo;
   lo.params = model.params;  // features exactly as the model was trained on
-  laser_loop::PairRules rules;
-  rules.d_pos_m = ap.optionDouble("d-pos");
-  rules.d_neg_m = ap.optionDouble("d-neg");
-  rules.min_travel_m = ap.optionDouble("min-travel");
-  rules.max_positives = static_cast<size_t>(ap.optionInt("max-positives"));
-  rules.max_heading_diff_rad = ap.optionDouble("max-heading-diff") * M_PI / 180;
+  laser_loop::PairRules rules = pairRulesFrom(ap);
   rules.negatives_per_positive = ap.optionDouble("negatives-per-positive");
   rules.min_negatives = static_cast<size_t>(ap.optionInt("min-negatives"));
-  rules.seed = static_cast<uint64_t>(ap.optionInt("seed"));
 
   common::Stopwatch clock;
   std::vector<laser_loop::ScanSet> sets;

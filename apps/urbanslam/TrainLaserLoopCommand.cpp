@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "ArgParser.h"
+#include "PairRuleOptions.h"
 #include "Commands.h"
 #include "urbanslam/common/Error.h"
 #include "urbanslam/common/Json.h"
@@ -36,15 +37,11 @@ int trainLaserLoopCommand(const Argv& args) {
                            "Victoria Park via GPS)", true, true);
   ap.addOption("out", "MODEL", "model file to write");
   ap.addOption("plots", "DIR", "write cv.csv and cv.png (Figure 3.5) here");
-  ap.addOption("d-pos", "M", "positive pair: reference positions within this distance", "1.0");
-  ap.addOption("d-neg", "M", "negative pair: reference positions farther apart than this", "3.0");
-  ap.addOption("min-travel", "M", "positive pair: at least this much reference trajectory between the scans", "10");
   // Training positives default to ≤ 30° of heading difference: a 180° scanner sees disjoint
   // half-planes from opposite headings, and such "positives" are label noise to the stumps.
   // Measured on held-out logs, training this way raises any-heading detection at 1 % FA (e.g.
   // indoor → campus 22 % → 34 %); eval-laser-loop still scores positives at any heading.
-  ap.addOption("max-heading-diff", "DEG", "positive pair: heading difference at most this (180: any heading)", "30");
-  ap.addOption("max-positives", "N", "positives per log (random subset beyond; keeps one big log from dominating)", "3000");
+  addPairRuleOptions(ap, "30", "3000", "positives per log (random subset beyond; keeps one big log from dominating)");
   ap.addOption("t-max", "N", "cross-validate T = 1..N", "100");
   ap.addOption("folds", "K", "cross-validation folds (0: no cross-validation, use --t)", "10");
   ap.addOption("t", "N", "use this T instead of the cross-validated choice");
@@ -70,13 +67,7 @@ int trainLaserLoopCommand(const Argv& args) {
   lo.params.beam_increment_deg = ap.optionDouble("beam-increment");
   if (!(lo.params.r_max_m > 0) || !(lo.params.g_max_dist_m > 0) || lo.params.g_min_size < 0)
     throw common::InputError("--r-max and --g-max-dist must be > 0, --g-min-size >= 0");
-  laser_loop::PairRules rules;
-  rules.d_pos_m = ap.optionDouble("d-pos");
-  rules.d_neg_m = ap.optionDouble("d-neg");
-  rules.min_travel_m = ap.optionDouble("min-travel");
-  rules.max_positives = static_cast<size_t>(ap.optionInt("max-positives"));
-  rules.max_heading_diff_rad = ap.optionDouble("max-heading-diff") * M_PI / 180;
-  rules.seed = static_cast<uint64_t>(ap.optionInt("seed"));
+  const laser_loop::PairRules rules = pairRulesFrom(ap);
   const int folds = static_cast<int>(ap.optionInt("folds"));
   const int t_max = static_cast<int>(ap.optionInt("t-max"));
   if (folds == 1 || folds < 0) throw common::InputError("--folds must be 0 or >= 2");
