@@ -3,7 +3,6 @@
 
 #include "ArgParser.h"
 #include "Commands.h"
-#include "urbanslam/common/OptionsSchema.h"
 #include "urbanslam/slam/PipelineOptions.h"
 
 namespace urbanslam::cli {
@@ -19,10 +18,7 @@ int checkIniCommand(const Argv& args) {
   std::string resolved;
   const slam::PipelineOptions o = slam::loadPipelineOptions(ap.positional("FILE"), &resolved);
   if (ap.flag("json")) {
-    slam::PipelineOptions copy = o;
-    common::OptionsSchema schema;
-    slam::declareOptions(schema, copy);
-    std::cout << schema.toJson().dump() << "\n";
+    std::cout << slam::optionsToJson(o).dump() << "\n";
   } else {
     std::cout << "// " << ap.positional("FILE") << ": OK. Resolved configuration:\n" << resolved;
   }

@@ -99,5 +99,4 @@ TEST(EsdfPipeline, WrongPlaceClosureIsGatedOut) {
   EXPECT_EQ(r.reason, "gating") << "rms " << r.rms_m;
   EXPECT_GT(r.mahalanobis2, r.gate_threshold);
   EXPECT_EQ(f.factorCount(), factors_before);  // nothing touched the filter
-  // The genuine pair (the real scan) would not be rejected by the gate for being inconsistent.
 }

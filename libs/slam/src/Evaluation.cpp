@@ -267,6 +267,8 @@ LoopMetrics classifyLoopClosures(const std::vector<LoopRow>& loops, const std::v
     }
     bool ok;
     if (positions_only) {
+      // GPS alone has no heading, and Victoria Park's fixes jump by metres: compare distances
+      // only, with 2 m of slack for the fixes themselves.
       ok = std::abs(std::hypot(b.x - a.x, b.y - a.y) - std::hypot(l.measurement.x, l.measurement.y)) <= tol_m + 2.0;
     } else {
       const Pose2 err = common::between(common::between(a, b), l.measurement);

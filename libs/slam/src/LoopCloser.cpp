@@ -42,6 +42,24 @@ void LoopCloser::rebuildIndex(const std::vector<Keyframe>& keyframes) {
 
 void LoopCloser::addToIndex(const Keyframe& kf) { grid_.insert(kf.index, kf.pose.x, kf.pose.y); }
 
+// Covariance of the relative pose ⊖x_i ⊕ x_k from the (conservative) joint covariance. Kept for
+// the current keyframe: the candidate search computes it, the alignment choice reuses it.
+Eigen::Matrix3d LoopCloser::relativeCovariance(esdf::Esdf& filter, size_t i, size_t k) {
+  if (cached_for_ != k) {
+    cached_.clear();
+    cached_for_ = k;
+  }
+  if (const auto it = cached_.find(i); it != cached_.end()) return it->second;
+  const esdf::Mat6 joint = filter.jointCovariance(static_cast<int>(i), static_cast<int>(k), esdf::CovarianceMode::Conservative);
+  esdf::Mat3 ja, jb;
+  esdf::betweenJacobians(filter.mean(static_cast<int>(i)), filter.mean(static_cast<int>(k)), &ja, &jb);
+  Eigen::Matrix<double, 3, 6> j;
+  j << ja, jb;
+  const Eigen::Matrix3d s = j * joint * j.transpose();
+  cached_[i] = s;
+  return s;
+}
+
 std::vector<size_t> LoopCloser::candidates(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t current) {
   const auto& cur = keyframes[current];
   if (current < static_cast<size_t>(options_.min_keyframe_gap)) return {};
@@ -66,13 +84,8 @@ std::vector<size_t> LoopCloser::candidates(esdf::Esdf& filter, const std::vector
   std::vector<std::pair<double, size_t>> final_set;
   const double r2 = 0.25 * options_.search_radius_m * options_.search_radius_m;
   for (const auto& [d, i] : initial) {
-    const esdf::Mat6 joint = filter.jointCovariance(static_cast<int>(i), static_cast<int>(current), esdf::CovarianceMode::Conservative);
     const esdf::Vec3 xi = filter.mean(static_cast<int>(i)), xk = filter.mean(static_cast<int>(current));
-    esdf::Mat3 ja, jb;
-    esdf::betweenJacobians(xi, xk, &ja, &jb);
-    Eigen::Matrix<double, 3, 6> j;
-    j << ja, jb;
-    const Eigen::Matrix3d s = j * joint * j.transpose();
+    const Eigen::Matrix3d s = relativeCovariance(filter, i, current);
     const Eigen::Matrix2d st = s.topLeftCorner<2, 2>() + r2 * Eigen::Matrix2d::Identity();
     const Eigen::Vector2d t = esdf::between(xi, xk).head<2>();
     const double d2 = t.dot(st.inverse() * t);
@@ -106,12 +119,7 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
   if (options_.method == "auto") {
     // A well-known relative pose needs only the fast local refinement (PL-ICP); a poorly known
     // one the global coarse alignment first (CRF-match, then ICP), as in the thesis.
-    const esdf::Mat6 joint = filter.jointCovariance(static_cast<int>(earlier), static_cast<int>(current), esdf::CovarianceMode::Conservative);
-    esdf::Mat3 ja, jb;
-    esdf::betweenJacobians(xi, xk, &ja, &jb);
-    Eigen::Matrix<double, 3, 6> j;
-    j << ja, jb;
-    const Eigen::Matrix3d s = j * joint * j.transpose();
+    const Eigen::Matrix3d s = relativeCovariance(filter, earlier, current);
     const double sxy = std::sqrt(std::max(s(0, 0), s(1, 1))), sphi = std::sqrt(s(2, 2));
     ao.method = 3 * sxy < options_.auto_local_max_m && 3 * sphi < options_.auto_local_max_deg * M_PI / 180
                     ? alignment::Method::PlIcp

@@ -76,6 +76,13 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("write_grid", o.output.write_grid, "grid.png + grid.yaml (occupancy grid, map_server convention)");
 }
 
+common::Json optionsToJson(const PipelineOptions& options) {
+  PipelineOptions copy = options;  // the schema binds to mutable members
+  common::OptionsSchema schema;
+  declareOptions(schema, copy);
+  return schema.toJson();
+}
+
 PipelineOptions loadPipelineOptions(const std::string& ini_path, std::string* resolved_ini) {
   PipelineOptions o;
   common::OptionsSchema schema;

@@ -5,7 +5,6 @@
 
 #include "urbanslam/common/AtomicFile.h"
 #include "urbanslam/common/Error.h"
-#include "urbanslam/common/OptionsSchema.h"
 #include "urbanslam/common/Timing.h"
 #include "urbanslam/esdf/PoseGraphIO.h"
 #include "urbanslam/io/MapOutputs.h"
@@ -139,12 +138,7 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   t["peak_rss_mb"] = static_cast<double>(common::peakResidentBytes()) / (1024.0 * 1024.0);
   if (grid.size() > 0) j["grid"] = grid;
   j["files"] = files;
-  {
-    PipelineOptions copy = o;
-    common::OptionsSchema schema;
-    declareOptions(schema, copy);
-    j["config"] = schema.toJson();
-  }
+  j["config"] = optionsToJson(o);
   common::AtomicFile f(path("stats.json"));
   f.stream() << j.dump(2) << "\n";
   f.commit();

@@ -66,11 +66,15 @@ class LoopCloser {
                              bool commit = true);
 
  private:
+  Eigen::Matrix3d relativeCovariance(esdf::Esdf& filter, size_t i, size_t k);
+
   LoopClosureOptions options_;
   KeyframeGrid grid_;
   CandidateScorer scorer_;
   std::string detector_ = "geometric";
   double chi2_2dof_;
+  size_t cached_for_ = static_cast<size_t>(-1);
+  std::unordered_map<size_t, Eigen::Matrix3d> cached_;  // relative covariances for cached_for_
 };
 
 }  // namespace urbanslam::slam

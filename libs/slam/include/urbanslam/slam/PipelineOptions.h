@@ -108,6 +108,9 @@ struct PipelineOptions {
 
 void declareOptions(common::OptionsSchema& schema, PipelineOptions& options);
 
+// The options as JSON ({section: {key: value}}), for stats.json and check-ini --json.
+common::Json optionsToJson(const PipelineOptions& options);
+
 // Defaults, overridden by the ini file when `ini_path` is not empty. Throws common::ConfigError.
 // `resolved_ini` (optional) receives the resolved configuration as ini text.
 PipelineOptions loadPipelineOptions(const std::string& ini_path, std::string* resolved_ini = nullptr);
