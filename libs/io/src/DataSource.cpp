@@ -5,6 +5,7 @@
 #include "TextScanner.h"
 #include "urbanslam/common/Error.h"
 #include "urbanslam/io/CarmenReader.h"
+#include "urbanslam/io/ImageFolderSource.h"
 #include "urbanslam/io/RawlogReader.h"
 #include "urbanslam/io/VictoriaParkReader.h"
 
@@ -17,7 +18,7 @@ LogFormat detectLogFormat(const std::string& path) {
   std::error_code ec;
   if (!fs::exists(path, ec)) throw InputError(path + ": no such file or folder");
   if (VictoriaParkReader::looksLike(path)) return LogFormat::VictoriaPark;
-  if (fs::is_directory(path, ec)) return LogFormat::Unknown;
+  if (fs::is_directory(path, ec)) return ImageFolderSource::looksLike(path) ? LogFormat::ImageFolder : LogFormat::Unknown;
   // Look at the (decompressed) head: CARMEN logs are text with known message tags; anything
   // else binary is tried as an MRPT rawlog (whose reader reports a clear error if it is not).
   auto in = detail::openGzFile(path);
@@ -42,9 +43,10 @@ std::unique_ptr<DataSource> openDataSource(const std::string& path) {
     case LogFormat::MrptRawlog: return std::make_unique<RawlogReader>(path);
     case LogFormat::Carmen: return std::make_unique<CarmenReader>(path);
     case LogFormat::VictoriaPark: return std::make_unique<VictoriaParkReader>(path);
+    case LogFormat::ImageFolder: return std::make_unique<ImageFolderSource>(path);
     case LogFormat::Unknown: break;
   }
-  throw InputError(path + ": unrecognised format (expected an MRPT rawlog, a CARMEN log or a Victoria Park folder/zip)");
+  throw InputError(path + ": unrecognised format (expected an MRPT rawlog, a CARMEN log, a Victoria Park folder/zip or a folder of images)");
 }
 
 }  // namespace urbanslam::io

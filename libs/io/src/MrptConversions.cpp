@@ -113,4 +113,25 @@ struct ToMrpt {
 
 mrpt::obs::CObservation::Ptr toMrpt(const Measurement& m) { return std::visit(ToMrpt{}, m); }
 
+CameraImage toGray(const mrpt::img::CImage& src, double t, const std::string& label, const std::string& where) {
+  mrpt::img::CImage gray;
+  try {
+    src.grayscale(gray);  // loads an externally stored image on demand
+  } catch (const std::exception& e) {
+    throw InputError(where + ": cannot load image (" + std::string(e.what()) + ")");
+  }
+  CameraImage img;
+  img.timestamp = t;
+  img.label = label;
+  img.source = src.isExternallyStored() ? src.getExternalStorageFile() : std::string();
+  img.width = static_cast<int>(gray.getWidth());
+  img.height = static_cast<int>(gray.getHeight());
+  auto px = std::make_shared<std::vector<uint8_t>>(static_cast<size_t>(img.width) * static_cast<size_t>(img.height));
+  for (int r = 0; r < img.height; ++r)
+    std::copy_n(gray.ptrLine<uint8_t>(static_cast<unsigned>(r)), static_cast<size_t>(img.width),
+                px->data() + static_cast<size_t>(r) * static_cast<size_t>(img.width));
+  img.pixels = std::move(px);
+  return img;
+}
+
 }  // namespace urbanslam::io::detail

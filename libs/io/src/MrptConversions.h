@@ -2,6 +2,7 @@
 // Conversions between our measurement structs and MRPT's observation classes. Private to io:
 // only the rawlog reader/writer and the map writers include MRPT headers.
 #include <mrpt/obs/CObservation.h>
+#include <mrpt/img/CImage.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 
 #include "urbanslam/io/Measurements.h"
@@ -22,5 +23,9 @@ LaserScan fromMrptScan(const mrpt::obs::CObservation2DRangeScan& o, const std::s
 
 // Any measurement as an MRPT observation.
 mrpt::obs::CObservation::Ptr toMrpt(const Measurement& m);
+
+// An MRPT image (colour or gray, embedded or stored externally) as our 8-bit gray CameraImage.
+// Throws common::InputError (with `where`) when an external image cannot be loaded.
+CameraImage toGray(const mrpt::img::CImage& src, double t, const std::string& label, const std::string& where);
 
 }  // namespace urbanslam::io::detail

@@ -53,26 +53,6 @@ class GzMrptStream : public mrpt::io::CStream {
   uint64_t pos_ = 0;
 };
 
-CameraImage toGray(const mrpt::img::CImage& src, double t, const std::string& label, const std::string& where) {
-  mrpt::img::CImage gray;
-  try {
-    src.grayscale(gray);  // loads an externally stored image on demand
-  } catch (const std::exception& e) {
-    throw InputError(where + ": cannot load image (" + std::string(e.what()) + ")");
-  }
-  CameraImage img;
-  img.timestamp = t;
-  img.label = label;
-  img.source = src.isExternallyStored() ? src.getExternalStorageFile() : std::string();
-  img.width = static_cast<int>(gray.getWidth());
-  img.height = static_cast<int>(gray.getHeight());
-  auto px = std::make_shared<std::vector<uint8_t>>(static_cast<size_t>(img.width) * static_cast<size_t>(img.height));
-  for (int r = 0; r < img.height; ++r)
-    std::copy_n(gray.ptrLine<uint8_t>(static_cast<unsigned>(r)), static_cast<size_t>(img.width),
-                px->data() + static_cast<size_t>(r) * static_cast<size_t>(img.width));
-  img.pixels = std::move(px);
-  return img;
-}
 
 }  // namespace
 
@@ -99,9 +79,9 @@ struct RawlogReader::Impl {
       have_odom = true;
       odom = {od->odometry.x(), od->odometry.y(), od->odometry.phi()};
     } else if (auto im = std::dynamic_pointer_cast<CObservationImage>(obs)) {
-      pending.emplace_back(toGray(im->image, t, im->sensorLabel, where()));
+      pending.emplace_back(detail::toGray(im->image, t, im->sensorLabel, where()));
     } else if (auto st = std::dynamic_pointer_cast<CObservationStereoImages>(obs)) {
-      pending.emplace_back(toGray(st->imageLeft, t, st->sensorLabel, where()));
+      pending.emplace_back(detail::toGray(st->imageLeft, t, st->sensorLabel, where()));
     } else if (auto daq = std::dynamic_pointer_cast<CObservationRawDAQ>(obs);
                daq && daq->sensorLabel == detail::kDriveLabel && daq->AIN_double.size() == 2) {
       pending.emplace_back(DriveReading{t, daq->AIN_double[0], daq->AIN_double[1]});

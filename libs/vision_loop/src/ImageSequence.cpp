@@ -67,43 +67,11 @@ class LogSequence : public ImageSequence {
 
 }  // namespace
 
-bool isImageFileName(const std::string& name) {
-  static const char* kExt[] = {".jpg", ".jpeg", ".png", ".bmp", ".pgm", ".ppm", ".pbm", ".tif", ".tiff", ".webp"};
-  const std::string e = lower(fs::path(name).extension().string());
-  return std::find(std::begin(kExt), std::end(kExt), e) != std::end(kExt);
-}
-
-bool naturalLess(const std::string& a, const std::string& b) {
-  size_t i = 0, j = 0;
-  while (i < a.size() && j < b.size()) {
-    if (std::isdigit(static_cast<unsigned char>(a[i])) && std::isdigit(static_cast<unsigned char>(b[j]))) {
-      size_t i2 = i, j2 = j;
-      while (i2 < a.size() && std::isdigit(static_cast<unsigned char>(a[i2]))) ++i2;
-      while (j2 < b.size() && std::isdigit(static_cast<unsigned char>(b[j2]))) ++j2;
-      std::string na = a.substr(i, i2 - i), nb = b.substr(j, j2 - j);
-      na.erase(0, std::min(na.find_first_not_of('0'), na.size()));
-      nb.erase(0, std::min(nb.find_first_not_of('0'), nb.size()));
-      if (na.size() != nb.size()) return na.size() < nb.size();
-      if (na != nb) return na < nb;
-      i = i2, j = j2;
-    } else {
-      if (a[i] != b[j]) return a[i] < b[j];
-      ++i, ++j;
-    }
-  }
-  return a.size() - i < b.size() - j;
-}
-
 std::unique_ptr<ImageSequence> openImageSequence(const std::string& path) {
   if (!fs::exists(path)) throw common::InputError(path + ": no such file or folder");
   if (fs::is_directory(path)) {
-    std::vector<std::string> files;
-    for (const auto& e : fs::directory_iterator(path))
-      if (e.is_regular_file() && isImageFileName(e.path().filename().string())) files.push_back(e.path().string());
+    std::vector<std::string> files = io::imageFilesIn(path);
     if (files.empty()) throw common::InputError(path + ": folder holds no image files");
-    std::sort(files.begin(), files.end(), [](const std::string& a, const std::string& b) {
-      return naturalLess(fs::path(a).filename().string(), fs::path(b).filename().string());
-    });
     return std::make_unique<FileListSequence>(std::move(files));
   }
   if (isImageFileName(path)) return std::make_unique<FileListSequence>(std::vector<std::string>{path});

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "urbanslam/io/ImageFolderSource.h"
+
 namespace urbanslam::vision_loop {
 
 struct NamedImage {
@@ -31,9 +33,9 @@ class ImageSequence {
 // Throws common::InputError for a missing path or an empty folder/list.
 std::unique_ptr<ImageSequence> openImageSequence(const std::string& path);
 
-// True for the file extensions OpenCV's imread handles that we accept in folders.
-bool isImageFileName(const std::string& name);
-// Natural order: digit runs compare as numbers ("img2" < "img10").
-bool naturalLess(const std::string& a, const std::string& b);
+// Folder listing rules shared with io's image-folder log (the pipeline reads the same folders in
+// the same order): accepted extensions, natural order ("img2" < "img10").
+using io::isImageFileName;
+using io::naturalLess;
 
 }  // namespace urbanslam::vision_loop
