@@ -30,7 +30,8 @@ class ProgressObserver : public slam::PipelineObserver {
 int runCommand(const Argv& args) {
   ArgParser ap("urbanslam run [--ini FILE] [--out DIR] [--quiet] [--json] [LOG]",
                "Builds a map and trajectory from a log: MRPT rawlog (either layout, gzipped or not),\n"
-               "CARMEN log (raw or Freiburg-corrected) or Victoria Park (folder or zip).");
+               "CARMEN log (raw or Freiburg-corrected), Victoria Park (folder or zip) or a folder of camera\n"
+               "images (one keyframe per image; image loop proposals need [loop_closure] image_detector).");
   ap.addPositional("LOG", "input log; default: the shipped rawlogs/intel.rawlog", false);
   ap.addOption("ini", "FILE", "configuration (see ini/default.ini for every key)", "ini/default.ini");
   ap.addOption("out", "DIR", "output folder (created if needed)", "out");
@@ -38,7 +39,8 @@ int runCommand(const Argv& args) {
   ap.addFlag("json", "print stats.json as one JSON object on stdout");
   ap.addEpilog(
       "outputs in DIR: trajectory_keyframes.tum, trajectory_odometry.tum, reference.tum (when the log\n"
-      "has one), map.ply/.pcd/.xyz, map.simplemap, grid.png + grid.yaml, config.ini, stats.json\n"
+      "has one), map.ply/.pcd/.xyz, map.simplemap, grid.png + grid.yaml, pose_graph.g2o,\n"
+      "loop_closures.csv (every hypothesis, laser or image, and its fate), config.ini, stats.json\n"
       "(written last: its presence marks a complete run).");
   if (!ap.parse(args)) return 0;
 
@@ -49,6 +51,8 @@ int runCommand(const Argv& args) {
   slam::PipelineOptions options = slam::loadPipelineOptions(ini, &resolved);
   if (options.loop_closure.laser_model.empty())
     options.loop_closure.laser_model = projectHome() + "/share/laser_loop/default.model";
+  if (options.image_loop.vocabulary.empty())
+    options.image_loop.vocabulary = projectHome() + "/" + vision_loop::kDefaultVocabularyPath;
 
   auto source = io::openDataSource(log);
   slam::Pipeline pipeline(options);

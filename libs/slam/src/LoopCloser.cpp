@@ -98,15 +98,17 @@ std::vector<size_t> LoopCloser::candidates(esdf::Esdf& filter, const std::vector
 }
 
 LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current,
-                                       bool commit) {
+                                       bool commit, const Detection* detection) {
   LoopClosureRecord r;
   r.from = earlier;
   r.to = current;
   r.from_time = keyframes[earlier].timestamp;
   r.to_time = keyframes[current].timestamp;
-  r.detector = detector_;
-  // Detection: the appearance test, when a detector is configured.
-  if (scorer_) {
+  r.detector = detection ? detection->detector : detector_;
+  // Detection: the appearance test, when a detector is configured (a proposal comes with its own).
+  if (detection) {
+    r.score = detection->score;
+  } else if (scorer_) {
     r.score = scorer_(earlier, current);
     if (r.score < options_.laser_threshold) {
       r.reason = "classifier";
@@ -140,7 +142,7 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
   r.measurement = a.transform;
   r.rms_m = a.rms_residual_m;
   const double matched = matchedFraction(a);
-  if (!scorer_) r.score = matched;
+  if (!scorer_ && !detection) r.score = matched;
   if (!good(a)) {
     r.reason = "alignment";
     return r;

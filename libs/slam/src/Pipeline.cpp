@@ -11,6 +11,8 @@
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/esdf/PoseOps.h"
 #include "urbanslam/laser_loop/LoopDetector.h"
+#include "urbanslam/vision_loop/LoopDetector.h"
+#include "urbanslam/vision_loop/VocabularyFile.h"
 
 namespace urbanslam::slam {
 
@@ -20,7 +22,10 @@ constexpr double kDeg = M_PI / 180.0;
 }  // namespace
 
 Pipeline::Pipeline(PipelineOptions options)
-    : options_(std::move(options)), motion_(options_.motion, options_.vehicle), closer_(options_.loop_closure) {
+    : options_(std::move(options)),
+      motion_(options_.motion, options_.vehicle),
+      images_(options_.loop_closure.image_max_offset_s),
+      closer_(options_.loop_closure) {
   std::stringstream ss(options_.input.laser_labels);
   std::string label;
   while (std::getline(ss, label, ',')) {
@@ -44,6 +49,13 @@ Pipeline::Pipeline(PipelineOptions options)
           return laser_detector_->score(laser_detector_->keyframe(current), earlier) - laser_detector_->factor();
         },
         "laser");
+  }
+  if (options_.loop_closure.image_detector == "tree_of_words") {
+    // Tree of Words over the keyframe images (thesis §4.2); the vocabulary decides SIFT or ORB.
+    const std::string path = options_.image_loop.vocabulary.empty() ? vision_loop::kDefaultVocabularyPath : options_.image_loop.vocabulary;
+    auto vocabulary = std::make_shared<const vision_loop::Vocabulary>(vision_loop::loadVocabulary(path));
+    const auto features = vision_loop::featureOptions(options_.image_loop, vocabulary->descriptorType());
+    image_detector_ = std::make_unique<vision_loop::LoopDetector>(vocabulary, features, vision_loop::detectorOptions(options_.image_loop));
   }
 }
 
@@ -108,6 +120,7 @@ bool Pipeline::stepOnce(io::DataSource& source) {
   } else if (const auto* img = std::get_if<io::CameraImage>(&m)) {
     ++stats_.images;
     for (auto* o : observers_) o->onImage(*img);
+    onCameraImage(*img);
   } else if (std::holds_alternative<io::GpsFix>(m)) {
     ++stats_.gps;
   }
@@ -121,6 +134,7 @@ void Pipeline::run(io::DataSource& source) {
 }
 
 void Pipeline::finish() {
+  if (auto last = images_.finish()) attachImage(*last);  // the last keyframe's image is final now
   for (LoopClosureRecord r : pending_) {  // hypotheses still waiting for a confirmation
     r.reason = "unconfirmed";
     r.accepted = false;
@@ -148,7 +162,8 @@ void Pipeline::onScan(io::LaserScan scan, double progress) {
   applyRangeLimits(scan);
   // Keyframe decision: has the vehicle moved or turned enough since the last keyframe?
   const common::Pose2& d = motion_.increment();
-  const bool make_keyframe = keyframes_.empty() || std::hypot(d.x, d.y) >= options_.keyframes.min_translation_m ||
+  // (The first scan after camera-only keyframes starts the laser map.)
+  const bool make_keyframe = keyframes_.empty() || !have_scan_keyframe_ || std::hypot(d.x, d.y) >= options_.keyframes.min_translation_m ||
                              std::abs(d.phi) >= options_.keyframes.min_rotation_deg * kDeg;
   if (make_keyframe) {
     common::Stopwatch kw;
@@ -168,13 +183,17 @@ void Pipeline::addKeyframe(io::LaserScan scan) {
   common::Pose2 z = motion_.increment();
   Eigen::Matrix3d cov = motion_.covariance();
   cov.diagonal() += Eigen::Vector3d(1e-8, 1e-8, 1e-10);  // no motion at all is still a valid constraint
+  // The previous keyframe's image is final once this keyframe exists (it may be nearer in time).
+  if (auto done = images_.keyframeAdded(k, scan.timestamp)) attachImage(*done);
   Keyframe kf{k, scan.timestamp, {}, std::move(scan)};
+  // Scan matching needs scans on both sides (camera-only keyframes have none).
+  const bool match_scans = options_.local.scan_matching && kf.hasScan() && k > 0 && keyframes_.back().hasScan();
   if (k == 0) {
     // 2. The first keyframe anchors the map at the origin.
     if (filter) esdf_->initialise(esdf::Vec3::Zero(), esdf::Mat3::Identity() * 1e-9);
   } else {
     // 3. Local SLAM: refine the increment by aligning with the previous keyframe's scan.
-    if (options_.local.scan_matching) localScanMatching(kf.scan, z, cov);
+    if (match_scans) localScanMatching(kf.scan, z, cov);
     const Eigen::Matrix3d info = cov.inverse();
     edges_.push_back({k - 1, k, z, info, false});
     if (filter) {
@@ -201,6 +220,7 @@ void Pipeline::addKeyframe(io::LaserScan scan) {
     while (recent_sets_.size() > static_cast<size_t>(options_.local.submap_keyframes)) recent_sets_.pop_front();
   }
   if (laser_detector_) laser_detector_->addKeyframe(kf.scan);  // features once per keyframe
+  have_scan_keyframe_ = have_scan_keyframe_ || kf.hasScan();
   keyframes_.push_back(std::move(kf));
   keyframe_odom_.push_back(motion_.odometryPose());
   motion_.reset();
@@ -229,6 +249,7 @@ void Pipeline::localScanMatching(const io::LaserScan& scan, common::Pose2& z, Ei
     const auto t = alignment::transformed(recent_sets_[i - first], common::between(keyframes_.back().pose, keyframes_[i].pose));
     reference.insert(reference.end(), t.begin(), t.end());
   }
+  if (reference.empty()) return;  // the recent keyframes have no scans: keep the odometry
   const auto a = alignment::alignPointSets(reference, alignment::pointSetFromScan(scan, ao.scan, ao.in_vehicle_frame), z, ao);
   const common::Pose2 correction = common::between(z, a.transform);
   if (!a.converged || std::hypot(correction.x, correction.y) > options_.local.max_correction_m ||
@@ -265,10 +286,9 @@ bool Pipeline::consistent(const LoopClosureRecord& a, const LoopClosureRecord& b
          std::abs(d.phi) <= options_.loop_closure.confirm_tolerance_deg * kDeg;
 }
 
-void Pipeline::searchLoopClosures(size_t current) {
-  common::Stopwatch sw;
-  const size_t window = static_cast<size_t>(options_.loop_closure.confirm_window);
+void Pipeline::expirePending(size_t current) {
   // Hypotheses that waited too long for a confirmation are dropped.
+  const size_t window = static_cast<size_t>(options_.loop_closure.confirm_window);
   while (!pending_.empty() && current - pending_.front().to > window) {
     LoopClosureRecord r = pending_.front();
     pending_.pop_front();
@@ -276,50 +296,65 @@ void Pipeline::searchLoopClosures(size_t current) {
     r.reason = "unconfirmed";
     reportClosure(r);
   }
-  // 6. Candidates: initial set near the estimate, final set by Mahalanobis distance.
-  std::vector<size_t> cands = closer_.candidates(*esdf_, keyframes_, current);
+}
+
+Pipeline::Admission Pipeline::admit(LoopClosureRecord r, size_t current) {
+  const size_t window = static_cast<size_t>(options_.loop_closure.confirm_window);
+  if (!r.accepted) {
+    reportClosure(r);
+    return Admission::Rejected;
+  }
+  if (window == 0) {  // tryClose already added it to the filter
+    edges_.push_back({r.from, current, r.measurement, r.information, true});
+    reportClosure(r);
+    return Admission::Accepted;
+  }
+  // Confirmation by an earlier hypothesis that this one agrees with: both go in, gated again
+  // against the current state.
+  auto match = std::find_if(pending_.begin(), pending_.end(),
+                            [&](const LoopClosureRecord& p) { return p.to < current && consistent(p, r); });
+  if (match == pending_.end()) {
+    if (pending_.size() < 4 * window) pending_.push_back(r);
+    return Admission::Pending;
+  }
+  LoopClosureRecord first = *match;
+  pending_.erase(match);
+  bool accepted = false;
+  for (LoopClosureRecord* c : {&first, &r}) {
+    const auto res = esdf_->observeRelative(static_cast<int>(c->from), static_cast<int>(c->to), esdf::toVec(c->measurement),
+                                            c->information, true);
+    c->accepted = res.accepted;
+    c->mahalanobis2 = res.gate.mahalanobis2;
+    if (!res.accepted) c->reason = "gating";
+    if (c->accepted) {
+      edges_.push_back({c->from, c->to, c->measurement, c->information, true});
+      accepted = true;
+    }
+    reportClosure(*c);
+  }
+  return accepted ? Admission::Accepted : Admission::Rejected;
+}
+
+void Pipeline::searchLoopClosures(size_t current) {
+  common::Stopwatch sw;
+  expirePending(current);
+  // 6. Candidates: initial set near the estimate, final set by Mahalanobis distance (keyframes
+  // with scans only: alignment needs both).
+  std::vector<size_t> cands;
+  if (keyframes_[current].hasScan()) cands = closer_.candidates(*esdf_, keyframes_, current);
+  cands.erase(std::remove_if(cands.begin(), cands.end(), [&](size_t i) { return !keyframes_[i].hasScan(); }), cands.end());
   if (cands.size() > static_cast<size_t>(options_.loop_closure.max_candidates))
     cands.resize(static_cast<size_t>(options_.loop_closure.max_candidates));
   for (auto* o : observers_) o->onCandidates({current, &cands});
-  const bool confirm = window > 0;
+  const bool confirm = options_.loop_closure.confirm_window > 0;
   bool accepted = false;
   for (size_t i : cands) {
     // 7-9. Detection, alignment and gating (the update itself waits for a confirmation).
-    LoopClosureRecord r = closer_.tryClose(*esdf_, keyframes_, i, current, !confirm);
     ++stats_.closures_tried;
-    if (!r.accepted) {
-      reportClosure(r);
-      continue;
-    }
-    if (!confirm) {
-      edges_.push_back({i, current, r.measurement, r.information, true});
-      reportClosure(r);
+    if (admit(closer_.tryClose(*esdf_, keyframes_, i, current, !confirm), current) == Admission::Accepted) {
       accepted = true;
       break;  // one closure per keyframe; the next keyframe sees the corrected map
     }
-    // Confirmation by an earlier hypothesis that this one agrees with: both go in, gated again
-    // against the current state.
-    auto match = std::find_if(pending_.begin(), pending_.end(),
-                              [&](const LoopClosureRecord& p) { return p.to < current && consistent(p, r); });
-    if (match == pending_.end()) {
-      if (pending_.size() < 4 * window) pending_.push_back(r);
-      continue;
-    }
-    LoopClosureRecord first = *match;
-    pending_.erase(match);
-    for (LoopClosureRecord* c : {&first, &r}) {
-      const auto res = esdf_->observeRelative(static_cast<int>(c->from), static_cast<int>(c->to), esdf::toVec(c->measurement),
-                                              c->information, true);
-      c->accepted = res.accepted;
-      c->mahalanobis2 = res.gate.mahalanobis2;
-      if (!res.accepted) c->reason = "gating";
-      if (c->accepted) {
-        edges_.push_back({c->from, c->to, c->measurement, c->information, true});
-        accepted = true;
-      }
-      reportClosure(*c);
-    }
-    if (accepted) break;
   }
   // 10. Full recovery after a closure (with relinearisation), then the corrected poses.
   if (accepted) recoverAll();

@@ -42,6 +42,8 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("detector", o.loop_closure.detector, {"none", "laser"}, "none: alignment + gating verify every candidate; laser: AdaBoost classifier first");
   s.add("laser_model", o.loop_closure.laser_model, {}, "laser classifier model; empty: share/laser_loop/default.model");
   s.add("laser_threshold", o.loop_closure.laser_threshold, -100.0, 100.0, "", "classifier decision offset (higher: fewer false alarms)");
+  s.add("image_detector", o.loop_closure.image_detector, {"none", "tree_of_words"}, "image loop closures: tree_of_words proposes pairs from keyframe images ([image_loop])");
+  s.add("image_max_offset_s", o.loop_closure.image_max_offset_s, 0.0, 3600.0, "s", "an image belongs to the nearest keyframe in time only within this");
   s.add("min_keyframe_gap", o.loop_closure.min_keyframe_gap, 1, 100000, "keyframes", "only keyframes at least this much older are candidates");
   s.add("search_radius_m", o.loop_closure.search_radius_m, 0.1, 1000.0, "m", "initial candidate set: within this distance (plus 3 sigma)");
   s.add("mahalanobis_probability", o.loop_closure.mahalanobis_probability, 0.5, 0.999999, "", "final candidate set: chi2 (2 dof) probability");
@@ -57,6 +59,9 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("confirm_window", o.loop_closure.confirm_window, 0, 1000, "keyframes", "a closure is added once another within this many keyframes agrees with it; 0: at once");
   s.add("confirm_tolerance_m", o.loop_closure.confirm_tolerance_m, 0.0, 100.0, "m", "agreement of two closures: position");
   s.add("confirm_tolerance_deg", o.loop_closure.confirm_tolerance_deg, 0.0, 180.0, "deg", "agreement of two closures: heading");
+
+  s.section("image_loop", "Tree of Words image loop-closure detection (used when [loop_closure] image_detector = tree_of_words)");
+  vision_loop::declareImageLoopOptions(s, o.image_loop);
 
   s.section("estimator", "The estimator behind the map");
   s.add("type", o.estimator.type, {"esdf", "dead_reckoning"}, "esdf: the delayed-state information filter; dead_reckoning: odometry only");

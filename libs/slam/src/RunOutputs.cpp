@@ -89,7 +89,7 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   if (o.output.write_xyz) { io::writeXyz(path("map.xyz"), pts); files.push("map.xyz"); }
   if (o.output.write_simplemap) { io::writeSimpleMap(path("map.simplemap"), posed); files.push("map.simplemap"); }
   Json grid = Json::object();
-  if (o.output.write_grid && !posed.empty()) {
+  if (o.output.write_grid && !pts.empty()) {  // camera-only runs have no map points
     io::OccupancyGridOptions g;
     g.resolution_m = o.map.grid_resolution_m;
     const auto [w, h] = io::writeOccupancyGrid(path("grid"), posed, g);
@@ -122,6 +122,8 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   c["loop_closures_tried"] = s.closures_tried;
   c["loop_closures_accepted"] = s.closures_accepted;
   c["loop_closures_rejected"] = s.closures_rejected;
+  c["image_keyframes"] = s.image_keyframes;
+  c["image_proposals"] = s.image_proposals;
   Json& t = j["timing"];
   const double duration = s.last_timestamp - s.first_timestamp;
   t["wall_s"] = s.wall_s;

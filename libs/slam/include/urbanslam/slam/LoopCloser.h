@@ -21,10 +21,12 @@ struct Keyframe;
 struct LoopClosureRecord {
   size_t from = 0, to = 0;           // earlier keyframe, current keyframe
   double from_time = 0, to_time = 0;
-  std::string detector;              // "laser" or "geometric" (alignment + gating only)
-  double score = 0;                  // classifier margin, or alignment matched fraction
+  std::string detector;              // "laser", "image" or "geometric" (alignment + gating only)
+  double score = 0;                  // classifier margin, image normalised score, or alignment matched fraction
   bool accepted = false;
-  std::string reason;                // classifier | alignment | gating | unconfirmed (when rejected)
+  // When not accepted: classifier | alignment | gating | unconfirmed, or for image proposals that
+  // could not be verified: no_scans (a keyframe has no laser scan) | no_filter (dead reckoning).
+  std::string reason;
   common::Pose2 measurement;         // aligned relative pose (from -> to)
   Eigen::Matrix3d information = Eigen::Matrix3d::Identity();  // as added to the filter
   double rms_m = 0, mahalanobis2 = 0, gate_threshold = 0;
@@ -33,6 +35,13 @@ struct LoopClosureRecord {
 // Optional appearance test of a candidate pair before alignment (the laser classifier).
 // Returns the score; the pair proceeds when score >= threshold.
 using CandidateScorer = std::function<double(size_t earlier, size_t current)>;
+
+// A pair already proposed by a detector outside the loop closer (Tree of Words): it skips the
+// scorer and goes straight to alignment and gating.
+struct Detection {
+  std::string detector;
+  double score = 0;
+};
 
 // A uniform grid over keyframe positions: the initial candidate set in constant time.
 class KeyframeGrid {
@@ -63,7 +72,7 @@ class LoopCloser {
   // Detection, alignment and gating of one candidate. With `commit`, a closure that passes is
   // added to the filter; without, it is only tested (accepted = passed) for later confirmation.
   LoopClosureRecord tryClose(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current,
-                             bool commit = true);
+                             bool commit = true, const Detection* detection = nullptr);
 
  private:
   Eigen::Matrix3d relativeCovariance(esdf::Esdf& filter, size_t i, size_t k);

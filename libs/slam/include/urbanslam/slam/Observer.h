@@ -38,6 +38,26 @@ struct LoopClosureEvent {
   std::string reason;        // why rejected: "classifier", "alignment", "gating"; empty if accepted
 };
 
+// The image chosen for a keyframe (the nearest in time, within [loop_closure]
+// image_max_offset_s). The pipeline keeps only the image's words; an observer that wants the
+// pixels keeps the shared buffer (image->pixels), which is immutable, instead of copying it.
+struct KeyframeImageEvent {
+  size_t keyframe = 0;
+  const io::CameraImage* image = nullptr;  // valid during the callback
+};
+
+// Tree of Words proposed that the image of keyframe `current_keyframe` shows the place of the
+// earlier keyframe `matched_keyframe`, and what became of the proposal so far.
+struct ImageMatchEvent {
+  size_t current_keyframe = 0, matched_keyframe = 0;
+  double score = 0;        // normalised score (similarity relative to the previous frame's)
+  bool accepted = false;   // the closure went into the filter
+  // "accepted"; "pending" (passed alignment and gating, awaiting a confirming closure; the
+  // final fate follows as a LoopClosureEvent with detector "image"); else why not:
+  // alignment | gating | no_scans | no_filter | loop_closure_disabled.
+  std::string fate;
+};
+
 struct CandidatesEvent {
   size_t keyframe = 0;                 // the current keyframe
   const std::vector<size_t>* candidates = nullptr;
@@ -59,6 +79,8 @@ class PipelineObserver {
   virtual void onCandidates(const CandidatesEvent&) {}
   virtual void onLoopClosure(const LoopClosureEvent&) {}
   virtual void onImage(const io::CameraImage&) {}
+  virtual void onKeyframeImage(const KeyframeImageEvent&) {}
+  virtual void onImageMatch(const ImageMatchEvent&) {}
   virtual void onStep(const StepEvent&) {}
   virtual void onFinished() {}
 };

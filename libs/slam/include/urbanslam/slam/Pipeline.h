@@ -12,15 +12,20 @@
 #include "urbanslam/alignment/PointSet.h"
 #include "urbanslam/io/DataSource.h"
 #include "urbanslam/io/MapOutputs.h"
+#include "urbanslam/slam/KeyframeImages.h"
 #include "urbanslam/slam/LoopCloser.h"
 #include "urbanslam/slam/MotionIntegrator.h"
 #include "urbanslam/slam/Observer.h"
 #include "urbanslam/slam/PipelineOptions.h"
+#include "urbanslam/vision_loop/BagOfWords.h"
 
 namespace urbanslam::esdf {
 class Esdf;
 }
 namespace urbanslam::laser_loop {
+class LoopDetector;
+}
+namespace urbanslam::vision_loop {
 class LoopDetector;
 }
 
@@ -30,7 +35,11 @@ struct Keyframe {
   size_t index = 0;
   double timestamp = 0;
   common::Pose2 pose;   // current estimate
-  io::LaserScan scan;   // kept so the map can be rebuilt from the current estimates
+  io::LaserScan scan;   // kept so the map can be rebuilt from the current estimates; empty
+                        // for keyframes made from camera images alone
+  bool has_image = false;              // an image was attached (nearest in time)
+  vision_loop::BagOfWords image_words;  // its Tree of Words vector (tree_of_words only); no pixels
+  bool hasScan() const { return !scan.ranges.empty(); }
 };
 
 // A constraint between two keyframes as it went into the filter (for the g2o output).
@@ -46,6 +55,8 @@ struct PipelineStats {
          reference = 0, keyframes = 0;
   size_t scan_matches_used = 0, scan_matches_rejected = 0;
   size_t closures_tried = 0, closures_accepted = 0, closures_rejected = 0;
+  size_t image_keyframes = 0;   // keyframes with an image attached
+  size_t image_proposals = 0;   // Tree of Words detections (each also a loop_closures.csv row)
   double first_timestamp = 0, last_timestamp = 0;
   double wall_s = 0;             // processing time, reading included
   std::vector<double> step_ms;   // per processed scan
@@ -92,6 +103,14 @@ class Pipeline {
   void addKeyframe(io::LaserScan scan);
   void localScanMatching(const io::LaserScan& scan, common::Pose2& z, Eigen::Matrix3d& cov);
   void searchLoopClosures(size_t current);
+  // Camera images (PipelineImages.cpp): attachment to keyframes, Tree of Words proposals.
+  void onCameraImage(const io::CameraImage& image);
+  void attachImage(const AssignedImage& assigned);
+  void proposeImageClosure(size_t earlier, size_t current, double score);
+  // A verified hypothesis (passed alignment and gating, or not) through the confirmation step.
+  enum class Admission { Rejected, Pending, Accepted };
+  Admission admit(LoopClosureRecord r, size_t current);
+  void expirePending(size_t current);
   void reportClosure(const LoopClosureRecord& r);
   bool consistent(const LoopClosureRecord& a, const LoopClosureRecord& b) const;
   void recoverAll();
@@ -112,10 +131,14 @@ class Pipeline {
   MotionIntegrator motion_;
   std::unique_ptr<esdf::Esdf> esdf_;
   std::unique_ptr<laser_loop::LoopDetector> laser_detector_;  // [loop_closure] detector = laser
+  std::unique_ptr<vision_loop::LoopDetector> image_detector_; // [loop_closure] image_detector = tree_of_words
+  std::vector<size_t> image_keyframes_;  // image database id -> keyframe
+  KeyframeImageAssigner images_;
   std::deque<LoopClosureRecord> pending_;  // passed alignment + gate, awaiting confirmation
   std::deque<alignment::PointSet> recent_sets_;  // point sets of the last keyframes (local submap)
   LoopCloser closer_;
   bool have_first_ts_ = false;
+  bool have_scan_keyframe_ = false;  // camera-only logs make a keyframe of every image until a scan comes
   bool dirty_since_recovery_ = false;
 };
 

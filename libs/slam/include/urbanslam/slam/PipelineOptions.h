@@ -5,6 +5,7 @@
 #include <string>
 
 #include "urbanslam/common/OptionsSchema.h"
+#include "urbanslam/vision_loop/ImageLoopOptions.h"
 
 namespace urbanslam::slam {
 
@@ -55,6 +56,10 @@ struct LoopClosureOptions {
   std::string detector = "none";       // none (alignment + gating only) | laser (AdaBoost classifier)
   std::string laser_model;             // classifier model file; empty = share/laser_loop/default.model
   double laser_threshold = 0.0;        // strong-classifier margin offset (higher: fewer false alarms)
+  // Image proposals (Tree of Words, [image_loop]) go through the same alignment, gating and
+  // confirmation as the laser candidates; without scans they are only recorded.
+  std::string image_detector = "none";  // none | tree_of_words
+  double image_max_offset_s = 0.5;      // an image is attached to the nearest keyframe only this close in time
   int min_keyframe_gap = 30;           // closures only with keyframes at least this much older
   double search_radius_m = 4.0;        // initial set: earlier keyframes this close (+ 3 sigma)
   double mahalanobis_probability = 0.99;  // final set: chi2 (2 dof) gate on the relative position
@@ -101,6 +106,7 @@ struct PipelineOptions {
   MotionOptions motion;
   LocalOptions local;
   LoopClosureOptions loop_closure;
+  vision_loop::ImageLoopOptions image_loop;
   EstimatorOptions estimator;
   MapOptions map;
   OutputOptions output;

@@ -10,6 +10,9 @@
 
 namespace urbanslam::vision_loop {
 
+// Relative to the project home (applications resolve it; the library uses it as given).
+constexpr const char* kDefaultVocabularyPath = "share/vision_loop/sift_k10_L4.usvoc";
+
 struct ImageLoopOptions {
   std::string vocabulary;                // empty: share/vision_loop/sift_k10_L4.usvoc
   int max_features = 500;
