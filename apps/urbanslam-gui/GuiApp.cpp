@@ -1,4 +1,4 @@
-// urbanslam-gui [FILE] [--ini FILE] [--autorun] [--screenshot FILE] [--exit-when-done]
+// urbanslam-gui [FILE] [--ini FILE] [--autorun] [--speed X] [--screenshot FILE] [--exit-when-done]
 #include <wx/app.h>
 #include <wx/image.h>
 
@@ -11,11 +11,12 @@
 namespace {
 
 constexpr const char* kUsage =
-    "usage: urbanslam-gui [FILE] [--ini FILE] [--autorun] [--screenshot FILE] [--exit-when-done]\n\n"
-    "Opens a log (MRPT rawlog, CARMEN log, Victoria Park folder/zip; default: the shipped\n"
+    "usage: urbanslam-gui [FILE] [--ini FILE] [--autorun] [--speed X] [--screenshot FILE] [--exit-when-done]\n\n"
+    "Opens a log (MRPT rawlog, CARMEN log, Victoria Park folder/zip, folder of images; default: the shipped\n"
     "rawlogs/intel.rawlog) and shows the map and its loop closures as they are built.\n\n"
     "  --ini FILE          configuration (default: ini/default.ini)\n"
     "  --autorun           start processing at once\n"
+    "  --speed X           log seconds per wall second (1: real time); 0 (default): as fast as possible\n"
     "  --screenshot FILE   with --exit-when-done: save the final view as PNG\n"
     "  --exit-when-done    quit when the log is processed; prints one JSON line with what was drawn\n"
     "  --snapshot-at N:FILE  save the view as PNG once N keyframes are drawn (the run goes on)\n";
@@ -46,6 +47,15 @@ class GuiApp : public wxApp {
       } else if (a == "--ini") o.ini = value();
       else if (a == "--screenshot") o.screenshot = value();
       else if (a == "--autorun") o.autorun = true;
+      else if (a == "--speed") {
+        const std::string v = value();
+        char* end = nullptr;
+        o.speed = std::strtod(v.c_str(), &end);
+        if (v.empty() || *end != '\0' || !(o.speed >= 0)) {
+          std::cerr << "urbanslam-gui: error: --speed expects a number >= 0, got '" << v << "'\n";
+          std::exit(2);
+        }
+      }
       else if (a == "--snapshot-at") {
         const std::string v = value();
         const auto colon = v.find(':');

@@ -12,6 +12,7 @@
 #include <wx/statusbr.h>
 #include <wx/toolbar.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 
@@ -75,8 +76,10 @@ MainFrame::MainFrame(const GuiOptions& options)
     const double tolerance = std::max(0.5, canvas_->getZoomDistance() * 0.02);
     if (const auto k = pickKeyframe(last_snapshot_, x, y, tolerance)) {
       keyframe_->show(last_snapshot_, *k);
-      notebook_->SetSelection(3);
       layers_.selected_keyframe = *k;
+      // A keyframe with an image is shown on the camera page (with its Tree of Words match).
+      const bool has_image = *k < last_snapshot_.keyframes.size() && last_snapshot_.keyframes[*k].image;
+      notebook_->SetSelection(has_image ? 2 : 3);
       refreshView(true);
     }
   };
@@ -276,7 +279,8 @@ void MainFrame::showError(const std::string& message) {
 
 bool MainFrame::openLog(const std::string& path) {
   try {
-    auto worker = std::make_unique<PipelineWorker>(path, options_.ini, options_.home + "/share/laser_loop/default.model");
+    auto worker = std::make_unique<PipelineWorker>(path, options_.ini, options_.home + "/share/laser_loop/default.model",
+                                                   options_.home + "/" + vision_loop::kDefaultVocabularyPath);
     worker_.reset();  // the previous run's thread ends first
     worker_ = std::move(worker);
   } catch (const std::exception& e) {
@@ -288,6 +292,8 @@ bool MainFrame::openLog(const std::string& path) {
   drawn_version_ = static_cast<size_t>(-1);
   auto_finished_ = false;
   snapshot_taken_ = false;
+  camera_page_shown_ = false;
+  worker_->setSpeed(options_.speed);
   if (options_.autorun) worker_->play();
   updateTitle();
   return true;
@@ -336,7 +342,11 @@ void MainFrame::refreshView(bool force) {
   canvas_->setDrawList(buildDrawList(last_snapshot_, layers_));
   stats_->update(last_snapshot_, worker_->logPath(), worker_->iniPath());
   closures_->update(last_snapshot_);
-  camera_->update(last_snapshot_);
+  camera_->update(cameraView(last_snapshot_, layers_.selected_keyframe));
+  if (!camera_page_shown_ && !last_snapshot_.keyframes.empty() && last_snapshot_.keyframes.back().image) {
+    camera_page_shown_ = true;  // a log with images: show them (once; the user may switch away)
+    notebook_->SetSelection(2);
+  }
   SetStatusText(wxString::Format("%zu keyframes, %.0f %%%s", last_snapshot_.stats.keyframes,
                                  100 * last_snapshot_.stats.progress, last_snapshot_.finished ? " - finished" : ""), 0);
 }
@@ -371,9 +381,17 @@ void MainFrame::finishAutomaticRun() {
     size_t pipeline_keyframes = 0;
     worker_->withPipeline([&](const slam::Pipeline& p) { pipeline_keyframes = p.keyframes().size(); });
     const DrawList d = buildDrawList(last_snapshot_, layers_);
-    std::printf("{\"keyframes_drawn\":%zu,\"keyframes\":%zu,\"map_points_drawn\":%zu,\"screenshot\":\"%s\",\"screenshot_ok\":%s}\n",
-                d.keyframes_drawn, pipeline_keyframes, d.map_points.size(), options_.screenshot.c_str(),
-                screenshot_ok ? "true" : "false");
+    // What the camera panel shows (from the model), so tests need not read pixels.
+    const CameraView cam = cameraView(last_snapshot_, layers_.selected_keyframe);
+    const auto id = [](const CameraFrame& f) { return f.image && f.keyframe ? static_cast<long>(*f.keyframe) : -1L; };
+    std::printf("{\"keyframes_drawn\":%zu,\"keyframes\":%zu,\"map_points_drawn\":%zu,\"image_keyframes\":%zu,"
+                "\"image_matches\":%zu,\"camera_current_keyframe\":%ld,\"camera_matched_keyframe\":%ld,"
+                "\"camera_match_score\":%.4f,\"camera_match_fate\":\"%s\",\"screenshot\":\"%s\",\"screenshot_ok\":%s}\n",
+                d.keyframes_drawn, pipeline_keyframes, d.map_points.size(),
+                static_cast<size_t>(std::count_if(last_snapshot_.keyframes.begin(), last_snapshot_.keyframes.end(),
+                                                  [](const KeyframeView& k) { return k.image != nullptr; })),
+                last_snapshot_.image_matches.size(), id(cam.current), id(cam.matched), cam.match ? cam.match->score : 0.0,
+                cam.match ? cam.match->fate.c_str() : "", options_.screenshot.c_str(), screenshot_ok ? "true" : "false");
     std::fflush(stdout);
     if (!screenshot_ok) g_exit_code = 1;
     Close(true);

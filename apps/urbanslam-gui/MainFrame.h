@@ -23,6 +23,7 @@ struct GuiOptions {
   std::string log, ini;
   std::string home;  // the project folder (shipped rawlogs, ini, share/)
   bool autorun = false;
+  double speed = 0;  // log seconds per wall second; 0: as fast as possible
   bool exit_when_done = false;
   std::string screenshot;
   size_t snapshot_at_keyframes = 0;  // also save `snapshot_path` once this many keyframes are drawn
@@ -65,6 +66,7 @@ class MainFrame : public wxFrame {
   MapSnapshot last_snapshot_;
   bool auto_finished_ = false;
   bool snapshot_taken_ = false;
+  bool camera_page_shown_ = false;
 };
 
 }  // namespace urbanslam::gui

@@ -105,25 +105,52 @@ void ClosuresPanel::update(const MapSnapshot& s) {
 
 CameraPanel::CameraPanel(wxWindow* parent) : wxPanel(parent) {
   auto* sizer = new wxBoxSizer(wxVERTICAL);
-  caption_ = new wxStaticText(this, wxID_ANY, "no camera images in this log");
-  current_ = new wxStaticBitmap(this, wxID_ANY, wxBitmap(320, 240));
-  sizer->Add(caption_, 0, wxALL, 6);
-  sizer->Add(current_, 0, wxALL, 6);
+  auto* row = new wxBoxSizer(wxHORIZONTAL);
+  auto* left = new wxBoxSizer(wxVERTICAL);
+  auto* right = new wxBoxSizer(wxVERTICAL);
+  current_caption_ = new wxStaticText(this, wxID_ANY, "no camera images in this log");
+  matched_caption_ = new wxStaticText(this, wxID_ANY, "");
+  current_ = new wxStaticBitmap(this, wxID_ANY, wxBitmap(160, 120));
+  matched_ = new wxStaticBitmap(this, wxID_ANY, wxBitmap(160, 120));
+  match_caption_ = new wxStaticText(this, wxID_ANY, "no Tree of Words proposal");
+  left->Add(current_caption_, 0, wxBOTTOM, 3);
+  left->Add(current_, 0);
+  right->Add(matched_caption_, 0, wxBOTTOM, 3);
+  right->Add(matched_, 0);
+  row->Add(left, 1, wxALL, 4);
+  row->Add(right, 1, wxALL, 4);
+  sizer->Add(row, 0, wxEXPAND);
+  sizer->Add(match_caption_, 0, wxALL, 6);
   SetSizer(sizer);
 }
 
-void CameraPanel::update(const MapSnapshot& s) {
-  if (!s.last_image || s.last_image.get() == shown_) return;
-  shown_ = s.last_image.get();
-  const auto& im = *s.last_image;
+void CameraPanel::showFrame(const CameraFrame& f, wxStaticBitmap* bitmap, wxStaticText* caption, const io::CameraImage*& shown) {
+  caption->SetLabel(f.caption);
+  const int width = std::max(80, (GetClientSize().x - 24) / 2);  // two frames side by side
+  if (f.image.get() == shown && width == shown_width_) return;
+  shown = f.image.get();
+  if (!f.image) {
+    bitmap->SetBitmap(wxBitmap(width, width * 3 / 4));
+    return;
+  }
+  const auto& im = *f.image;
   wxImage img(im.width, im.height);
   for (size_t i = 0; i < im.pixels->size(); ++i) {
     unsigned char* d = img.GetData() + 3 * i;
     d[0] = d[1] = d[2] = (*im.pixels)[i];
   }
-  const double scale = std::min(1.0, 320.0 / std::max(1, im.width));
-  current_->SetBitmap(wxBitmap(img.Scale(static_cast<int>(im.width * scale), static_cast<int>(im.height * scale))));
-  caption_->SetLabel(wxString::Format("%s  t = %.3f s", im.label, im.timestamp));
+  const double scale = static_cast<double>(width) / std::max(1, im.width);
+  bitmap->SetBitmap(wxBitmap(img.Scale(width, std::max(1, static_cast<int>(im.height * scale)), wxIMAGE_QUALITY_BILINEAR)));
+}
+
+void CameraPanel::update(const CameraView& v) {
+  if (!v.current.image && !v.match && !shown_current_) return;  // nothing yet: keep the hint
+  const int width = std::max(80, (GetClientSize().x - 24) / 2);
+  showFrame(v.current, current_, current_caption_, shown_current_);
+  showFrame(v.matched, matched_, matched_caption_, shown_matched_);
+  shown_width_ = width;
+  match_caption_->SetLabel(v.match ? v.match_caption : "no recent Tree of Words proposal");
+  if (v.match) match_caption_->SetForegroundColour(v.match->accepted ? wxColour(20, 140, 50) : wxColour(170, 40, 150));
   Layout();
 }
 

@@ -8,6 +8,7 @@
 
 #include <functional>
 
+#include "model/CameraView.h"
 #include "model/MapSnapshot.h"
 
 namespace urbanslam::gui {
@@ -45,15 +46,20 @@ class ClosuresPanel : public wxPanel {
   size_t shown_ = 0;
 };
 
+// The current (or clicked) keyframe's frame and, beside it, the earlier frame Tree of Words
+// matched it with; what to show comes from the model's cameraView().
 class CameraPanel : public wxPanel {
  public:
   explicit CameraPanel(wxWindow* parent);
-  void update(const MapSnapshot& s);
+  void update(const CameraView& view);
 
  private:
-  wxStaticBitmap* current_;
-  wxStaticText* caption_;
-  const io::CameraImage* shown_ = nullptr;
+  void showFrame(const CameraFrame& f, wxStaticBitmap* bitmap, wxStaticText* caption, const io::CameraImage*& shown);
+  wxStaticBitmap *current_, *matched_;
+  wxStaticText *current_caption_, *matched_caption_, *match_caption_;
+  const io::CameraImage* shown_current_ = nullptr;
+  const io::CameraImage* shown_matched_ = nullptr;
+  int shown_width_ = 0;
 };
 
 class KeyframePanel : public wxPanel {

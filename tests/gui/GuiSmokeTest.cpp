@@ -51,3 +51,31 @@ TEST(GuiSmoke, AutorunUnderXvfbDrawsTheMap) {
     }
   EXPECT_GT(static_cast<double>(map) / static_cast<double>(total), 0.02) << map << " of " << total << " pixels in map colours";
 }
+
+// The camera-only RTAB-Map excerpt with Tree of Words: the camera panel's model holds the
+// current keyframe's frame and the matched earlier frame at the end, and the GUI saw as many
+// proposals as the CLI reports for the same input and ini.
+TEST(GuiSmoke, CameraPanelShowsBothFramesOnTheImageSequence) {
+  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run not installed (make deps)";
+  const fs::path d = test::scratchDir("gui_smoke_images");
+  const std::string input = test::repoPath("rawlogs/rtabmap-loop-excerpt"), ini = test::repoPath("ini/rtabmap-excerpt.ini");
+  const std::string shot = (d / "view.png").string(), out = (d / "gui.json").string();
+  const std::string cmd = "xvfb-run -a -s '-screen 0 1280x800x24' " + std::string(URBANSLAM_GUI) + " " + input + " --ini " + ini +
+                          " --autorun --exit-when-done --screenshot " + shot + " > " + out + " 2>" + (d / "err.txt").string();
+  const int status = std::system(cmd.c_str());
+  const std::string json = test::slurp(out);
+  ASSERT_EQ(WEXITSTATUS(status), 0) << json << test::slurp((d / "err.txt").string());
+  const test::CliResult cli = test::runCli("run --quiet --json --ini " + ini + " --out " + (d / "cli").string() + " " + input);
+  ASSERT_EQ(cli.code, 0) << cli.err;
+  EXPECT_EQ(jsonCount(json, "keyframes_drawn"), jsonCount(cli.out, "keyframes")) << json;
+  EXPECT_EQ(jsonCount(json, "image_keyframes"), 32u) << json;
+  EXPECT_EQ(jsonCount(json, "image_matches"), jsonCount(cli.out, "image_proposals")) << json << cli.out;
+  EXPECT_GT(jsonCount(json, "image_matches"), 0u) << json;
+  // Both frames on the panel: the proposing keyframe and an earlier matched one.
+  const long current = std::stol(json.substr(json.find("\"camera_current_keyframe\":") + 26));
+  const long matched = std::stol(json.substr(json.find("\"camera_matched_keyframe\":") + 26));
+  EXPECT_GE(matched, 0) << json;
+  EXPECT_GT(current, matched) << json;
+  EXPECT_NE(json.find("\"camera_match_fate\":\"no_scans\""), std::string::npos) << json;
+  EXPECT_TRUE(fs::exists(shot));
+}

@@ -20,6 +20,17 @@ struct KeyframeView {
   double timestamp = 0;
   common::Pose2 pose;
   std::shared_ptr<const std::vector<io::Point2>> points;  // scan points in the vehicle frame
+  // The keyframe's camera image, when it has one. Shared, never copied: the pixel buffer is the
+  // reader's (immutable), so a snapshot copies a pointer, not the frame.
+  std::shared_ptr<const io::CameraImage> image;
+};
+
+// A Tree of Words proposal: the current keyframe's image shows the place of an earlier one.
+struct ImageMatchView {
+  size_t current = 0, matched = 0;  // keyframe indices
+  double score = 0;                 // normalised score
+  bool accepted = false;
+  std::string fate;                 // accepted | pending | alignment | gating | unconfirmed | no_scans | ...
 };
 
 struct RunStats {
@@ -36,7 +47,8 @@ struct MapSnapshot {
   std::array<double, 9> current_covariance{};
   std::vector<slam::LoopClosureEvent> closures;
   std::vector<size_t> candidates;  // of the current keyframe
-  std::shared_ptr<const io::CameraImage> last_image;
+  std::shared_ptr<const io::CameraImage> last_image;  // the latest camera frame of the log
+  std::vector<ImageMatchView> image_matches;          // in the order proposed
   RunStats stats;
   bool finished = false;
 };

@@ -18,8 +18,10 @@ namespace urbanslam::gui {
 class PipelineWorker {
  public:
   // Opens the log and the ini; throws common::InputError with the CLI's message on bad input.
-  // `default_laser_model`: the classifier used when the ini names none ([loop_closure] laser_model).
-  PipelineWorker(const std::string& log_path, const std::string& ini_path, const std::string& default_laser_model = "");
+  // `default_laser_model`: the classifier used when the ini names none ([loop_closure] laser_model);
+  // `default_vocabulary`: the same for the Tree of Words vocabulary ([image_loop] vocabulary).
+  PipelineWorker(const std::string& log_path, const std::string& ini_path, const std::string& default_laser_model = "",
+                 const std::string& default_vocabulary = "");
   ~PipelineWorker();
 
   void play();

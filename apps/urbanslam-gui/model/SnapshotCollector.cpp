@@ -27,6 +27,15 @@ void SnapshotCollector::onCandidates(const slam::CandidatesEvent& e) {
 void SnapshotCollector::onLoopClosure(const slam::LoopClosureEvent& e) {
   std::lock_guard<std::mutex> lock(mutex_);
   state_.closures.push_back(e);
+  if (e.detector == "image") {
+    // The final fate of a proposal that was waiting for a confirming closure.
+    for (auto it = state_.image_matches.rbegin(); it != state_.image_matches.rend(); ++it)
+      if (it->current == e.to_keyframe && it->matched == e.from_keyframe) {
+        it->accepted = e.accepted;
+        it->fate = e.accepted ? "accepted" : e.reason;
+        break;
+      }
+  }
   (e.accepted ? state_.stats.closures_accepted : state_.stats.closures_rejected)++;
   ++state_.version;
 }
@@ -35,6 +44,22 @@ void SnapshotCollector::onImage(const io::CameraImage& image) {
   auto copy = std::make_shared<const io::CameraImage>(image);
   std::lock_guard<std::mutex> lock(mutex_);
   state_.last_image = std::move(copy);
+  ++state_.version;
+}
+
+void SnapshotCollector::onKeyframeImage(const slam::KeyframeImageEvent& e) {
+  // A copy of the small header; the pixels stay in the shared buffer.
+  auto image = std::make_shared<const io::CameraImage>(*e.image);
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (e.keyframe < state_.keyframes.size() && state_.keyframes[e.keyframe].index == e.keyframe) {
+    state_.keyframes[e.keyframe].image = std::move(image);
+    ++state_.version;
+  }
+}
+
+void SnapshotCollector::onImageMatch(const slam::ImageMatchEvent& e) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  state_.image_matches.push_back({e.current_keyframe, e.matched_keyframe, e.score, e.accepted, e.fate});
   ++state_.version;
 }
 

@@ -16,6 +16,8 @@ class SnapshotCollector : public slam::PipelineObserver {
   void onCandidates(const slam::CandidatesEvent& e) override;
   void onLoopClosure(const slam::LoopClosureEvent& e) override;
   void onImage(const io::CameraImage& image) override;
+  void onKeyframeImage(const slam::KeyframeImageEvent& e) override;
+  void onImageMatch(const slam::ImageMatchEvent& e) override;
   void onStep(const slam::StepEvent& e) override;
   void onFinished() override;
 
