@@ -61,7 +61,7 @@ MainFrame::MainFrame(const GuiOptions& options)
   notebook_->AddPage(closures_, "Loop closures");
   notebook_->AddPage(camera_, "Camera");
   notebook_->AddPage(keyframe_, "Keyframe");
-  split->SplitVertically(canvas_, notebook_, -360);
+  split->SplitVertically(canvas_, notebook_, -440);  // room for two camera frames side by side
   split->SetSashGravity(1.0);
   split->SetMinimumPaneSize(200);
   SetDropTarget(new DropTarget(this));

@@ -13,9 +13,9 @@ CameraFrame keyframeFrame(const MapSnapshot& s, size_t k, const char* role) {
   f.keyframe = k;
   char buf[160];
   if (f.image)
-    std::snprintf(buf, sizeof buf, "%s: keyframe %zu, t = %.3f s", role, k, f.image->timestamp);
+    std::snprintf(buf, sizeof buf, "%s\nkeyframe %zu, t = %.3f s", role, k, f.image->timestamp);
   else
-    std::snprintf(buf, sizeof buf, "%s: keyframe %zu has no image", role, k);
+    std::snprintf(buf, sizeof buf, "%s\nkeyframe %zu: no image", role, k);
   f.caption = buf;
   return f;
 }
@@ -36,7 +36,9 @@ CameraView cameraView(const MapSnapshot& s, std::optional<size_t> selected) {
     v.current = keyframeFrame(s, *left, selected ? "selected" : "current");
   } else if (s.last_image) {
     v.current.image = s.last_image;
-    v.current.caption = "camera frame, t = " + std::to_string(s.last_image->timestamp) + " s";
+    char buf[80];
+    std::snprintf(buf, sizeof buf, "camera frame\nt = %.3f s", s.last_image->timestamp);
+    v.current.caption = buf;
   }
   if (!left) return v;
   // The proposal to show: for a clicked keyframe, its own latest one (as either side); for the
@@ -57,7 +59,7 @@ CameraView cameraView(const MapSnapshot& s, std::optional<size_t> selected) {
   if (!selected && m.current != *left) v.current = keyframeFrame(s, m.current, "proposal");
   v.matched = keyframeFrame(s, other, "matched");
   char buf[200];
-  std::snprintf(buf, sizeof buf, "Tree of Words: keyframe %zu matches %zu, score %.2f, %s", m.current, m.matched, m.score,
+  std::snprintf(buf, sizeof buf, "Tree of Words: keyframe %zu matches %zu\nscore %.2f, %s", m.current, m.matched, m.score,
                 m.fate.c_str());
   v.match_caption = buf;
   return v;

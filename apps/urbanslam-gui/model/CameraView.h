@@ -20,7 +20,7 @@ struct CameraFrame {
 struct CameraView {
   CameraFrame current, matched;
   std::optional<ImageMatchView> match;  // the proposal behind `matched`
-  std::string match_caption;            // e.g. "Tree of Words: 41 ↔ 3, score 0.74, accepted"
+  std::string match_caption;            // e.g. "Tree of Words: keyframe 41 matches 3\nscore 0.74, accepted"
 };
 
 // A proposal stays on screen this many keyframes after it was made, so a short-lived match is

@@ -102,11 +102,16 @@ void PipelineWorker::loop() {
     const double speed = speed_;
     const double t = pipeline_->stats().last_timestamp;
     lock.unlock();
-    // Real-time pacing: wait until the wall clock catches up with the log's clock.
+    // Real-time pacing: wait until the wall clock catches up with the log's clock, in short
+    // naps so pause/stop stay responsive (a log with seconds between measurements, such as a
+    // folder of images at 1 s each, must wait the whole gap, not one nap).
     if (speed > 0) {
       if (log0 < 0) log0 = t;
-      const double ahead = (t - log0) / speed - std::chrono::duration<double>(clock::now() - wall0).count();
-      if (ahead > 0) std::this_thread::sleep_for(std::chrono::duration<double>(std::min(ahead, 0.5)));
+      for (;;) {
+        const double ahead = (t - log0) / speed - std::chrono::duration<double>(clock::now() - wall0).count();
+        if (ahead <= 0 || stop_ || !running_) break;
+        std::this_thread::sleep_for(std::chrono::duration<double>(std::min(ahead, 0.05)));
+      }
     }
   }
 }

@@ -120,7 +120,7 @@ bool Pipeline::stepOnce(io::DataSource& source) {
   } else if (const auto* img = std::get_if<io::CameraImage>(&m)) {
     ++stats_.images;
     for (auto* o : observers_) o->onImage(*img);
-    onCameraImage(*img);
+    onCameraImage(*img, source.progress());
   } else if (std::holds_alternative<io::GpsFix>(m)) {
     ++stats_.gps;
   }

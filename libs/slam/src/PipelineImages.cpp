@@ -10,7 +10,7 @@
 
 namespace urbanslam::slam {
 
-void Pipeline::onCameraImage(const io::CameraImage& image) {
+void Pipeline::onCameraImage(const io::CameraImage& image, double progress) {
   if (!image.pixels || image.width <= 0 || image.height <= 0) return;
   if (stats_.scans > 0) {
     images_.addImage(image);  // goes to the nearest keyframe in time, decided one keyframe later
@@ -27,7 +27,7 @@ void Pipeline::onCameraImage(const io::CameraImage& image) {
   const double ms = sw.milliseconds();
   stats_.keyframe_ms.push_back(ms);
   stats_.step_ms.push_back(ms);
-  StepEvent ev{stats_.scans_used, keyframes_.size(), stats_.last_timestamp, ms, 0};
+  StepEvent ev{stats_.scans_used, keyframes_.size(), stats_.last_timestamp, ms, progress};
   for (auto* o : observers_) o->onStep(ev);
 }
 

@@ -104,7 +104,7 @@ class Pipeline {
   void localScanMatching(const io::LaserScan& scan, common::Pose2& z, Eigen::Matrix3d& cov);
   void searchLoopClosures(size_t current);
   // Camera images (PipelineImages.cpp): attachment to keyframes, Tree of Words proposals.
-  void onCameraImage(const io::CameraImage& image);
+  void onCameraImage(const io::CameraImage& image, double progress);
   void attachImage(const AssignedImage& assigned);
   void proposeImageClosure(size_t earlier, size_t current, double score);
   // A verified hypothesis (passed alignment and gating, or not) through the confirmation step.
