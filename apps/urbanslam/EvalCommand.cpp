@@ -38,13 +38,6 @@ std::vector<io::StampedPose> loadReference(const std::string& path, bool& positi
   throw common::InputError(path + ": carries no reference trajectory (no reference poses, no GPS)");
 }
 
-common::Json meanStd(const slam::MeanStd& m) {
-  common::Json j = common::Json::object();
-  j["mean"] = m.mean;
-  j["std"] = m.std;
-  return j;
-}
-
 }  // namespace
 
 int evalCommand(const Argv& args) {
@@ -61,6 +54,7 @@ int evalCommand(const Argv& args) {
   ap.addOption("relations", "FILE", "Freiburg relations file (t1 t2 x y z roll pitch yaw)");
   ap.addOption("reference", "FILE", "reference trajectory: TUM file or a log that carries one");
   ap.addOption("time-offset", "S", "seconds added to the run's timestamps for --relations (default: found)");
+  ap.addOption("max-gap", "S", "a relation is used only when the trajectory poses around each of its times are at most this far apart [s] (sparse trajectories need more)", "1");
   ap.addOption("loop-tolerance-m", "M", "a closure is true when its measurement agrees with the reference within this", "0.5");
   ap.addOption("loop-tolerance-deg", "DEG", "... and this", "5");
   ap.addFlag("json", "print the figures as one JSON object");
@@ -87,7 +81,9 @@ int evalCommand(const Argv& args) {
       for (const auto& p : estimate) log_times.push_back(p.timestamp);
       offset = slam::findRelationTimeOffset(reference.empty() ? estimate : reference, rel, log_times);
     }
-    const auto m = slam::relationMetrics(estimate, rel, offset);
+    const double max_gap = ap.optionDouble("max-gap");
+    if (!(max_gap > 0)) throw common::InputError("--max-gap: must be a positive number of seconds");
+    const auto m = slam::relationMetrics(estimate, rel, offset, max_gap);
     common::Json& r = j["relations"];
     r["file"] = ap.option("relations");
     r["used"] = m.used;

@@ -12,9 +12,9 @@ namespace {
 MapSnapshot threeKeyframes() {
   MapSnapshot s;
   auto pts = std::make_shared<const std::vector<io::Point2>>(std::vector<io::Point2>{{1, 0}, {0, 1}});
-  s.keyframes.push_back({0, 0.0, {0, 0, 0}, pts});
-  s.keyframes.push_back({1, 1.0, {2, 0, M_PI / 2}, pts});
-  s.keyframes.push_back({2, 2.0, {2, 3, M_PI}, pts});
+  s.keyframes.push_back({0, 0.0, {0, 0, 0}, pts, nullptr});
+  s.keyframes.push_back({1, 1.0, {2, 0, M_PI / 2}, pts, nullptr});
+  s.keyframes.push_back({2, 2.0, {2, 3, M_PI}, pts, nullptr});
   return s;
 }
 

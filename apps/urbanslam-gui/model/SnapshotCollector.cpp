@@ -6,7 +6,7 @@ void SnapshotCollector::onKeyframe(const slam::KeyframeEvent& e) {
   // Converting the scan to points happens outside the lock.
   auto pts = std::make_shared<const std::vector<io::Point2>>(io::scanToPoints(*e.scan, true));
   std::lock_guard<std::mutex> lock(mutex_);
-  state_.keyframes.push_back({e.index, e.timestamp, e.pose, std::move(pts)});
+  state_.keyframes.push_back({e.index, e.timestamp, e.pose, std::move(pts), nullptr});
   state_.current_covariance = e.covariance;
   state_.stats.keyframes = state_.keyframes.size();
   ++state_.version;

@@ -185,7 +185,7 @@ void Pipeline::addKeyframe(io::LaserScan scan) {
   cov.diagonal() += Eigen::Vector3d(1e-8, 1e-8, 1e-10);  // no motion at all is still a valid constraint
   // The previous keyframe's image is final once this keyframe exists (it may be nearer in time).
   if (auto done = images_.keyframeAdded(k, scan.timestamp)) attachImage(*done);
-  Keyframe kf{k, scan.timestamp, {}, std::move(scan)};
+  Keyframe kf{k, scan.timestamp, {}, std::move(scan), false, {}};
   // Scan matching needs scans on both sides (camera-only keyframes have none).
   const bool match_scans = options_.local.scan_matching && kf.hasScan() && k > 0 && keyframes_.back().hasScan();
   if (k == 0) {
