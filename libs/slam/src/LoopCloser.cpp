@@ -118,6 +118,7 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
   // Alignment from the current estimate of the relative pose.
   const esdf::Vec3 xi = filter.mean(static_cast<int>(earlier)), xk = filter.mean(static_cast<int>(current));
   alignment::AlignerOptions ao;
+  ao.min_constraint_ratio = options_.min_constraint_ratio;
   if (options_.method == "auto") {
     // A well-known relative pose needs only the fast local refinement (PL-ICP); a poorly known
     // one the global coarse alignment first (CRF-match, then ICP), as in the thesis.

@@ -54,6 +54,7 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("auto_local_max_deg", o.loop_closure.auto_local_max_deg, 0.0, 180.0, "deg", "auto: ... and 3 sigma of the relative heading below this");
   s.add("max_rms_m", o.loop_closure.max_rms_m, 0.001, 10.0, "m", "alignment accepted only below this RMS residual");
   s.add("min_matched_fraction", o.loop_closure.min_matched_fraction, 0.0, 1.0, "", "alignment accepted only with this share of points matched");
+  s.add("min_constraint_ratio", o.loop_closure.min_constraint_ratio, 0.0, 1.0, "", "alignment accepted only when its weakest translation direction has this share of the strongest's information (corridors slide)");
   s.add("covariance_scale", o.loop_closure.covariance_scale, 0.1, 1000.0, "", "inflation of the alignment covariance");
   s.add("chi2_gate_probability", o.loop_closure.chi2_gate_probability, 0.5, 0.9999999, "", "innovation gate (chi2, 3 dof)");
   s.add("confirm_window", o.loop_closure.confirm_window, 0, 1000, "keyframes", "a closure is added once another within this many keyframes agrees with it; 0: at once");

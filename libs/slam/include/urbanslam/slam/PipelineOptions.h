@@ -70,6 +70,9 @@ struct LoopClosureOptions {
   double auto_local_max_deg = 15.0;    // ... and this; CRF-match + ICP otherwise
   double max_rms_m = 0.08;             // alignment accepted only below this residual ...
   double min_matched_fraction = 0.5;   // ... and with this share of points matched
+  // ... and with the geometry constraining every direction: the weakest / strongest translation
+  // eigenvalue of the alignment's information at least this. A closure along a corridor slides.
+  double min_constraint_ratio = 0.1;
   double covariance_scale = 4.0;
   double chi2_gate_probability = 0.99;   // innovation gate (3 dof); 0.99 measured better than 0.999 on Intel
   // A closure goes into the filter only once a second one, within this many keyframes, agrees
