@@ -10,6 +10,7 @@
 //   g_max_dist_m 2.5
 //   g_min_size 3
 //   beam_increment_deg 1
+//   log_features 1                               (optional; absent: 0, the plain features)
 //   factor 0.5
 //   provenance <key> <value to end of line>      (any number)
 //   features 20 area average_range ...

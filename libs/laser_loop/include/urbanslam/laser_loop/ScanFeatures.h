@@ -31,6 +31,13 @@ struct FeatureParams {
   // than this are decimated to it (every k-th beam, k = round(this / increment)) before the
   // features are computed; 0 keeps every beam.
   double beam_increment_deg = 1.0;
+  // Each feature f is replaced by sign(f)·ln(1 + |f|) after it is computed. The weak classifiers
+  // of 3.25 then threshold |Δ ln(1 + f)|, i.e. roughly the ratio of two scans' values rather than
+  // their difference, so a threshold learned in small indoor rooms still means "alike" in a large
+  // outdoor place (measured: held-out detection at 1 % FA, indoor → campus 37 % → 46 %, see
+  // share/laser_loop/README.md). Still a pure, rotation-invariant function of one scan. Off
+  // reproduces the thesis's features exactly.
+  bool log_features = false;
 };
 
 enum class Feature : int {
