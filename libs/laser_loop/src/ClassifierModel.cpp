@@ -74,6 +74,7 @@ std::string modelToText(const ClassifierModel& m) {
   os << "g_min_size " << m.params.g_min_size << "\n";
   os << "beam_increment_deg " << num(m.params.beam_increment_deg) << "\n";
   os << "log_features " << (m.params.log_features ? 1 : 0) << "\n";
+  os << "submap_window_m " << num(m.submap_window_m) << "\n";
   os << "factor " << num(m.factor) << "\n";
   for (const auto& [k, v] : m.provenance) {
     std::string value = v;
@@ -169,6 +170,11 @@ ClassifierModel parseModel(const std::string& text, const std::string& source) {
       if (f[1] == "1") m.params.log_features = true;
       else if (f[1] == "0") m.params.log_features = false;
       else p.fail(ln, "log_features must be 0 or 1, got '" + f[1] + "'");
+    } else if (key == "submap_window_m") {
+      // Optional: models written before the option existed use each scan alone.
+      need(2);
+      m.submap_window_m = p.number(f[1], ln, key);
+      if (m.submap_window_m < 0) p.fail(ln, "submap_window_m must be >= 0");
     } else if (key == "factor") {
       need(2);
       m.factor = p.number(f[1], ln, key);
