@@ -84,7 +84,10 @@ TEST(SubmapScan, ScansOlderThanTheWindowAreDropped) {
   const PolarScan v = b.add(now, {frontScan(now)});
   EXPECT_EQ(b.scansInWindow(), 1u);
   // Only the current forward half (bearings −90°..90°) is seen.
-  for (size_t k = 0; k < v.ranges.size(); ++k)
-    if (std::fabs(v.bearings[k]) > 91 * kDeg) EXPECT_FALSE(v.valid[k]) << "sector " << k;
+  for (size_t k = 0; k < v.ranges.size(); ++k) {
+    if (std::fabs(v.bearings[k]) > 91 * kDeg) {
+      EXPECT_FALSE(v.valid[k]) << "sector " << k;
+    }
+  }
   expectConsistentWithRoom(v, now);
 }
