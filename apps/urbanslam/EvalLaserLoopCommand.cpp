@@ -63,6 +63,7 @@ int evalLaserLoopCommand(const Argv& args) {
 
   laser_loop::ScanLoadOptions lo;
   lo.params = model.params;  // features exactly as the model was trained on
+  lo.submap_window_m = model.submap_window_m;
   laser_loop::PairRules rules = pairRulesFrom(ap);
   rules.negatives_per_positive = ap.optionDouble("negatives-per-positive");
   rules.min_negatives = static_cast<size_t>(ap.optionInt("min-negatives"));

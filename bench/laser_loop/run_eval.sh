@@ -7,10 +7,10 @@
 #
 #   bench/laser_loop/run_eval.sh [BUILD_DIR] [OUT_DIR]
 #
-# Needs ../shared/data (Freiburg corrected logs, Victoria Park). Takes a few minutes.
+# Needs ../shared/data (Freiburg corrected logs, Victoria Park). Takes about 3 minutes.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-BUILD=${1:-build-laser}
+BUILD=${1:-build}
 OUT=${2:-$BUILD/laser_loop_eval}
 U=$BUILD/apps/urbanslam/urbanslam
 D=../shared/data/freiburg_slam_benchmark/corrected_logs
@@ -27,6 +27,10 @@ VP_RULES="--d-pos 3 --d-neg 10 --min-travel 20"
 
 log "train: indoor (intel, aces, csail, fr079)"
 $U train-laser-loop $INDOOR_TRAIN --out "$OUT/indoor.model" --plots "$OUT/cv-indoor" --quiet --json > "$OUT/train-indoor.json"
+log "train: indoor, log-scale features (--log-features 1), measured against the plain indoor model"
+$U train-laser-loop $INDOOR_TRAIN --log-features 1 --out "$OUT/indoor-log.model" --quiet --json > "$OUT/train-indoor-log.json"
+log "train: indoor, virtual 360° scans from the last 5 m of odometry (--submap-window 5)"
+$U train-laser-loop $INDOOR_TRAIN --submap-window 5 --out "$OUT/indoor-submap5.model" --quiet --json > "$OUT/train-indoor-submap5.json"
 log "train: outdoor (Freiburg campus)"
 $U train-laser-loop $CAMPUS --out "$OUT/campus.model" --plots "$OUT/cv-campus" --quiet --json > "$OUT/train-campus.json"
 
@@ -36,6 +40,12 @@ evaluate() {  # name model rules... data...
   $U eval-laser-loop "$model" "$@" --out "$OUT/$name" --quiet --json > "$OUT/$name.json"
 }
 evaluate indoor-on-campus "$OUT/indoor.model" $CAMPUS
+evaluate indoor-log-on-campus "$OUT/indoor-log.model" $CAMPUS
+evaluate indoor-log-on-heldout-indoor "$OUT/indoor-log.model" $INDOOR_HELDOUT
+evaluate indoor-log-on-victoria-park "$OUT/indoor-log.model" $VP_RULES $VP
+# Victoria Park has speed + steering, not odometry poses, so the submap model is not run on it.
+evaluate indoor-submap5-on-campus "$OUT/indoor-submap5.model" $CAMPUS
+evaluate indoor-submap5-on-heldout-indoor "$OUT/indoor-submap5.model" $INDOOR_HELDOUT
 evaluate indoor-on-campus-heading30 "$OUT/indoor.model" --max-heading-diff 30 $CAMPUS
 evaluate indoor-on-heldout-indoor "$OUT/indoor.model" $INDOOR_HELDOUT
 evaluate indoor-on-victoria-park "$OUT/indoor.model" $VP_RULES $VP
@@ -45,19 +55,27 @@ evaluate campus-on-victoria-park "$OUT/campus.model" $VP_RULES $VP
 evaluate default-on-heldout-indoor share/laser_loop/default.model $INDOOR_HELDOUT
 evaluate default-on-heldout-indoor-heading30 share/laser_loop/default.model --max-heading-diff 30 $INDOOR_HELDOUT
 evaluate default-on-victoria-park share/laser_loop/default.model $VP_RULES $VP
+# Close-pair protocol (positives within 1 m with no minimum travel, so consecutive scans count —
+# the "scans very close together" positives attributed to the ICRA 2009 paper), any heading and
+# same direction.
+CLOSE="--min-travel 0"
+evaluate close-default-on-heldout-indoor share/laser_loop/default.model $CLOSE $INDOOR_HELDOUT
+evaluate close-default-on-heldout-indoor-heading30 share/laser_loop/default.model $CLOSE --max-heading-diff 30 $INDOOR_HELDOUT
+evaluate close-indoor-on-campus "$OUT/indoor.model" $CLOSE $CAMPUS
+evaluate close-indoor-on-campus-heading30 "$OUT/indoor.model" $CLOSE --max-heading-diff 30 $CAMPUS
 
 python3 - "$OUT" <<'PY'
 import json, sys, os
 out = sys.argv[1]
-print(f"{'evaluation':38s} {'pos':>6s} {'neg':>6s} | {'det@0%':>7s} {'det@0.1%':>8s} {'det@1%':>7s} | {'NN@0%':>6s} {'NN@1%':>6s} | {'>90deg':>7s} {'<30deg':>7s}  (published: 66 % @0 %, 85 % @1 %)")
+print(f"{'evaluation':42s} {'pos':>6s} {'neg':>6s} | {'det@0%':>7s} {'det@0.1%':>8s} {'det@1%':>7s} | {'NN@0%':>6s} {'NN@1%':>6s} | {'>90deg':>7s} {'<30deg':>7s}  (published: 66 % @0 %, 85 % @1 %)")
 for f in sorted(os.listdir(out)):
     if not f.endswith('.json') or f.startswith('train-'): continue
     d = json.load(open(os.path.join(out, f)))
     r = d['rotation_at_fa_0.01']
     p = lambda v: f"{100*v:6.1f}%"
-    print(f"{f[:-5]:38s} {d['positives']:6d} {d['negatives']:6d} | {p(d['detection_at_fa_0'])} {p(d['detection_at_fa_0.001']):>8s} {p(d['detection_at_fa_0.01'])} | "
-          f"{p(d['baseline_detection_at_fa_0'])} {p(d['baseline_detection_at_fa_0.01'])} | {p(r['detection_heading_gt_90'])} {p(r['detection_heading_lt_30'])}")
-for f in ('train-indoor.json', 'train-campus.json'):
+    print(f"{f[:-5]:42s} {d['positives']:6d} {d['negatives']:6d} | {p(d['detection_at_fa_0'])} {p(d['detection_at_fa_0.001']):>8s} {p(d['detection_at_fa_0.01'])} | "
+          f"{p(d['baseline_detection_at_fa_0'])} {p(d['baseline_detection_at_fa_0.01'])} | {p(r['detection_heading_gt_90'])} {p(r['detection_heading_lt_30'])}  ({r['pairs_heading_gt_90']}/{r['pairs_heading_lt_30']})")
+for f in ('train-indoor.json', 'train-indoor-log.json', 'train-indoor-submap5.json', 'train-campus.json'):
     d = json.load(open(os.path.join(out, f)))
     print(f"{f}: T={d['T']} (CV chose {d['cv_chosen_T']}), CV FA {d['cv_fa_rate']:.3f} MD {d['cv_md_rate']:.3f} total {d['cv_total_rate']:.3f} on {d['positives']}+{d['negatives']} pairs")
 PY

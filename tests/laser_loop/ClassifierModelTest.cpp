@@ -17,6 +17,8 @@ ClassifierModel sample() {
   m.params.r_max_m = 27.5;
   m.params.g_max_dist_m = 1.25;
   m.params.g_min_size = 4;
+  m.params.log_features = true;
+  m.submap_window_m = 7.5;
   m.factor = 0.45;
   m.comments = {"command: urbanslam train-laser-loop a.log --out m.model"};
   m.provenance = {{"data", "a.log b.log"}, {"pairs", "120 positive, 120 negative"}};
@@ -52,6 +54,8 @@ TEST(ClassifierModel, SaveLoadRoundTripIsExact) {
   EXPECT_EQ(r.params.r_max_m, m.params.r_max_m);
   EXPECT_EQ(r.params.g_max_dist_m, m.params.g_max_dist_m);
   EXPECT_EQ(r.params.g_min_size, m.params.g_min_size);
+  EXPECT_EQ(r.params.log_features, true);
+  EXPECT_EQ(r.submap_window_m, 7.5);
   EXPECT_EQ(r.factor, m.factor);
   EXPECT_EQ(r.comments, m.comments);
   EXPECT_EQ(r.provenance, m.provenance);
@@ -64,6 +68,16 @@ TEST(ClassifierModel, SaveLoadRoundTripIsExact) {
   }
   EXPECT_EQ(modelToText(r), modelToText(m));
   EXPECT_EQ(r.provenanceValue("pairs"), "120 positive, 120 negative");
+}
+
+// Models written before log_features existed have no such line: they compare the plain features.
+TEST(ClassifierModel, ModelWithoutLogFeaturesKeyUsesPlainFeatures) {
+  EXPECT_FALSE(parseModel(modelWith("log_features 1\n", ""), "m.model").params.log_features);
+  EXPECT_EQ(parseModel(modelWith("submap_window_m 7.5\n", ""), "m.model").submap_window_m, 0.0);
+  EXPECT_NE(errorOf(modelWith("submap_window_m 7.5", "submap_window_m -1")).find("submap_window_m must be >= 0"),
+            std::string::npos);
+  EXPECT_NE(errorOf(modelWith("log_features 1", "log_features yes")).find("log_features must be 0 or 1"),
+            std::string::npos);
 }
 
 TEST(ClassifierModel, MalformedFilesGiveClearErrors) {

@@ -8,6 +8,7 @@
 #include <set>
 
 #include "TestPaths.h"
+#include "urbanslam/common/Error.h"
 #include "urbanslam/laser_loop/AdaBoost.h"
 #include "urbanslam/laser_loop/CrossValidation.h"
 #include "urbanslam/laser_loop/LoopDetector.h"
@@ -135,6 +136,13 @@ TEST(LoopDetector, ScreenAgreesWithPairScores) {
   EXPECT_EQ(matches.size(), matches_all.size());
   for (size_t i = 1; i < matches.size(); ++i) EXPECT_GE(matches[i - 1].score, matches[i].score);
   for (const auto& mm : matches) EXPECT_GE(mm.score, 0.5);
+}
+
+TEST(LoopDetector, RejectsSubmapModels) {
+  ClassifierModel m;
+  m.classifier = StrongClassifier({{{0, 1.0, 1}, 1.0}});
+  m.submap_window_m = 5;
+  EXPECT_THROW(LoopDetector{m}, common::InputError);
 }
 
 TEST(NearestNeighbourBaseline, UnitScaledDistance) {

@@ -116,6 +116,22 @@ TEST(ScanFeatures, HandComputedOpenScan) {
   EXPECT_NEAR(get(f, Feature::CircularityRadius), 1.4834685043265632, 1e-10);
 }
 
+// log_features: each value of the hand-checked open scan above becomes sign(f)·ln(1 + |f|); the
+// reference applies that transform here to the plain features (3.7's 3.2 m → ln 4.2).
+TEST(ScanFeatures, LogFeaturesAreTheLogOfThePlainFeatures) {
+  auto p = params(10, 1.0, 1);
+  const auto scan = makeScan({2, 2, 0, 1, 1}, 0, 45 * kDeg);
+  const auto plain = computeFeatures(scan, p);
+  p.log_features = true;
+  const auto logf = computeFeatures(scan, p);
+  EXPECT_NEAR(get(logf, Feature::AverageRange), std::log(4.2), 1e-12);
+  EXPECT_EQ(get(logf, Feature::CurvatureMean), 0);  // ln(1 + 0)
+  for (int k = 0; k < kFeatureCount; ++k) {
+    const double v = plain[static_cast<size_t>(k)];
+    EXPECT_NEAR(logf[static_cast<size_t>(k)], (v < 0 ? -1 : 1) * std::log(1 + std::fabs(v)), 1e-12) << featureName(k);
+  }
+}
+
 // Closed 360° scan of four unit-range beams: the square (1,0),(0,1),(−1,0),(0,−1).
 TEST(ScanFeatures, HandComputedClosedSquare) {
   const auto f = computeFeatures(makeScan({1, 1, 1, 1}, 0, 90 * kDeg), params(10, 2.0, 2));
@@ -177,6 +193,19 @@ TEST(ScanFeatures, InvariantUnderSensorRotation360) {
   io::LaserScan moved = base;
   moved.angle_min_rad += 1.234;  // any heading
   expectSame(f0, computeFeatures(moved, p), "angle_min");
+}
+
+TEST(ScanFeatures, LogFeaturesInvariantUnderSensorRotation360) {
+  auto p = params(30, 1.0, 3);
+  p.log_features = true;
+  const io::LaserScan base = roomScan360();
+  const auto f0 = computeFeatures(base, p);
+  for (int shift : {1, 90, 181}) {
+    io::LaserScan rot = base;
+    std::rotate(rot.ranges.begin(), rot.ranges.begin() + shift, rot.ranges.end());
+    std::rotate(rot.valid.begin(), rot.valid.begin() + shift, rot.valid.end());
+    expectSame(f0, computeFeatures(rot, p), "cyclic shift " + std::to_string(shift));
+  }
 }
 
 TEST(ScanFeatures, InvariantUnderHeadingFor180DegreeScans) {

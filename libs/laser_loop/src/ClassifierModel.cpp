@@ -73,6 +73,8 @@ std::string modelToText(const ClassifierModel& m) {
   os << "g_max_dist_m " << num(m.params.g_max_dist_m) << "\n";
   os << "g_min_size " << m.params.g_min_size << "\n";
   os << "beam_increment_deg " << num(m.params.beam_increment_deg) << "\n";
+  os << "log_features " << (m.params.log_features ? 1 : 0) << "\n";
+  os << "submap_window_m " << num(m.submap_window_m) << "\n";
   os << "factor " << num(m.factor) << "\n";
   for (const auto& [k, v] : m.provenance) {
     std::string value = v;
@@ -162,6 +164,17 @@ ClassifierModel parseModel(const std::string& text, const std::string& source) {
       m.params.beam_increment_deg = p.number(f[1], ln, key);
       if (m.params.beam_increment_deg < 0) p.fail(ln, "beam_increment_deg must be >= 0");
       have_b = true;
+    } else if (key == "log_features") {
+      // Optional: models written before the option existed compare the plain features.
+      need(2);
+      if (f[1] == "1") m.params.log_features = true;
+      else if (f[1] == "0") m.params.log_features = false;
+      else p.fail(ln, "log_features must be 0 or 1, got '" + f[1] + "'");
+    } else if (key == "submap_window_m") {
+      // Optional: models written before the option existed use each scan alone.
+      need(2);
+      m.submap_window_m = p.number(f[1], ln, key);
+      if (m.submap_window_m < 0) p.fail(ln, "submap_window_m must be >= 0");
     } else if (key == "factor") {
       need(2);
       m.factor = p.number(f[1], ln, key);

@@ -3,9 +3,16 @@
 #include <algorithm>
 #include <cmath>
 
+#include "urbanslam/common/Error.h"
+
 namespace urbanslam::laser_loop {
 
 LoopDetector::LoopDetector(ClassifierModel model) : model_(std::move(model)), factor_(model_.factor) {
+  // features(scan) computes each scan alone; a submap model would silently get other features.
+  if (model_.submap_window_m > 0)
+    throw common::InputError("laser loop model uses submap_window_m " + std::to_string(model_.submap_window_m) +
+                             " (virtual 360° scans), which the detector does not build; use a model trained "
+                             "without --submap-window");
   std::vector<int> column(kFeatureCount, -1);
   for (const auto& s : model_.classifier.stumps()) {
     int& c = column[s.stump.feature];

@@ -227,6 +227,8 @@ FeatureVector compute(const Beams& b, const FeatureParams& p) {
       f[int(Feature::CircularityRadius)] = degenerate ? 0.0 : std::sqrt(std::max(0.0, c0 + a * a + bb * bb));
     }
   }
+  if (p.log_features)
+    for (double& v : f) v = std::copysign(std::log1p(std::fabs(v)), v);
   return f;
 }
 

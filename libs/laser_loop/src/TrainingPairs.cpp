@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <random>
 #include <unordered_set>
 
 #include "urbanslam/common/Error.h"
 #include "urbanslam/io/DataSource.h"
+#include "urbanslam/laser_loop/SubmapScan.h"
 
 namespace urbanslam::laser_loop {
 
@@ -42,10 +44,18 @@ ScanSet loadLabelledScans(const std::string& path, const ScanLoadOptions& opt) {
   // observation of the place: they are merged about the vehicle origin before the features.
   std::vector<io::LaserScan> group;
   long group_ref = -1;
+  // Odometry for the submap window: the last reading before the scan (identity until the first).
+  common::Pose2 odom, group_odom;  // latest reading; the reading when the group's first scan came
+  bool have_odom = false;
+  std::unique_ptr<SubmapScanBuilder> submap;
+  if (opt.submap_window_m > 0)
+    submap = std::make_unique<SubmapScanBuilder>(opt.submap_window_m, opt.params.beam_increment_deg > 0 ? opt.params.beam_increment_deg : 1.0,
+                                                 opt.params.r_max_m);
   auto flush = [&] {
     if (group.empty()) return;
-    const FeatureVector f = group.size() == 1 ? computeFeatures(group[0], opt.params)
-                                              : computeFeatures(mergeScans(group, opt.params.beam_increment_deg), opt.params);
+    const FeatureVector f = submap ? computeFeatures(submap->add(group_odom, group), opt.params)
+                            : group.size() == 1 ? computeFeatures(group[0], opt.params)
+                                                : computeFeatures(mergeScans(group, opt.params.beam_increment_deg), opt.params);
     scans.push_back({group[0].timestamp, f, group_ref});
     group.clear();
   };
@@ -57,6 +67,8 @@ ScanSet loadLabelledScans(const std::string& path, const ScanLoadOptions& opt) {
         flush();
         group_ref = since_last_scan;
         since_last_scan = -1;
+        // flush() runs when the next instant's scan arrives, after that instant's odometry.
+        group_odom = odom;
       }
       group.push_back(std::move(*s));
     } else if (const auto* r = std::get_if<io::ReferencePose>(&m)) {
@@ -64,10 +76,16 @@ ScanSet loadLabelledScans(const std::string& path, const ScanLoadOptions& opt) {
       refs.push_back({r->timestamp, r->pose});
     } else if (const auto* g = std::get_if<io::GpsFix>(&m)) {
       gps.push_back({g->timestamp, g->x_m, g->y_m});
+    } else if (const auto* o = std::get_if<io::OdometryReading>(&m)) {
+      odom = o->pose;
+      have_odom = true;
     }
     if (opt.progress && (++count & 1023) == 0) opt.progress(source->progress());
   }
   flush();
+  if (submap && !have_odom)
+    throw common::InputError(path + ": the submap window (" + std::to_string(opt.submap_window_m) +
+                             " m) needs odometry, and this log has none");
   set.scans_read = scans.size();
   if (refs.empty() && gps.empty())
     throw common::InputError(path + ": no reference trajectory (neither reference poses nor GPS) to label scan pairs");

@@ -10,6 +10,8 @@
 //   g_max_dist_m 2.5
 //   g_min_size 3
 //   beam_increment_deg 1
+//   log_features 1                               (optional; absent: 0, the plain features)
+//   submap_window_m 10                           (optional; absent: 0, each scan alone)
 //   factor 0.5
 //   provenance <key> <value to end of line>      (any number)
 //   features 20 area average_range ...
@@ -36,6 +38,8 @@ constexpr const char* kModelMagic = "urbanslam-laser-loop-model";
 struct ClassifierModel {
   FeatureParams params;
   double factor = 0.5;  // eq. 3.30's factor: match when the normalised vote >= factor
+  // > 0: features of the virtual 360° scan over this much recent odometry (SubmapScan.h).
+  double submap_window_m = 0;
   StrongClassifier classifier;
   std::vector<std::pair<std::string, std::string>> provenance;  // key, value (one line each)
   std::vector<std::string> comments;                            // written as "# ..." lines

@@ -22,6 +22,8 @@ constexpr const char* kDefaultModelPath = "share/laser_loop/default.model";
 
 class LoopDetector {
  public:
+  // Throws common::InputError for a model trained on virtual submap scans (submap_window_m > 0):
+  // the detector computes the features of each scan alone.
   explicit LoopDetector(ClassifierModel model);
   // Loads a model file (loadModel's errors).
   static LoopDetector fromFile(const std::string& path);

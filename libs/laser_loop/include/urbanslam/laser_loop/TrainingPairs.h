@@ -43,6 +43,9 @@ struct ScanLoadOptions {
   FeatureParams params;
   double ref_max_gap_s = 0.05;
   double gps_max_gap_s = 1.0;
+  // > 0: each scan's features are those of the virtual 360° scan built from the scans of the last
+  // this many metres of odometry (SubmapScan.h); the log must carry odometry. 0: the scan alone.
+  double submap_window_m = 0;
   // Optional: called with the fraction of the input read.
   std::function<void(double)> progress;
 };
