@@ -1,6 +1,11 @@
 // convert → read back: the same observations and timestamps, in both rawlog layouts.
 #include <gtest/gtest.h>
 
+#include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/obs/CRawlog.h>
+#include <mrpt/serialization/CArchive.h>
+
 #include <cmath>
 
 #include "TestPaths.h"
@@ -103,6 +108,32 @@ TEST(RoundTrip, FramesLayoutKeepsScansAndOdometryIncrements) {
     EXPECT_NEAR(common::wrapToPi(da.phi - db.phi), 0, 1e-6);
     EXPECT_NEAR(oa[i + 1].timestamp, ob[i].timestamp, 1e-6);
   }
+}
+
+// A log without odometry (speed + steering) in the classic layout: MRPT's own pair reader (what
+// icp-slam and rbpf-slam use) must see one action/frame pair per scan, not one frame holding all.
+TEST(RoundTrip, FramesLayoutWithoutOdometryGivesMrptOnePairPerScan) {
+  const std::string in = test::repoPath("rawlogs/victoria-park-excerpt");
+  const std::string out = (test::scratchDir("rt_sf_vp") / "vp.rawlog").string();
+  convert(in, out, io::RawlogLayout::SensoryFrames);
+  const size_t scans = only<io::LaserScan>(readAll(in)).size();
+  ASSERT_EQ(scans, 250u);
+  mrpt::io::CFileGZInputStream f(out);
+  auto arch = mrpt::serialization::archiveFrom(f);
+  mrpt::obs::CActionCollection::Ptr acts;
+  mrpt::obs::CSensoryFrame::Ptr sf;
+  mrpt::obs::CObservation::Ptr obs;
+  size_t pos = 0, pairs = 0, scans_read = 0;
+  while (mrpt::obs::CRawlog::getActionObservationPairOrObservation(arch, acts, sf, obs, pos)) {
+    ASSERT_TRUE(sf) << "entry " << pos << " is not an action/frame pair";
+    size_t in_frame = 0;
+    for (const auto& o : *sf) in_frame += o->GetRuntimeClass() == CLASS_ID(mrpt::obs::CObservation2DRangeScan);
+    EXPECT_LE(in_frame, 1u) << "frame " << pairs;
+    scans_read += in_frame;
+    ++pairs;
+  }
+  EXPECT_EQ(scans_read, scans);
+  EXPECT_GE(pairs, scans);
 }
 
 TEST(RoundTrip, VictoriaParkDriveAndGpsSurvive) {

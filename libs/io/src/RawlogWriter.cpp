@@ -22,6 +22,8 @@ struct RawlogWriter::Impl {
   RawlogLayout layout;
   mrpt::io::CFileGZOutputStream out;
   mrpt::obs::CSensoryFrame::Ptr frame;  // SensoryFrames layout: observations since the last odometry
+  bool frame_has_scan = false;          // a frame holds one laser scan: a second one starts the next
+  bool action_since_frame = false;      // an action was written after the last frame
   bool have_odom = false;
   common::Pose2 last_odom;
   size_t written = 0;
@@ -30,8 +32,13 @@ struct RawlogWriter::Impl {
   void flushFrame() {
     if (!frame || frame->size() == 0) return;
     auto arch = mrpt::serialization::archiveFrom(out);
+    // The classic layout alternates actions and frames (MRPT's readers pair them); a log without
+    // odometry (speed + steering, camera only) gets an empty action before each frame.
+    if (!action_since_frame) arch << mrpt::obs::CActionCollection();
     arch << *frame;
     frame = mrpt::obs::CSensoryFrame::Create();
+    frame_has_scan = false;
+    action_since_frame = false;
   }
 };
 
@@ -69,11 +76,17 @@ void RawlogWriter::write(const Measurement& m) {
       mrpt::obs::CActionCollection acts;
       acts.insert(mv);
       arch << acts;
+      impl_->action_since_frame = true;
     }
     impl_->have_odom = true;
     impl_->last_odom = od->pose;
   } else {
+    // One scan per frame, as SLAM apps (icp-slam) process a frame as one observation step; a log
+    // without odometry would otherwise end up as a single frame.
+    const bool scan = std::holds_alternative<LaserScan>(m);
+    if (scan && impl_->frame_has_scan) impl_->flushFrame();
     impl_->frame->insert(detail::toMrpt(m));
+    impl_->frame_has_scan = impl_->frame_has_scan || scan;
   }
   ++impl_->written;
 }
