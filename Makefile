@@ -7,7 +7,7 @@ CMAKE_ARGS ?=
 # Every Debian 12 package the project needs (build, tests, GUI, benchmarks and their peers).
 DEB_PACKAGES = cmake g++ make ninja-build ccache pkg-config \
   libmrpt-dev mrpt-common mrpt-apps libopencv-dev libeigen3-dev libsuitesparse-dev \
-  libwxgtk3.2-dev libgtest-dev libbenchmark-dev zlib1g-dev libzip-dev \
+  libwxgtk3.2-dev libgtest-dev libbenchmark-dev zlib1g-dev libzip-dev libceres-dev \
   xvfb xauth opencv-doc plasma-workspace-wallpapers
 
 .PHONY: all deps configure build demo test bench clean

@@ -13,7 +13,9 @@
 //     that factorisation: exact (refactorise + column solves) / conservative (old factor + dead
 //     reckoning, no refactorisation).
 // Usage: esdf_bench [--no-full-above N] [--ordering amd|metis|auto|natural] [--backend N]...
-//                   [--final-passes P] [--min-gap F] [--incremental-passes P] SIZE...
+//                   [--final-passes P] [--min-gap F] [--incremental-passes P] [--window-passes P]
+//                   [--window-from-closure 0|1] [--max-window W] SIZE...
+//        esdf_bench --write-graph N PREFIX   (the back end's drive as PREFIX.g2o + PREFIX.truth.g2o)
 //   (default sizes 1000 10000 100000 1000000; each --backend N also runs the pose-graph back end,
 //   with its recovery policy, on the same drive of N poses)
 #include <Eigen/Core>
@@ -28,6 +30,7 @@
 #include "urbanslam/common/Timing.h"
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/esdf/PoseGraphBackend.h"
+#include "urbanslam/esdf/PoseGraphIO.h"
 
 using namespace urbanslam;
 using esdf::Mat3;
@@ -136,7 +139,8 @@ Row runSize(long n, long no_full_above) {
 }
 
 // The same drive as a pose graph (odometry + loop-closure edges), for the back end's policy.
-esdf::PoseGraph cityGraph(long n) {
+// With `truth`, also the true poses (vertex k = pose k).
+esdf::PoseGraph cityGraph(long n, std::vector<esdf::PoseGraphVertex>* truth_out = nullptr) {
   std::mt19937 rng(static_cast<unsigned>(n) + 7);
   std::normal_distribution<double> g(0.0, 1.0);
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -146,6 +150,7 @@ esdf::PoseGraph cityGraph(long n) {
   const int half_blocks = std::max(2, static_cast<int>(std::sqrt(static_cast<double>(n)) / 6));
   std::unordered_map<long long, std::pair<int, Vec3>> last_visit;
   Vec3 truth = Vec3::Zero();
+  if (truth_out) truth_out->assign(1, {0, truth});
   int dir = 0;
   for (long k = 1; k < n; ++k) {
     double dphi = 0;
@@ -163,6 +168,7 @@ esdf::PoseGraph cityGraph(long n) {
     }
     const Vec3 step(std::cos(dphi), std::sin(dphi), dphi);
     truth = esdf::compose(truth, step);
+    if (truth_out) truth_out->push_back({k, truth});
     graph.edges.push_back({k - 1, k, step + Vec3(0.05 * g(rng), 0.05 * g(rng), 0.01 * g(rng)), odo});
     const long long key = (static_cast<long long>(std::lround(truth.x())) << 32) ^ (std::lround(truth.y()) & 0xffffffff);
     auto it = last_visit.find(key);
@@ -175,9 +181,21 @@ esdf::PoseGraph cityGraph(long n) {
   return graph;
 }
 
+// --write-graph N PREFIX: the back end's drive of N poses as PREFIX.g2o (edges only, what
+// the back end sees) and PREFIX.truth.g2o (the true poses as vertices, plus the same edges),
+// for running peers (ceres_pose_graph) and the ground-truth error on the same graph.
+void writeGraph(long n, const std::string& prefix) {
+  std::vector<esdf::PoseGraphVertex> truth;
+  esdf::PoseGraph g = cityGraph(n, &truth);
+  esdf::writePoseGraph(g, prefix + ".g2o", esdf::PoseGraphFormat::G2o);
+  g.vertices = std::move(truth);
+  esdf::writePoseGraph(g, prefix + ".truth.g2o", esdf::PoseGraphFormat::G2o);
+}
+
 int g_final_passes = -1;
 double g_min_gap = -1;
 int g_incremental_passes = -1;
+int g_window_passes = -1, g_max_window = -1, g_window_from_closure = -1;
 
 void runBackend(const std::vector<long>& sizes) {
   std::printf("\nback end (urbanslam graph's policy: partial recovery after closures, amortised full recoveries,\n"
@@ -190,6 +208,9 @@ void runBackend(const std::vector<long>& sizes) {
     if (g_final_passes >= 0) o.filter.relinearise_max_passes = g_final_passes;
     if (g_min_gap >= 0) o.full_recovery_min_gap_fraction = g_min_gap;
     if (g_incremental_passes >= 0) o.incremental_relinearise_passes = g_incremental_passes;
+    if (g_window_passes >= 0) o.window_relinearise_passes = g_window_passes;
+    if (g_max_window >= 0) o.max_window_poses = g_max_window;
+    if (g_window_from_closure >= 0) o.window_from_previous_closure = g_window_from_closure != 0;
     const auto r = esdf::runPoseGraphBackend(graph, o);
     std::printf("%9ld %8d | %9.4f %9.4f %9.1f | %8d %8d | %9.3f %9.3f | %12.3f %s\n", n, r.edges,
                 common::percentile(r.step_ms, 50), common::percentile(r.step_ms, 99), common::percentile(r.step_ms, 100),
@@ -206,10 +227,17 @@ int main(int argc, char** argv) {
   long no_full_above = 100000000;
   for (int a = 1; a < argc; ++a) {
     if (!std::strcmp(argv[a], "--no-full-above") && a + 1 < argc) no_full_above = std::atol(argv[++a]);
+    else if (!std::strcmp(argv[a], "--write-graph") && a + 2 < argc) {
+      writeGraph(std::atol(argv[a + 1]), argv[a + 2]);
+      return 0;
+    }
     else if (!std::strcmp(argv[a], "--backend") && a + 1 < argc) backend_sizes.push_back(std::atol(argv[++a]));
     else if (!std::strcmp(argv[a], "--final-passes") && a + 1 < argc) g_final_passes = std::atoi(argv[++a]);
     else if (!std::strcmp(argv[a], "--min-gap") && a + 1 < argc) g_min_gap = std::atof(argv[++a]);
     else if (!std::strcmp(argv[a], "--incremental-passes") && a + 1 < argc) g_incremental_passes = std::atoi(argv[++a]);
+    else if (!std::strcmp(argv[a], "--window-passes") && a + 1 < argc) g_window_passes = std::atoi(argv[++a]);
+    else if (!std::strcmp(argv[a], "--max-window") && a + 1 < argc) g_max_window = std::atoi(argv[++a]);
+    else if (!std::strcmp(argv[a], "--window-from-closure") && a + 1 < argc) g_window_from_closure = std::atoi(argv[++a]);
     else if (!std::strcmp(argv[a], "--ordering") && a + 1 < argc) {
       const std::string o = argv[++a];
       g_ordering = o == "metis" ? esdf::FillReducingOrdering::Metis

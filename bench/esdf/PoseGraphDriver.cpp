@@ -5,6 +5,10 @@
 //   esdf_pose_graph --eval EDGES_FILE POSES_FILE   chi2 of EDGES_FILE's edges at POSES_FILE's vertices
 //   esdf_pose_graph --init IN OUT                  IN with dead-reckoned vertices (for batch tools
 //                                                  that need VERTEX lines), written as g2o
+//   esdf_pose_graph --error REFERENCE ESTIMATE      ATE RMSE (m, after rigid alignment) and mean
+//                                                  absolute heading error (deg) of ESTIMATE's
+//                                                  vertices against REFERENCE (see TrajectoryError.h)
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -12,6 +16,7 @@
 
 #include "urbanslam/common/Timing.h"
 #include "urbanslam/esdf/PoseGraphBackend.h"
+#include "urbanslam/esdf/TrajectoryError.h"
 
 using namespace urbanslam;
 
@@ -31,6 +36,16 @@ int main(int argc, char** argv) {
       }
       std::printf("%.6f\n", esdf::poseGraphChi2(edges, x, ids));
       return 0;
+    }
+    if (!std::strcmp(argv[a], "--error") && a + 2 < argc) {
+      try {
+        const auto e = esdf::trajectoryError(esdf::readPoseGraph(argv[a + 2]).vertices, esdf::readReferencePoses(argv[a + 1]));
+        std::printf("%.6f %.6f %zu\n", e.ate_rmse_m, e.heading_mean_abs_rad * 180.0 / M_PI, e.matched);
+        return 0;
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "%s\n", e.what());
+        return 2;
+      }
     }
     if (!std::strcmp(argv[a], "--init") && a + 2 < argc) {
       // Dead reckoning through the back end's augmenting edges = the filter before any update.

@@ -1,74 +1,106 @@
 #!/usr/bin/env bash
-# Pose-graph benchmark: `urbanslam graph` (ESDF, incremental) vs MRPT's batch
-# `graph-slam --2d --levmarq` on the 2D pose graphs of /work/shared/data/pose_graphs_2d, same
-# file, same run. Prints one table row per dataset: final chi2 (sum e' Omega e over the file's
-# edges, g2o convention, evaluated by the same code for both results) and wall time of each
-# process (reading, solving and writing included). The last column is urbanslam with
-# --no-relinearise (the thesis filter, every edge linearised once).
+# Pose-graph benchmark on the 2D pose graphs of /work/shared/data/pose_graphs_2d, every peer on
+# the same file in the same run:
+#   * urbanslam graph (ESDF, incremental);
+#   * ceres_pose_graph: the weighted batch optimum (Ceres LM, sparse Cholesky, one thread),
+#     started from the file's vertices, or from dead reckoning through the back end's spanning
+#     edges for edges-only files (what the filter starts from);
+#   * MRPT's batch `graph-slam --2d --levmarq`.
+# chi2 is sum e' Omega e over the file's edges (g2o convention), evaluated by the same code
+# (PoseGraphIO) for every result. Times are wall times of each process (reading, solving and
+# writing included), the median of REPEAT runs for urbanslam and Ceres (MRPT runs once).
 #
-# Notes:
-#  * MRPT needs VERTEX lines; edges-only files get dead-reckoned vertices first (esdf_pose_graph
-#    --init, same edges and information matrices). graph-slam then computes its own initial
-#    guess from a Dijkstra spanning tree.
-#  * MRPT 2.5's graph-slam app loads the graph as CNetworkOfPoses2D, which drops the edges'
-#    information matrices (its output file has identity information): it minimises the
-#    unweighted error, so its chi2 here is of its unweighted optimum under the weighted metric.
-#    For an apples-to-apples comparison with MRPT's own optimum, the last two columns run
-#    urbanslam on MRPT's output file (same edges, identity information) and give both chi2
-#    values of that unweighted problem (uw_*).
+# Table 1: urbanslam vs Ceres (ratio = urbanslam chi2 / Ceres chi2, speedup = Ceres time /
+#   urbanslam time), and urbanslam with --no-relinearise (the thesis filter, every edge
+#   linearised once).
+# Table 2: MRPT as before. MRPT needs VERTEX lines; edges-only files get dead-reckoned
+#   vertices first (esdf_pose_graph --init). MRPT 2.5's graph-slam loads the graph as
+#   CNetworkOfPoses2D, which drops the information matrices (its output has identity
+#   information): it minimises the unweighted error, so mrpt_chi2 is its unweighted optimum
+#   under the weighted metric. uw_* run urbanslam on MRPT's output file (same edges, identity
+#   information) and give both chi2 values of that unweighted problem.
+# Table 3: error against ground truth where the data set has it: ATE RMSE (m, positions after
+#   the best rigid alignment) and mean absolute heading error (deg) (esdf_pose_graph --error).
 #
 # Usage: bench/esdf/run_pose_graphs.sh [BUILD_DIR]   (default build dir: build)
-#   env URBANSLAM=path/to/urbanslam  ESDF_TOOL=path/to/esdf_pose_graph  DATA=dir  GRAPH_SLAM=...
+#   env URBANSLAM=...  ESDF_TOOL=...  CERES_TOOL=...  GRAPH_SLAM=...  DATA=dir  REPEAT=3
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(cd "$here/../.." && pwd)"
 build="${1:-$root/build}"
 URBANSLAM="${URBANSLAM:-$build/apps/urbanslam/urbanslam}"
 ESDF_TOOL="${ESDF_TOOL:-$build/bench/esdf/esdf_pose_graph}"
+CERES_TOOL="${CERES_TOOL:-$build/bench/esdf/ceres_pose_graph}"
 GRAPH_SLAM="${GRAPH_SLAM:-/usr/bin/graph-slam}"
 DATA="${DATA:-$root/../shared/data/pose_graphs_2d}"
-for tool in "$URBANSLAM" "$ESDF_TOOL" "$GRAPH_SLAM"; do
-  [[ -x "$tool" ]] || { echo "missing executable: $tool" >&2; exit 2; }
+REPEAT="${REPEAT:-3}"
+for tool in "$URBANSLAM" "$ESDF_TOOL" "$CERES_TOOL" "$GRAPH_SLAM"; do
+  [[ -x "$tool" ]] || { echo "missing executable: $tool (ceres_pose_graph needs libceres-dev)" >&2; exit 2; }
 done
 [[ -d "$DATA" ]] || { echo "missing data folder: $DATA" >&2; exit 2; }
+[[ "$REPEAT" =~ ^[1-9][0-9]*$ ]] || { echo "REPEAT must be a positive integer" >&2; exit 2; }
 
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 
+# dataset [ground truth]
 datasets=(
-  se-sync/manhattan.g2o
-  vertigo/manhattan/manhattanOlson3500.g2o
-  se-sync/city10000.g2o.gz
-  se-sync/intel.g2o
-  se-sync/CSAIL.g2o
-  se-sync/MIT.g2o
-  se-sync/kitti_00.g2o
-  se-sync/ais2klinik.g2o.gz
-  vertigo/ring/ring.g2o
-  vertigo/ringCity/ringCity.g2o
-  hog-man/w10000.graph.gz
+  "se-sync/manhattan.g2o vertigo/manhattan/manhattanOlson3500_nodes_groundTruth.dat"
+  "vertigo/manhattan/manhattanOlson3500.g2o vertigo/manhattan/manhattanOlson3500_nodes_groundTruth.dat"
+  "se-sync/city10000.g2o.gz"
+  "se-sync/intel.g2o"
+  "se-sync/CSAIL.g2o"
+  "se-sync/MIT.g2o"
+  "se-sync/kitti_00.g2o"
+  "se-sync/ais2klinik.g2o.gz"
+  "vertigo/ring/ring.g2o vertigo/ring/ring.groundTruth.g2o"
+  "vertigo/ringCity/ringCity.g2o vertigo/ringCity/ringCity.groundTruth.g2o"
+  "hog-man/w10000.graph.gz"
 )
 
 now() { date +%s.%N; }
-printf "%-42s %6s %6s | %14s %8s | %14s %8s %6s | %9s %7s | %14s | %12s %12s %9s\n" dataset poses edges \
-  urbanslam_chi2 time_s mrpt_chi2 time_s rc chi2_ratio speedup chi2_no_relin uw_urbanslam uw_mrpt uw_ratio
-for d in "${datasets[@]}"; do
+json() { sed -E "s/.*\"$1\":\"?([^,\"}]*).*/\1/" "$2"; }
+median() { sort -g | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
+t1="$work/table1"; t2="$work/table2"; t3="$work/table3"
+printf "%-42s %6s %6s | %14s %8s | %14s %8s %5s | %8s %7s | %14s\n" dataset poses edges \
+  urbanslam_chi2 time_s ceres_chi2 time_s iters chi2_ratio speedup chi2_no_relin > "$t1"
+printf "%-42s | %14s %8s | %14s %8s %3s | %9s %7s | %12s %12s %9s\n" dataset \
+  urbanslam_chi2 time_s mrpt_chi2 time_s rc chi2_ratio speedup uw_urbanslam uw_mrpt uw_ratio > "$t2"
+printf "%-42s %6s | %10s %9s | %10s %9s | %10s %9s\n" dataset matched \
+  urb_ate_m urb_hdg_deg ceres_ate_m cer_hdg_deg mrpt_ate_m mrpt_hdg_deg > "$t3"
+total_u=0; total_c=0
+for entry in "${datasets[@]}"; do
+  read -r d gt <<< "$entry"
   f="$DATA/$d"
-  [[ -f "$f" ]] || { printf "%-42s absent\n" "$d"; continue; }
+  [[ -f "$f" ]] || { printf "%-42s absent\n" "$d" | tee -a "$t1" >> "$t2"; continue; }
   name="$(basename "$d")"; name="${name%%.*}"
-  t0=$(now)
-  "$URBANSLAM" graph "$f" --json --out "$work/$name.esdf.g2o" > "$work/$name.json"
-  t1=$(now)
-  chi2_u=$(sed -E 's/.*"chi2":([^,]*).*/\1/' "$work/$name.json")
-  poses=$(sed -E 's/.*"poses":([^,]*).*/\1/' "$work/$name.json")
-  edges=$(sed -E 's/.*"edges":([^,]*).*/\1/' "$work/$name.json")
-  # The thesis filter (every edge linearised once) for comparison: the effect of relinearisation.
+  : > "$work/tu"; : > "$work/tc"
+  for ((r = 0; r < REPEAT; ++r)); do
+    a=$(now)
+    "$URBANSLAM" graph "$f" --json --out "$work/$name.esdf.g2o" > "$work/$name.json"
+    b=$(now)
+    "$CERES_TOOL" "$f" --out "$work/$name.ceres.g2o" > "$work/$name.ceres.json"
+    c=$(now)
+    echo "$b - $a" | bc -l >> "$work/tu"
+    echo "$c - $b" | bc -l >> "$work/tc"
+  done
+  tu=$(median < "$work/tu"); tc=$(median < "$work/tc")
+  total_u=$(echo "$total_u + $tu" | bc -l); total_c=$(echo "$total_c + $tc" | bc -l)
+  chi2_u=$(json chi2 "$work/$name.json"); poses=$(json poses "$work/$name.json"); edges=$(json edges "$work/$name.json")
+  chi2_c=$(json chi2 "$work/$name.ceres.json"); iters=$(json iterations "$work/$name.ceres.json")
+  # The thesis filter (every edge linearised once): the effect of relinearisation.
   chi2_once=$("$URBANSLAM" graph "$f" --json --no-relinearise | sed -E 's/.*"chi2":([^,]*).*/\1/')
+  ratio=$(awk -v a="$chi2_u" -v b="$chi2_c" 'BEGIN{ printf "%.4f", a / b }')
+  speed=$(awk -v a="$tu" -v b="$tc" 'BEGIN{ printf "%.1fx", b / a }')
+  printf "%-42s %6s %6s | %14.4f %8.3f | %14.4f %8.3f %5s | %8s %7s | %14.4f\n" "$d" "$poses" "$edges" \
+    "$chi2_u" "$tu" "$chi2_c" "$tc" "$iters" "$ratio" "$speed" "$chi2_once" >> "$t1"
+
   "$ESDF_TOOL" --init "$f" "$work/$name.init.g2o"
-  t2=$(now)
+  a=$(now)
   rc=0
   "$GRAPH_SLAM" --2d --levmarq -i "$work/$name.init.g2o" -o "$work/$name.mrpt.g2o" > "$work/$name.mrpt.log" 2>&1 || rc=$?
-  t3=$(now)
+  b=$(now)
+  tm=$(echo "$b - $a" | bc -l)
   if [[ $rc -eq 0 && -f "$work/$name.mrpt.g2o" ]]; then
     chi2_m=$("$ESDF_TOOL" --eval "$f" "$work/$name.mrpt.g2o")
     uw_m=$("$ESDF_TOOL" --eval "$work/$name.mrpt.g2o" "$work/$name.mrpt.g2o")
@@ -76,10 +108,28 @@ for d in "${datasets[@]}"; do
   else
     chi2_m=nan; uw_m=nan; uw_u=nan
   fi
-  tu=$(echo "$t1 - $t0" | bc -l); tm=$(echo "$t3 - $t2" | bc -l)
   ratio=$(awk -v a="$chi2_u" -v b="$chi2_m" 'BEGIN{ if (b == "nan" || b + 0 == 0) print "n/a"; else printf "%.4f", a / b }')
   speed=$(awk -v a="$tu" -v b="$tm" 'BEGIN{ printf "%.1fx", b / a }')
   uw_ratio=$(awk -v a="$uw_u" -v b="$uw_m" 'BEGIN{ if (b == "nan" || b + 0 == 0) print "n/a"; else printf "%.4f", a / b }')
-  printf "%-42s %6s %6s | %14.4f %8.3f | %14s %8.3f %6s | %9s %7s | %14.4f | %12.6g %12.6g %9s\n" "$d" "$poses" "$edges" \
-    "$chi2_u" "$tu" "$chi2_m" "$tm" "$rc" "$ratio" "$speed" "$chi2_once" "$uw_u" "$uw_m" "$uw_ratio"
+  printf "%-42s | %14.4f %8.3f | %14s %8.3f %3s | %9s %7s | %12.6g %12.6g %9s\n" "$d" \
+    "$chi2_u" "$tu" "$chi2_m" "$tm" "$rc" "$ratio" "$speed" "$uw_u" "$uw_m" "$uw_ratio" >> "$t2"
+
+  if [[ -n "${gt:-}" && -f "$DATA/$gt" ]]; then
+    read -r ate_u hdg_u matched < <("$ESDF_TOOL" --error "$DATA/$gt" "$work/$name.esdf.g2o")
+    read -r ate_c hdg_c _ < <("$ESDF_TOOL" --error "$DATA/$gt" "$work/$name.ceres.g2o")
+    ate_m=nan; hdg_m=nan
+    [[ $rc -eq 0 ]] && read -r ate_m hdg_m _ < <("$ESDF_TOOL" --error "$DATA/$gt" "$work/$name.mrpt.g2o")
+    printf "%-42s %6s | %10.4f %9.4f | %10.4f %9.4f | %10s %9s\n" "$d" "$matched" \
+      "$ate_u" "$hdg_u" "$ate_c" "$hdg_c" "$ate_m" "$hdg_m" >> "$t3"
+  fi
 done
+printf "%-42s %13s | %14s %8.3f | %14s %8.3f %5s | %8s %7s |\n" "total (sum of medians)" "" "" "$total_u" "" "$total_c" "" "" \
+  "$(awk -v a="$total_u" -v b="$total_c" 'BEGIN{ printf "%.1fx", b / a }')" >> "$t1"
+echo "urbanslam vs Ceres (weighted batch optimum); times: median of $REPEAT runs"
+cat "$t1"
+echo
+echo "urbanslam vs MRPT graph-slam (unweighted LM, see header)"
+cat "$t2"
+echo
+echo "error against ground truth (rigid alignment)"
+cat "$t3"

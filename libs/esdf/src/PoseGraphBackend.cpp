@@ -58,6 +58,7 @@ PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBa
 
   int pending = 0;
   int last_full_size = 1;
+  int previous_closure = 0;  // the last pose that received a loop closure
   for (int k = 1; k < n; ++k) {
     const int b0 = bucket_start[k], b1 = bucket_start[k + 1];
     // The augmenting edge: to the previous pose when there is one, else the first edge.
@@ -131,9 +132,13 @@ PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBa
           ++res.full_recoveries;
           pending = 0;
         } else {
-          filter.recoverRecent(k - opt.recent_window_poses);
+          int first = k - opt.recent_window_poses;
+          if (opt.window_from_previous_closure)
+            first = std::max(std::min(first, previous_closure - opt.recent_window_poses), k - opt.max_window_poses);
+          filter.recoverRecent(first, opt.window_relinearise_passes);
           ++res.partial_recoveries;
         }
+        previous_closure = k;
       }
       res.step_ms.push_back(sw.milliseconds());
     }

@@ -33,6 +33,16 @@ struct PoseGraphBackendOptions {
   int incremental_relinearise_passes = 1;
   // Poses re-solved by the partial recovery after a loop closure that did not trigger a full one.
   int recent_window_poses = 50;
+  // The partial recovery also reaches back to recent_window_poses before the previous loop
+  // closure: the poses since then are dead reckoned, and the new closure's correction belongs
+  // to all of them, not only to the last recent_window_poses (squeezing it into those leaves
+  // the older stretch drifted, and later closures to it are then linearised far from the
+  // optimum). At most max_window_poses, so the step cost stays bounded by the length of a
+  // stretch without closures, not by the trajectory.
+  bool window_from_previous_closure = false;
+  int max_window_poses = 2000;
+  // Relinearise + re-solve rounds of the window in each partial recovery (local Gauss-Newton).
+  int window_relinearise_passes = 0;
   // Only the augmenting edges (dead reckoning through the spanning edges; for initial guesses).
   bool dead_reckoning_only = false;
   // Pose 0's prior (anchors the gauge freedom, as fixing the first vertex does in g2o).
