@@ -42,6 +42,8 @@ int graphCommand(const Argv& args) {
   ap.addOption("full-every", "N", "full recovery after N loop closures", "20");
   ap.addOption("innovation-chi2", "X", "full recovery at once after a closure with innovation chi2 above X", "50");
   ap.addOption("min-gap", "F", "full recoveries at least F * poses apart (amortises their cost)", "0.25");
+  ap.addOption("heading-innovation", "RAD",
+               "full recovery (whatever --min-gap says) before a closure whose heading innovation exceeds RAD", "1.0");
   ap.addOption("window", "W", "poses re-solved by the partial recovery after other loop closures", "50");
   ap.addEpilog("Example:\n  urbanslam graph manhattan.g2o --out manhattan_opt.g2o --json\n"
                "JSON keys: chi2, poses, edges, time_s (read + filter), read_s, filter_s, step_ms_p50,\n"
@@ -62,6 +64,9 @@ int graphCommand(const Argv& args) {
   o.full_recovery_innovation_chi2 = ap.optionDouble("innovation-chi2");
   o.full_recovery_min_gap_fraction = ap.optionDouble("min-gap");
   o.recent_window_poses = static_cast<int>(ap.optionInt("window"));
+  o.full_recovery_heading_innovation_rad = ap.optionDouble("heading-innovation");
+  if (!(o.full_recovery_heading_innovation_rad > 0))
+    throw common::InputError("--heading-innovation: must be > 0");
   if (o.full_recovery_every_closures < 1) throw common::InputError("--full-every: must be >= 1");
   if (o.recent_window_poses < 0) throw common::InputError("--window: must be >= 0");
   if (o.full_recovery_min_gap_fraction < 0) throw common::InputError("--min-gap: must be >= 0");
@@ -99,6 +104,8 @@ int graphCommand(const Argv& args) {
   j["partial_recoveries"] = r.partial_recoveries;
   j["factors_relinearised"] = r.factors_relinearised;
   j["final_relinearise_passes"] = r.final_relinearise_passes;
+  j["heading_triggered_recoveries"] = r.heading_triggered_recoveries;
+  j["large_heading_innovations"] = r.large_heading_innovations;
   j["converged"] = r.converged;
   j["relinearise"] = o.filter.relinearise;
   j["gate"] = o.gate_loop_closures;

@@ -13,8 +13,8 @@
 //     that factorisation: exact (refactorise + column solves) / conservative (old factor + dead
 //     reckoning, no refactorisation).
 // Usage: esdf_bench [--no-full-above N] [--ordering amd|metis|auto|natural] [--backend N]...
-//                   [--final-passes P] [--min-gap F] [--incremental-passes P] [--window-passes P]
-//                   [--window-from-closure 0|1] [--max-window W] SIZE...
+//                   [--final-passes P] [--min-gap F] [--incremental-passes P] [--heading-recovery RAD]
+//                   SIZE...
 //        esdf_bench --write-graph N PREFIX   (the back end's drive as PREFIX.g2o + PREFIX.truth.g2o)
 //   (default sizes 1000 10000 100000 1000000; each --backend N also runs the pose-graph back end,
 //   with its recovery policy, on the same drive of N poses)
@@ -195,7 +195,7 @@ void writeGraph(long n, const std::string& prefix) {
 int g_final_passes = -1;
 double g_min_gap = -1;
 int g_incremental_passes = -1;
-int g_window_passes = -1, g_max_window = -1, g_window_from_closure = -1;
+double g_heading_recovery = -1;
 
 void runBackend(const std::vector<long>& sizes) {
   std::printf("\nback end (urbanslam graph's policy: partial recovery after closures, amortised full recoveries,\n"
@@ -208,14 +208,15 @@ void runBackend(const std::vector<long>& sizes) {
     if (g_final_passes >= 0) o.filter.relinearise_max_passes = g_final_passes;
     if (g_min_gap >= 0) o.full_recovery_min_gap_fraction = g_min_gap;
     if (g_incremental_passes >= 0) o.incremental_relinearise_passes = g_incremental_passes;
-    if (g_window_passes >= 0) o.window_relinearise_passes = g_window_passes;
-    if (g_max_window >= 0) o.max_window_poses = g_max_window;
-    if (g_window_from_closure >= 0) o.window_from_previous_closure = g_window_from_closure != 0;
+    if (g_heading_recovery >= 0) o.full_recovery_heading_innovation_rad = g_heading_recovery;
     const auto r = esdf::runPoseGraphBackend(graph, o);
     std::printf("%9ld %8d | %9.4f %9.4f %9.1f | %8d %8d | %9.3f %9.3f | %12.3f %s\n", n, r.edges,
                 common::percentile(r.step_ms, 50), common::percentile(r.step_ms, 99), common::percentile(r.step_ms, 100),
                 r.full_recoveries, r.partial_recoveries, r.time_s, r.recovery_s, r.chi2,
                 r.converged ? "(converged)" : "(not converged)");
+    std::printf("          closures with heading innovation > pi/2 when added: %d (max %.3f rad); "
+                "full recoveries forced by the heading innovation: %d\n",
+                r.large_heading_innovations, r.max_heading_innovation_rad, r.heading_triggered_recoveries);
     std::fflush(stdout);
   }
 }
@@ -235,9 +236,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[a], "--final-passes") && a + 1 < argc) g_final_passes = std::atoi(argv[++a]);
     else if (!std::strcmp(argv[a], "--min-gap") && a + 1 < argc) g_min_gap = std::atof(argv[++a]);
     else if (!std::strcmp(argv[a], "--incremental-passes") && a + 1 < argc) g_incremental_passes = std::atoi(argv[++a]);
-    else if (!std::strcmp(argv[a], "--window-passes") && a + 1 < argc) g_window_passes = std::atoi(argv[++a]);
-    else if (!std::strcmp(argv[a], "--max-window") && a + 1 < argc) g_max_window = std::atoi(argv[++a]);
-    else if (!std::strcmp(argv[a], "--window-from-closure") && a + 1 < argc) g_window_from_closure = std::atoi(argv[++a]);
+    else if (!std::strcmp(argv[a], "--heading-recovery") && a + 1 < argc) g_heading_recovery = std::atof(argv[++a]);
     else if (!std::strcmp(argv[a], "--ordering") && a + 1 < argc) {
       const std::string o = argv[++a];
       g_ordering = o == "metis" ? esdf::FillReducingOrdering::Metis

@@ -1,7 +1,8 @@
 // esdf_pose_graph: runs the ESDF back end on pose-graph files with tunable recovery settings
 // and prints one line per file (chi2, time, recoveries). For tuning and quick comparisons; the
 // user-facing tool is `urbanslam graph`.
-//   esdf_pose_graph [--every N] [--innov CHI2] [--window W] [--passes P] [--no-relin] FILE...
+//   esdf_pose_graph [--every N] [--innov CHI2] [--window W] [--passes P] [--no-relin] [--gap F]
+//                   [--heading RAD] FILE...
 //   esdf_pose_graph --eval EDGES_FILE POSES_FILE   chi2 of EDGES_FILE's edges at POSES_FILE's vertices
 //   esdf_pose_graph --init IN OUT                  IN with dead-reckoned vertices (for batch tools
 //                                                  that need VERTEX lines), written as g2o
@@ -66,6 +67,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[a], "--auto")) o.filter.ordering = esdf::FillReducingOrdering::Auto;
     else if (!std::strcmp(argv[a], "--conservative")) o.filter.gate_covariance = esdf::CovarianceMode::Conservative;
     else if (!std::strcmp(argv[a], "--gap")) o.full_recovery_min_gap_fraction = std::atof(next());
+    else if (!std::strcmp(argv[a], "--heading")) o.full_recovery_heading_innovation_rad = std::atof(next());
     else {
       try {
         common::Stopwatch sw;

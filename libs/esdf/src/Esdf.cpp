@@ -310,18 +310,14 @@ double Esdf::cost() const {
   return c;
 }
 
-long long Esdf::relineariseMoved() { return relineariseMovedSince(0); }
-
-long long Esdf::relineariseMovedSince(int first) {
+long long Esdf::relineariseMoved() {
   const double tm = options_.relinearise_threshold_m, tr = options_.relinearise_threshold_rad;
   auto moved = [&](int p, const Vec3& lin) {
     const Vec3 d = state_.mean(p) - lin;
     return d.head<2>().norm() > tm || std::fabs(d.z()) > tr;
   };
   long long count = 0;
-  const size_t from = first <= 0 ? 0 : static_cast<size_t>(first_factor_of_pose_[static_cast<size_t>(first)]);
-  for (size_t k = from; k < factors_.size(); ++k) {
-    Factor& f = factors_[k];
+  for (Factor& f : factors_) {
     if (!moved(f.a, f.lin_a) && (f.b < 0 || !moved(f.b, f.lin_b))) continue;
     apply(f, -1.0);
     f.lin_a = state_.mean(f.a);
@@ -332,24 +328,21 @@ long long Esdf::relineariseMovedSince(int first) {
   return count;
 }
 
-void Esdf::recoverRecent(int first, int relinearise_passes) {
+void Esdf::recoverRecent(int first) {
   const int n = size();
   if (first <= 0) first = 0;
   if (first >= n) return;
-  for (int pass = 0;; ++pass) {
-    // Lambda_RR mu_R = eta_R - Lambda_RO mu_O, with O the poses before `first`.
-    Eigen::VectorXd rhs(3 * (n - first));
-    for (int p = first; p < n; ++p) {
-      Vec3 r = state_.eta(p);
-      for (const auto& l : state_.links(p))
-        if (l.other < first) r -= l.block * state_.mean(l.other);
-      rhs.segment<3>(3 * (p - first)) = r;
-    }
-    window_factor_.factorize(state_, first, n);
-    const Eigen::VectorXd mu = window_factor_.solve(rhs);
-    for (int p = first; p < n; ++p) state_.setMean(p, mu.segment<3>(3 * (p - first)));
-    if (pass >= relinearise_passes || !options_.relinearise || relineariseMovedSince(first) == 0) break;
+  // Lambda_RR mu_R = eta_R - Lambda_RO mu_O, with O the poses before `first`.
+  Eigen::VectorXd rhs(3 * (n - first));
+  for (int p = first; p < n; ++p) {
+    Vec3 r = state_.eta(p);
+    for (const auto& l : state_.links(p))
+      if (l.other < first) r -= l.block * state_.mean(l.other);
+    rhs.segment<3>(3 * (p - first)) = r;
   }
+  window_factor_.factorize(state_, first, n);
+  const Eigen::VectorXd mu = window_factor_.solve(rhs);
+  for (int p = first; p < n; ++p) state_.setMean(p, mu.segment<3>(3 * (p - first)));
 }
 
 Mat3 Esdf::covarianceColumnsBlock(int i, Eigen::MatrixXd* columns) {

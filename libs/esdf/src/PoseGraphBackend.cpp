@@ -2,6 +2,7 @@
 
 #include <Eigen/LU>
 #include <algorithm>
+#include <cmath>
 #include <unordered_map>
 
 #include "urbanslam/common/Error.h"
@@ -58,7 +59,6 @@ PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBa
 
   int pending = 0;
   int last_full_size = 1;
-  int previous_closure = 0;  // the last pose that received a loop closure
   for (int k = 1; k < n; ++k) {
     const int b0 = bucket_start[k], b1 = bucket_start[k + 1];
     // The augmenting edge: to the previous pose when there is one, else the first edge.
@@ -110,6 +110,22 @@ PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBa
           accepted = gr.accepted;
         }
         ++res.observation_edges;
+        if (accepted) {
+          double dh = std::fabs(relativePoseError(filter.mean(a), filter.mean(b), e.measurement).z());
+          if (dh > opt.full_recovery_heading_innovation_rad && pending > 0) {
+            // The estimate is too stale to linearise this closure on the right branch: bring
+            // it up to date first (whatever the spacing of full recoveries says).
+            const RecoveryStats st = filter.recover(opt.incremental_relinearise_passes);
+            res.recovery_s += st.seconds;
+            res.factors_relinearised += st.factors_relinearised;
+            ++res.full_recoveries;
+            ++res.heading_triggered_recoveries;
+            pending = 0;
+            dh = std::fabs(relativePoseError(filter.mean(a), filter.mean(b), e.measurement).z());
+          }
+          res.max_heading_innovation_rad = std::max(res.max_heading_innovation_rad, dh);
+          if (dh > M_PI / 2) ++res.large_heading_innovations;
+        }
         ObservationResult r;
         r.accepted = accepted;
         if (accepted) r = filter.observeRelative(a, b, e.measurement, e.information, false);
@@ -132,13 +148,9 @@ PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBa
           ++res.full_recoveries;
           pending = 0;
         } else {
-          int first = k - opt.recent_window_poses;
-          if (opt.window_from_previous_closure)
-            first = std::max(std::min(first, previous_closure - opt.recent_window_poses), k - opt.max_window_poses);
-          filter.recoverRecent(first, opt.window_relinearise_passes);
+          filter.recoverRecent(k - opt.recent_window_poses);
           ++res.partial_recoveries;
         }
-        previous_closure = k;
       }
       res.step_ms.push_back(sw.milliseconds());
     }

@@ -107,11 +107,7 @@ class Esdf {
   // (halved) while it would increase cost().
   RecoveryStats recover(int max_relinearise_passes = -1);
   // Partial recovery of poses [first, size()) with the older poses held at their current mean.
-  // With relinearise_passes > 0 (and options().relinearise), the factors that touch the window
-  // and whose poses moved are re-linearised and the window re-solved, up to that many times: a
-  // local Gauss-Newton whose cost depends on the window only (those factors are the tail of the
-  // factor list, as every factor is added with its later pose).
-  void recoverRecent(int first, int relinearise_passes = 0);
+  void recoverRecent(int first);
 
   // Marginal covariance of pose i and joint covariance of (x_i, x_j) (6x6, i's block first).
   Mat3 marginalCovariance(int i, CovarianceMode mode = CovarianceMode::Exact);
@@ -132,8 +128,6 @@ class Esdf {
   // Re-linearises every factor whose poses moved beyond the thresholds; returns their number.
   // recover() calls it; exposed for tests and experiments.
   long long relineariseMoved();
-  // The same for the factors added since pose `first` was created (those touching [first, n)).
-  long long relineariseMovedSince(int first);
 
  private:
   struct Factor {

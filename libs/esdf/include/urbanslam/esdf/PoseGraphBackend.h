@@ -23,6 +23,11 @@ struct PoseGraphBackendOptions {
   // ...or at once when a closure's innovation chi2 e' Omega e exceeds this (the estimate is far
   // from what the closure says, so deferring would linearise later closures badly).
   double full_recovery_innovation_chi2 = 50.0;
+  // A closure whose heading innovation exceeds this (rad) is preceded by a full recovery,
+  // whatever the spacing below says, when closures were added since the last one: linearised
+  // on an estimate that stale, its wrapped heading error may pick the wrong branch (a 2*pi
+  // twist no later Gauss-Newton step undoes).
+  double full_recovery_heading_innovation_rad = 1.0;
   // ...but never sooner than this fraction of the trajectory after the previous one: full
   // recoveries then come at geometrically spaced sizes, so their total cost stays a small
   // multiple of one recovery of the final graph however many loop closures there are.
@@ -33,16 +38,6 @@ struct PoseGraphBackendOptions {
   int incremental_relinearise_passes = 1;
   // Poses re-solved by the partial recovery after a loop closure that did not trigger a full one.
   int recent_window_poses = 50;
-  // The partial recovery also reaches back to recent_window_poses before the previous loop
-  // closure: the poses since then are dead reckoned, and the new closure's correction belongs
-  // to all of them, not only to the last recent_window_poses (squeezing it into those leaves
-  // the older stretch drifted, and later closures to it are then linearised far from the
-  // optimum). At most max_window_poses, so the step cost stays bounded by the length of a
-  // stretch without closures, not by the trajectory.
-  bool window_from_previous_closure = false;
-  int max_window_poses = 2000;
-  // Relinearise + re-solve rounds of the window in each partial recovery (local Gauss-Newton).
-  int window_relinearise_passes = 0;
   // Only the augmenting edges (dead reckoning through the spanning edges; for initial guesses).
   bool dead_reckoning_only = false;
   // Pose 0's prior (anchors the gauge freedom, as fixing the first vertex does in g2o).
@@ -59,6 +54,11 @@ struct PoseGraphBackendResult {
   long long factors_relinearised = 0;
   int final_relinearise_passes = 0;
   bool converged = false;        // the final relinearisation ended with nothing left to relinearise
+  // Loop closures whose heading innovation (at the estimate when they were added) exceeded
+  // pi/2, and the largest one: a closure linearised that far off may land on the wrong branch.
+  int large_heading_innovations = 0;
+  int heading_triggered_recoveries = 0;  // full recoveries forced by full_recovery_heading_innovation_rad
+  double max_heading_innovation_rad = 0;
   std::vector<double> step_ms;   // processing time of each edge (recovery charged to the last edge of a step)
   double time_s = 0;             // filter time (excludes reading the file)
   double recovery_s = 0;         // of which full recoveries
