@@ -60,6 +60,8 @@ int evalCommand(const Argv& args) {
   ap.addFlag("json", "print the figures as one JSON object");
   if (!ap.parse(args)) return 0;
   if (!ap.has("relations") && !ap.has("reference")) throw common::InputError("give --relations FILE and/or --reference FILE");
+  const double max_gap = ap.optionDouble("max-gap");
+  if (!(max_gap > 0)) throw common::InputError("--max-gap: must be a positive number of seconds");
   const fs::path dir = ap.positional("RUN_DIR");
   const fs::path traj_path = dir / "trajectory_odometry.tum";
   if (!fs::exists(traj_path)) throw common::InputError(traj_path.string() + ": missing (not a run folder?)");
@@ -81,8 +83,6 @@ int evalCommand(const Argv& args) {
       for (const auto& p : estimate) log_times.push_back(p.timestamp);
       offset = slam::findRelationTimeOffset(reference.empty() ? estimate : reference, rel, log_times);
     }
-    const double max_gap = ap.optionDouble("max-gap");
-    if (!(max_gap > 0)) throw common::InputError("--max-gap: must be a positive number of seconds");
     const auto m = slam::relationMetrics(estimate, rel, offset, max_gap);
     common::Json& r = j["relations"];
     r["file"] = ap.option("relations");

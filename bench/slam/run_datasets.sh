@@ -40,14 +40,13 @@ datasets=(
 )
 
 now() { date +%s.%N; }
-row() {  # system dataset evaljson wall duration [statsjson]
+row() {  # system dataset evaljson wall duration
   python3 - "$@" <<'PY'
 import json, sys
 system, name, ev, wall, dur = sys.argv[1:6]
 j = json.load(open(ev)); r = j.get('relations', {})
-loops = j.get('loops_accepted'); false = j.get('loops_false')
-if len(sys.argv) > 6 and system != 'urbanslam':
-    loops = false = None
+# Closures exist (loop_closures.csv) only in urbanslam's own run folder.
+loops, false = (j.get('loops_accepted'), j.get('loops_false')) if system == 'urbanslam' else (None, None)
 f = lambda v, fmt: (fmt % v) if v is not None else '-'
 ate = j.get('ate_rmse_m') if j.get('matched', 0) > 0 else None
 print(f"{name:14s} {system:15s} {f(r.get('used'), '%5d'):>5s} {f(r.get('abs_trans_mean_m'), '%8.4f'):>8s} {f(r.get('abs_rot_mean_deg'), '%7.3f'):>7s} "
@@ -70,7 +69,7 @@ for d in "${datasets[@]}"; do
   cp "$o/urbanslam/trajectory_keyframes.tum" "$o/urbanslam-scan/trajectory_odometry.tum"
   [[ -f $o/urbanslam/reference.tum ]] && cp "$o/urbanslam/reference.tum" "$o/urbanslam-scan/"
   $U eval "$o/urbanslam-scan" "${R[@]}" --max-gap 10 --reference "$log" --json > "$o/urbanslam-scan.eval.json"
-  row urbanslam@scan "$name" "$o/urbanslam-scan.eval.json" "$(python3 -c "print($t1 - $t0)")" "$dur" x
+  row urbanslam@scan "$name" "$o/urbanslam-scan.eval.json" "$(python3 -c "print($t1 - $t0)")" "$dur"
   # icp-slam on the same log, as an action/sensory-frame rawlog
   p=$o/icp-slam; mkdir -p "$p"
   $U convert "$log" "$p/log.rawlog" --layout frames --quiet > /dev/null
@@ -99,5 +98,5 @@ with open(p + '/trajectory_odometry.tum', 'w') as f:
 PY
   [[ -f $o/urbanslam/reference.tum ]] && cp "$o/urbanslam/reference.tum" "$p/"
   $U eval "$p" "${R[@]}" --max-gap 10 --reference "$log" --json > "$o/icp-slam.eval.json"
-  row icp-slam "$name" "$o/icp-slam.eval.json" "$(python3 -c "print($t1 - $t0)")" "$dur" x
+  row icp-slam "$name" "$o/icp-slam.eval.json" "$(python3 -c "print($t1 - $t0)")" "$dur"
 done

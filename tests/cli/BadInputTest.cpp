@@ -91,3 +91,11 @@ TEST(BadInput, IniAndOutputFolder) {
   writeFile(d / "a_file", "x");
   expectBadInput("run --quiet --out " + (d / "a_file" / "sub").string() + log, "cannot create the output folder");
 }
+
+TEST(BadInput, EvalArguments) {
+  const fs::path d = scratchDir("bad_eval");
+  const std::string rel = " --relations " + repoPath("rawlogs/intel-corrected-excerpt.log.gz");
+  expectBadInput("eval " + d.string(), "give --relations FILE and/or --reference FILE");
+  expectBadInput("eval " + d.string() + rel + " --max-gap 0", "--max-gap: must be a positive number of seconds");
+  expectBadInput("eval " + (d / "no-run").string() + rel, "trajectory_odometry.tum: missing (not a run folder?)");
+}
