@@ -28,6 +28,10 @@
 # Usage: bench/esdf/run_pose_graphs.sh [BUILD_DIR]   (default build dir: build)
 #   env URBANSLAM=...  ESDF_TOOL=...  CERES_TOOL=...  GRAPH_SLAM=...  DATA=dir  REPEAT=3
 set -euo pipefail
+# One core for every peer: Debian's CHOLMOD (used by urbanslam and by Ceres's sparse Cholesky)
+# opens OpenMP parallel regions inside its factorisation; urbanslam keeps them on the calling
+# thread itself, this makes the peers do the same (Ceres runs with num_threads = 1 anyway).
+export OMP_THREAD_LIMIT=1
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(cd "$here/../.." && pwd)"
 build="${1:-$root/build}"

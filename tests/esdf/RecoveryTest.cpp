@@ -7,6 +7,7 @@
 #include <memory>
 #include <tuple>
 
+#include "urbanslam/esdf/EnvelopeCholesky.h"
 #include "urbanslam/esdf/Esdf.h"
 
 namespace urbanslam::esdf {
@@ -61,6 +62,49 @@ TEST(Recovery, PartialRecoveryEqualsDenseConditionalSolve) {
   f.recoverRecent(first);
   EXPECT_LT((f.state().denseMean().tail(r) - ref).cwiseAbs().maxCoeff(), 1e-9);
   EXPECT_LT((f.state().denseMean().head(3 * first) - mu.head(3 * first)).norm(), 1e-15);  // older poses untouched
+}
+
+TEST(Recovery, EnvelopeCholeskySolvesEveryWindowLikeDenseLlt) {
+  // Windows with links leaving them (ignored), short in-window loops and, for first = 0, a link
+  // from the newest to the oldest pose (the dense worst case of the envelope).
+  std::mt19937 rng(33);
+  EsdfOptions o;
+  o.relinearise = false;
+  Esdf f(o);
+  buildGraph(f, rng, 50, 15);
+  f.observeRelative(0, 49, between(f.mean(0), f.mean(49)), kLoopInfo);
+  const Eigen::MatrixXd lambda = f.state().denseInformation();
+  for (int first : {0, 1, 17, 35, 49}) {
+    const int r = 3 * (f.size() - first);
+    const Eigen::VectorXd b = Eigen::VectorXd::Random(r);
+    EnvelopeCholesky env;
+    env.factorize(f.state(), first, f.size());
+    const Eigen::VectorXd ref = lambda.bottomRightCorner(r, r).llt().solve(b);
+    EXPECT_LT((env.solve(b) - ref).cwiseAbs().maxCoeff() / ref.cwiseAbs().maxCoeff(), 1e-10) << "first " << first;
+  }
+  // The envelope from the dense matrix: row p holds blocks from its first non-zero one to p.
+  size_t envelope = 0;
+  for (int p = 0; p < f.size(); ++p) {
+    int lo = 0;
+    while (lo < p && blk(lambda, p, lo).cwiseAbs().maxCoeff() == 0) ++lo;
+    envelope += static_cast<size_t>(p - lo + 1);
+  }
+  EnvelopeCholesky whole;
+  whole.factorize(f.state(), 0, f.size());
+  EXPECT_EQ(whole.storedBlocks(), envelope);
+  EXPECT_GE(whole.storedBlocks(), 50u + 49u);  // row 49 reaches pose 0
+}
+
+TEST(Recovery, EnvelopeCholeskyRejectsAnUnanchoredWindow) {
+  InformationState s;
+  s.addPose(Vec3::Zero());
+  s.addPose(Vec3::Zero());
+  s.addDiagonal(0, Mat3::Identity());
+  s.addDiagonal(1, Mat3::Identity());
+  s.addBlock(0, 1, -Mat3::Identity());  // [I -I; -I I]: singular
+  EnvelopeCholesky env;
+  EXPECT_THROW(env.factorize(s, 0, 2), std::runtime_error);
+  EXPECT_THROW(env.factorize(s, 1, 1), std::invalid_argument);
 }
 
 TEST(Recovery, MarginalsAndPairsEqualDenseInverse) {

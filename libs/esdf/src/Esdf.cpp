@@ -10,7 +10,7 @@
 namespace urbanslam::esdf {
 
 Esdf::Esdf(EsdfOptions options)
-    : options_(options), full_factor_(options.ordering), window_factor_(options.ordering) {}
+    : options_(options), full_factor_(options.ordering) {}
 Esdf::~Esdf() = default;
 
 void Esdf::reserve(int poses) {
@@ -47,31 +47,47 @@ Esdf::Linearisation Esdf::linearise(const Factor& f, const Vec3& xa, const Vec3&
       break;
     }
     case Factor::Kind::Relative:
-      l.e0 = relativePoseError(xa, xb, f.z);
-      relativePoseErrorJacobians(xa, xb, f.z, &l.a_a, &l.a_b);
+      l.e0 = relativePoseError(xa, xb, f.z, &l.a_a, &l.a_b);
       l.w = f.weight;
       break;
   }
   return l;
 }
 
-void Esdf::apply(const Factor& f, double sign) {
+Esdf::Contribution Esdf::contribution(const Factor& f) const {
   const Linearisation l = linearise(f, f.lin_a, f.lin_b);
   // Linear model e(x) ~ A x - c with c = A lin - e0: Lambda += A' W A, eta += A' W c.
+  Contribution c;
+  const Mat3 atw = l.a_a.transpose() * l.w;
+  c.aa = atw * l.a_a;
   if (f.kind == Factor::Kind::Prior) {
-    const Mat3 atw = l.a_a.transpose() * l.w;
-    state_.addDiagonal(f.a, sign * atw * l.a_a);
-    state_.addEta(f.a, sign * atw * (l.a_a * f.lin_a - l.e0));
-  } else {
-    const Vec3 wc = l.w * (l.a_a * f.lin_a + l.a_b * f.lin_b - l.e0);
-    const Mat3 atw = l.a_a.transpose() * l.w, btw = l.a_b.transpose() * l.w;
-    state_.addDiagonal(f.a, sign * atw * l.a_a);
-    state_.addDiagonal(f.b, sign * btw * l.a_b);
-    state_.addBlock(f.a, f.b, sign * atw * l.a_b);
-    state_.addEta(f.a, sign * l.a_a.transpose() * wc);
-    state_.addEta(f.b, sign * l.a_b.transpose() * wc);
+    c.eta_a = atw * (l.a_a * f.lin_a - l.e0);
+    return c;
+  }
+  const Vec3 wc = l.w * (l.a_a * f.lin_a + l.a_b * f.lin_b - l.e0);
+  const Mat3 btw = l.a_b.transpose() * l.w;
+  c.bb = btw * l.a_b;
+  c.ab = atw * l.a_b;
+  c.eta_a = l.a_a.transpose() * wc;
+  c.eta_b = l.a_b.transpose() * wc;
+  return c;
+}
+
+void Esdf::add(const Factor& f, const Contribution& c) {
+  state_.addDiagonal(f.a, c.aa);
+  state_.addEta(f.a, c.eta_a);
+  if (f.kind != Factor::Kind::Prior) {
+    state_.addDiagonal(f.b, c.bb);
+    state_.addBlock(f.a, f.b, c.ab);
+    state_.addEta(f.b, c.eta_b);
   }
   markChanged();
+}
+
+void Esdf::apply(const Factor& f, double sign) {
+  Contribution c = contribution(f);
+  if (sign != 1.0) c.scale(sign);
+  add(f, c);
 }
 
 void Esdf::addFactor(Factor f) {
@@ -243,6 +259,7 @@ RecoveryStats Esdf::recover(int max_passes) {
   if (max_passes < 0) max_passes = options_.relinearise_max_passes;
   const int n = size();
   Eigen::VectorXd old(3 * n);
+  double c_known = -1;  // cost at the current mean, once known (relinearising leaves the mean)
   for (int pass = 0;; ++pass) {
     ensureFactor();
     const Eigen::VectorXd mu = full_factor_.solve(state_.denseEta());
@@ -254,7 +271,7 @@ RecoveryStats Esdf::recover(int max_passes) {
     // Gauss-Newton with backtracking: a full step on a badly conditioned or strongly nonlinear
     // graph can increase the cost (and oscillate); halve it until the cost does not increase.
     for (int p = 0; p < n; ++p) old.segment<3>(3 * p) = state_.mean(p);
-    const double c_old = cost();
+    const double c_old = c_known >= 0 ? c_known : cost();
     double alpha = 1.0, c_new = 0;
     for (;;) {
       for (int p = 0; p < n; ++p) state_.setMean(p, old.segment<3>(3 * p) + alpha * (mu.segment<3>(3 * p) - old.segment<3>(3 * p)));
@@ -265,6 +282,11 @@ RecoveryStats Esdf::recover(int max_passes) {
     }
     if (c_new > c_old * (1 + 1e-12))
       for (int p = 0; p < n; ++p) state_.setMean(p, old.segment<3>(3 * p));
+    c_known = c_new > c_old * (1 + 1e-12) ? c_old : c_new;
+    if (pass > 0 && c_old - c_known <= options_.relinearise_cost_tolerance * c_old) {
+      st.converged = true;  // a relinearised step that no longer pays
+      break;
+    }
     if (pass >= max_passes) break;
     const long long moved = relineariseMoved();
     if (moved == 0) {
@@ -310,6 +332,8 @@ double Esdf::cost() const {
   return c;
 }
 
+long long Esdf::relinearise() { return options_.relinearise ? relineariseMoved() : 0; }
+
 long long Esdf::relineariseMoved() {
   const double tm = options_.relinearise_threshold_m, tr = options_.relinearise_threshold_rad;
   auto moved = [&](int p, const Vec3& lin) {
@@ -319,10 +343,13 @@ long long Esdf::relineariseMoved() {
   long long count = 0;
   for (Factor& f : factors_) {
     if (!moved(f.a, f.lin_a) && (f.b < 0 || !moved(f.b, f.lin_b))) continue;
-    apply(f, -1.0);
+    // One update of Lambda and eta with the difference of the two linearisations.
+    Contribution c = contribution(f);
+    c.scale(-1.0);
     f.lin_a = state_.mean(f.a);
     if (f.b >= 0) f.lin_b = state_.mean(f.b);
-    apply(f, +1.0);
+    c.accumulate(contribution(f));
+    add(f, c);
     ++count;
   }
   return count;

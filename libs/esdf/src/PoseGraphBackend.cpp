@@ -11,6 +11,19 @@
 namespace urbanslam::esdf {
 namespace {
 
+// An incremental full recovery: Gauss-Newton steps from the current linearisation, each followed
+// by relinearising the factors of the poses that moved (the next recovery, full or partial,
+// then starts from the fresh linearisation without another factorisation here).
+RecoveryStats incrementalRecovery(Esdf& filter, const PoseGraphBackendOptions& opt) {
+  RecoveryStats st = filter.recover(std::max(0, opt.incremental_relinearise_passes - 1));
+  common::Stopwatch sw;
+  const long long moved = filter.relinearise();
+  st.factors_relinearised += moved;
+  if (moved > 0) ++st.relinearise_passes;
+  st.seconds += sw.seconds();
+  return st;
+}
+
 }  // namespace
 
 PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBackendOptions& opt) {
@@ -100,7 +113,7 @@ PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBa
           GateResult gr = filter.gateRelative(a, b, e.measurement, e.information);
           if (!gr.accepted && pending > 0) {
             // The mean may be stale (recoveries deferred): judge the closure on a fresh one.
-            const RecoveryStats st = filter.recover(opt.incremental_relinearise_passes);
+            const RecoveryStats st = incrementalRecovery(filter, opt);
             res.recovery_s += st.seconds;
             res.factors_relinearised += st.factors_relinearised;
             ++res.full_recoveries;
@@ -115,7 +128,7 @@ PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBa
           if (dh > opt.full_recovery_heading_innovation_rad && pending > 0) {
             // The estimate is too stale to linearise this closure on the right branch: bring
             // it up to date first (whatever the spacing of full recoveries says).
-            const RecoveryStats st = filter.recover(opt.incremental_relinearise_passes);
+            const RecoveryStats st = incrementalRecovery(filter, opt);
             res.recovery_s += st.seconds;
             res.factors_relinearised += st.factors_relinearised;
             ++res.full_recoveries;
@@ -142,7 +155,7 @@ PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBa
         const bool allowed = k + 1 - last_full_size >= opt.full_recovery_min_gap_fraction * last_full_size;
         if (wanted && allowed) {
           last_full_size = k + 1;
-          const RecoveryStats st = filter.recover(opt.incremental_relinearise_passes);
+          const RecoveryStats st = incrementalRecovery(filter, opt);
           res.recovery_s += st.seconds;
           res.factors_relinearised += st.factors_relinearised;
           ++res.full_recoveries;

@@ -5,12 +5,13 @@
 #include <Eigen/Cholesky>
 
 #include <algorithm>
-#include <cerrno>
+#include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <sstream>
+#include <string_view>
 #include <unordered_map>
 
 #include "urbanslam/common/AtomicFile.h"
@@ -36,25 +37,42 @@ std::string readWholeFile(const std::string& path) {
   return out;
 }
 
-// Parses whitespace-separated numbers strictly (no trailing junk inside a token).
-bool parseNumbers(std::istringstream& in, double* out, int count) {
-  std::string tok;
+// Whitespace-separated tokens of one line, without copies (istringstream and strtod made
+// reading ~10 % of a back-end run on the larger graphs).
+class Tokens {
+ public:
+  explicit Tokens(std::string_view line) : rest_(line) {}
+  bool next(std::string_view* tok) {
+    size_t b = 0;
+    while (b < rest_.size() && std::isspace(static_cast<unsigned char>(rest_[b]))) ++b;
+    size_t e = b;
+    while (e < rest_.size() && !std::isspace(static_cast<unsigned char>(rest_[e]))) ++e;
+    *tok = rest_.substr(b, e - b);
+    rest_ = rest_.substr(e);
+    return !tok->empty();
+  }
+
+ private:
+  std::string_view rest_;
+};
+
+// Parses numbers strictly (no trailing junk inside a token, finite values only).
+bool parseNumbers(Tokens& in, double* out, int count) {
+  std::string_view tok;
   for (int k = 0; k < count; ++k) {
-    if (!(in >> tok)) return false;
-    char* end = nullptr;
-    errno = 0;
-    out[k] = std::strtod(tok.c_str(), &end);
-    if (end == tok.c_str() || *end != '\0' || !std::isfinite(out[k])) return false;
+    if (!in.next(&tok)) return false;
+    const char* first = tok.data() + (tok.front() == '+' ? 1 : 0);  // from_chars rejects '+'
+    const auto [end, ec] = std::from_chars(first, tok.data() + tok.size(), out[k]);
+    if (ec != std::errc() || end != tok.data() + tok.size() || !std::isfinite(out[k])) return false;
   }
   return true;
 }
 
-bool parseId(std::istringstream& in, long* id) {
-  std::string tok;
-  if (!(in >> tok)) return false;
-  char* end = nullptr;
-  *id = std::strtol(tok.c_str(), &end, 10);
-  return end != tok.c_str() && *end == '\0' && *id >= 0;
+bool parseId(Tokens& in, long* id) {
+  std::string_view tok;
+  if (!in.next(&tok)) return false;
+  const auto [end, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), *id);
+  return ec == std::errc() && end == tok.data() + tok.size() && *id >= 0;
 }
 
 }  // namespace
@@ -62,23 +80,24 @@ bool parseId(std::istringstream& in, long* id) {
 PoseGraph parsePoseGraph(const std::string& text, const std::string& name) {
   PoseGraph g;
   bool seen_g2o = false, seen_toro = false;
-  std::istringstream lines(text);
-  std::string line;
+  std::string_view rest(text);
   long lineno = 0;
   auto fail = [&](const std::string& what) {
     throw common::InputError(name + ":" + std::to_string(lineno) + ": " + what);
   };
-  while (std::getline(lines, line)) {
+  while (!rest.empty()) {
     ++lineno;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    std::istringstream in(line);
-    std::string tag;
-    if (!(in >> tag) || tag[0] == '#') continue;
+    const size_t eol = std::min(rest.find('\n'), rest.size());
+    const std::string_view line = rest.substr(0, eol);
+    rest = rest.substr(std::min(eol + 1, rest.size()));
+    Tokens in(line);  // '\r' of CRLF files is whitespace to the tokenizer
+    std::string_view tag;
+    if (!in.next(&tag) || tag[0] == '#') continue;
     if (tag == "VERTEX_SE2" || tag == "VERTEX2") {
       (tag == "VERTEX2" ? seen_toro : seen_g2o) = true;
       PoseGraphVertex v;
       double p[3];
-      if (!parseId(in, &v.id) || !parseNumbers(in, p, 3)) fail("malformed " + tag + " line (want: id x y theta)");
+      if (!parseId(in, &v.id) || !parseNumbers(in, p, 3)) fail("malformed " + std::string(tag) + " line (want: id x y theta)");
       v.pose = {p[0], p[1], p[2]};
       g.vertices.push_back(v);
     } else if (tag == "EDGE_SE2" || tag == "EDGE2") {
@@ -87,9 +106,9 @@ PoseGraph parsePoseGraph(const std::string& text, const std::string& name) {
       PoseGraphEdge e;
       double p[9];
       if (!parseId(in, &e.from) || !parseId(in, &e.to) || !parseNumbers(in, p, 9))
-        fail("malformed " + tag + " line (want: from to dx dy dtheta and 6 information entries)");
-      std::string extra;
-      if (in >> extra) fail("trailing data on " + tag + " line");
+        fail("malformed " + std::string(tag) + " line (want: from to dx dy dtheta and 6 information entries)");
+      std::string_view extra;
+      if (in.next(&extra)) fail("trailing data on " + std::string(tag) + " line");
       if (e.from == e.to) fail("edge from a vertex to itself");
       e.measurement = {p[0], p[1], p[2]};
       // g2o: upper triangle row-major, i11 i12 i13 i22 i23 i33. TORO: ff fs ss rr fr sr.

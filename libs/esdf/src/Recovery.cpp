@@ -1,6 +1,7 @@
 #include "urbanslam/esdf/Recovery.h"
 
 #include <cholmod.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <stdexcept>
@@ -8,6 +9,23 @@
 #include <vector>
 
 namespace urbanslam::esdf {
+
+namespace {
+// CHOLMOD (Debian's build) opens OpenMP parallel regions in its numeric factorisation. With no
+// active levels allowed they run on the calling thread: measured on w10000, the thread
+// wake-ups cost ~20 % of the back end's time, and the filter is meant to use one core. The
+// previous setting is restored, so code elsewhere in the process keeps its own parallelism.
+class SerialOpenMp {
+ public:
+  SerialOpenMp() : levels_(omp_get_max_active_levels()) { omp_set_max_active_levels(0); }
+  ~SerialOpenMp() { omp_set_max_active_levels(levels_); }
+  SerialOpenMp(const SerialOpenMp&) = delete;
+  SerialOpenMp& operator=(const SerialOpenMp&) = delete;
+
+ private:
+  int levels_;
+};
+}  // namespace
 
 struct SparseCholesky::Impl {
   cholmod_common common;
@@ -42,31 +60,33 @@ void SparseCholesky::factorize(const InformationState& s, int first, int last) {
   if (first < 0 || last > s.size() || first >= last) throw std::invalid_argument("factorize: bad pose range");
   const int poses = last - first;
   const size_t n = 3 * static_cast<size_t>(poses);
-  // Upper triangle (stype = 1), column by column: for block column p, the blocks Lambda(o, p)
-  // of linked poses o < p in the range (sorted), then the upper part of the diagonal block.
+  // Lower triangle (stype = -1), column by column: for block column p, the lower part of the
+  // diagonal block, then the blocks Lambda(o, p) of linked poses o > p in the range (sorted).
+  // (CHOLMOD's supernodal factorisation transposes a lower-stored matrix once, an upper-stored
+  // one twice.)
   std::vector<int> colptr(n + 1, 0);
   std::vector<int> rowind;
   std::vector<double> values;
   rowind.reserve(n * 6);
   values.reserve(n * 6);
-  std::vector<std::pair<int, const Mat3*>> lower;
+  std::vector<std::pair<int, const Mat3*>> higher;
   for (int p = first; p < last; ++p) {
-    lower.clear();
+    higher.clear();
     for (const auto& l : s.links(p))
-      if (l.other >= first && l.other < p) lower.emplace_back(l.other, &l.block);
-    std::sort(lower.begin(), lower.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+      if (l.other > p && l.other < last) higher.emplace_back(l.other, &l.block);
+    std::sort(higher.begin(), higher.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     const Mat3& d = s.diagonal(p);
     for (int c = 0; c < 3; ++c) {
-      for (const auto& [o, blk] : lower) {
+      for (int r = c; r < 3; ++r) {
+        rowind.push_back(3 * (p - first) + r);
+        values.push_back(d(r, c));
+      }
+      for (const auto& [o, blk] : higher) {
         // Lambda(o, p) = Lambda(p, o)' : entry (row r of o, col c of p) = blk(c, r).
         for (int r = 0; r < 3; ++r) {
           rowind.push_back(3 * (o - first) + r);
           values.push_back((*blk)(c, r));
         }
-      }
-      for (int r = 0; r <= c; ++r) {
-        rowind.push_back(3 * (p - first) + r);
-        values.push_back(d(r, c));
       }
       colptr[3 * (p - first) + c + 1] = static_cast<int>(rowind.size());
     }
@@ -77,7 +97,7 @@ void SparseCholesky::factorize(const InformationState& s, int first, int last) {
   a.p = colptr.data();
   a.i = rowind.data();
   a.x = values.data();
-  a.stype = 1;
+  a.stype = -1;
   a.itype = CHOLMOD_INT;
   a.xtype = CHOLMOD_REAL;
   a.dtype = CHOLMOD_DOUBLE;
@@ -85,6 +105,7 @@ void SparseCholesky::factorize(const InformationState& s, int first, int last) {
   a.packed = 1;
 
   cholmod_common* cm = &impl_->common;
+  const SerialOpenMp serial;
   const bool same_pattern = impl_->factor && colptr == impl_->last_p && rowind == impl_->last_i;
   if (!same_pattern) {
     if (impl_->factor) cholmod_free_factor(&impl_->factor, cm);
@@ -108,6 +129,7 @@ void SparseCholesky::factorize(const InformationState& s, int first, int last) {
 Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& b) const {
   if (!impl_->factor) throw std::logic_error("solve without a factor");
   cholmod_common* cm = &impl_->common;
+  const SerialOpenMp serial;
   Eigen::MatrixXd rhs = b;
   cholmod_dense bd{};
   bd.nrow = static_cast<size_t>(rhs.rows());

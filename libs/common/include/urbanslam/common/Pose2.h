@@ -8,6 +8,7 @@ namespace urbanslam::common {
 
 // Wraps an angle to (-pi, pi].
 inline double wrapToPi(double a) {
+  if (a > -M_PI && a <= M_PI) return a;  // the common case, without the costly fmod
   a = std::fmod(a + M_PI, 2.0 * M_PI);
   if (a <= 0.0) a += 2.0 * M_PI;
   return a - M_PI;

@@ -21,6 +21,7 @@
 #include <memory>
 #include <vector>
 
+#include "urbanslam/esdf/EnvelopeCholesky.h"
 #include "urbanslam/esdf/Gating.h"
 #include "urbanslam/esdf/InformationState.h"
 #include "urbanslam/esdf/MotionModels.h"
@@ -52,6 +53,10 @@ struct EsdfOptions {
   double relinearise_threshold_m = 1e-3;
   double relinearise_threshold_rad = 1e-4;
   int relinearise_max_passes = 20;
+  // ...or until a relinearised Gauss-Newton step lowers cost() by less than this fraction (the
+  // function tolerance of batch solvers; the pose-graph back end uses Ceres's default 1e-6).
+  // 0: stop only when nothing moves past the thresholds.
+  double relinearise_cost_tolerance = 0;
 
   FillReducingOrdering ordering = FillReducingOrdering::Amd;
 };
@@ -65,7 +70,7 @@ struct ObservationResult {
 struct RecoveryStats {
   int relinearise_passes = 0;
   long long factors_relinearised = 0;
-  bool converged = false;  // the last relinearisation pass found nothing to relinearise
+  bool converged = false;  // nothing left to relinearise, or the cost tolerance was reached
   int step_halvings = 0;   // backtracking steps taken (see recover())
   double seconds = 0;
 };
@@ -106,6 +111,9 @@ class Esdf {
   // With relinearisation each solve is a Gauss-Newton step from the current mean, shortened
   // (halved) while it would increase cost().
   RecoveryStats recover(int max_relinearise_passes = -1);
+  // Relinearises the factors whose poses moved past the thresholds since their linearisation
+  // (Lambda and eta updated exactly); returns how many. The mean is left as it is.
+  long long relinearise();
   // Partial recovery of poses [first, size()) with the older poses held at their current mean.
   void recoverRecent(int first);
 
@@ -147,6 +155,15 @@ class Esdf {
   Linearisation linearise(const Factor& f, const Vec3& xa, const Vec3& xb) const;
   // Error of a factor at the current mean and its weight.
   Vec3 factorError(const Factor& f, Mat3* w) const;
+  // A factor's contribution to Lambda (blocks aa, bb, ab) and eta at its linearisation point.
+  struct Contribution {
+    Mat3 aa = Mat3::Zero(), bb = Mat3::Zero(), ab = Mat3::Zero();
+    Vec3 eta_a = Vec3::Zero(), eta_b = Vec3::Zero();
+    void scale(double k) { aa *= k; bb *= k; ab *= k; eta_a *= k; eta_b *= k; }
+    void accumulate(const Contribution& o) { aa += o.aa; bb += o.bb; ab += o.ab; eta_a += o.eta_a; eta_b += o.eta_b; }
+  };
+  Contribution contribution(const Factor& f) const;
+  void add(const Factor& f, const Contribution& c);
   // Adds (sign = +1) or removes (sign = -1) a factor's contribution at its linearisation point.
   void apply(const Factor& f, double sign);
   void addFactor(Factor f);
@@ -164,7 +181,7 @@ class Esdf {
   std::vector<int> first_factor_of_pose_;  // factors_.size() when the pose was created
 
   SparseCholesky full_factor_;
-  SparseCholesky window_factor_;
+  EnvelopeCholesky window_factor_;  // partial recovery of the recent poses
   double gate_probability_ = -1, gate_threshold_ = 0;  // cached chi2 quantile
   std::uint64_t values_stamp_ = 0;          // bumped on every change of Lambda or eta
   std::uint64_t full_factor_values_ = ~std::uint64_t{0};

@@ -41,6 +41,8 @@ inline Vec3 poseDifference(const Vec3& a, const Vec3& b) {
 // error for its observation update: the estimate then converges to the optimum that the
 // batch tools report, not to a slightly different one.
 Vec3 relativePoseError(const Vec3& a, const Vec3& b, const Vec3& z);
+// The same error with de/da and de/db (either may be null), in one evaluation.
+Vec3 relativePoseError(const Vec3& a, const Vec3& b, const Vec3& z, Mat3* ja, Mat3* jb);
 // de/da, de/db of relativePoseError.
 void relativePoseErrorJacobians(const Vec3& a, const Vec3& b, const Vec3& z, Mat3* ja, Mat3* jb);
 
