@@ -111,59 +111,62 @@ double findRelationTimeOffset(const std::vector<io::StampedPose>& reference, con
     // Same time base already when most relations fall inside the trajectory.
     if (relationMetrics(sorted, rel, 0).used > rel.size() / 2) return 0;
   }
-  // Relation times are scan times: try aligning the first relation with every reference time,
-  // keep the offset with the smallest mean error among those that cover most relations.
-  double best = 0, best_err = 1e300;
   std::vector<Relation> sample;
   for (size_t i = 0; i < rel.size(); i += std::max<size_t>(1, rel.size() / 200)) sample.push_back(rel[i]);
-  for (const auto& p : sorted) {
-    const double off = r0 - p.timestamp;
+  // How well the reference itself fits the relations at an offset (lower is better); offsets
+  // that leave most relations outside the trajectory do not count.
+  const auto misfit = [&](double off) {
     const auto m = relationMetrics(sorted, sample, off, 5.0);
-    if (m.used < sample.size() * 8 / 10) continue;
-    const double err = m.abs_trans_m.mean + m.abs_rot_deg.mean / 10;
-    if (err < best_err) {
-      best_err = err;
-      best = off;
+    if (m.used < sample.size() * 8 / 10) return 1e300;
+    return m.abs_trans_m.mean + m.abs_rot_deg.mean / 10;
+  };
+  // Coarse: relation times are scan times; try aligning the first relation with every reference time.
+  double coarse = 0, coarse_err = 1e300;
+  for (const auto& p : sorted) {
+    const double off = r0 - p.timestamp, err = misfit(off);
+    if (err < coarse_err) {
+      coarse_err = err;
+      coarse = off;
     }
   }
-  // Fine: the mode of (relation time - log time) differences near the coarse offset, in 1 ms bins.
+  // Refined by the misfit itself, 50 ms then 5 ms then 0.5 ms steps around the coarse value.
+  double refined = coarse, refined_err = coarse_err, step = 0.05;
+  for (int round = 0; round < 3; ++round, step /= 10) {
+    const double centre = refined;
+    for (int k = -10; k <= 10; ++k) {
+      const double off = centre + k * step, err = misfit(off);
+      if (err < refined_err) {
+        refined_err = err;
+        refined = off;
+      }
+    }
+  }
+  // Exact: when the relations were taken at the log's own timestamps (Intel: the raw log's
+  // odometry times), the mode of (relation time - log time) near the refined value, in 1 ms bins.
   std::vector<double> times = log_times;
   for (const auto& p : sorted) times.push_back(p.timestamp);
   std::sort(times.begin(), times.end());
   std::map<long long, int> votes;
   for (const auto& r : rel)
     for (double tr : {r.t1, r.t2}) {
-      const double lo = tr - best - 1.0, hi = tr - best + 1.0;
+      const double lo = tr - refined - 1.0, hi = tr - refined + 1.0;
       for (auto it = std::lower_bound(times.begin(), times.end(), lo); it != times.end() && *it <= hi; ++it)
         ++votes[std::llround((tr - *it) * 1000.0)];
     }
-  // Most votes wins; among equals (regularly sampled logs) the one nearest the coarse value.
+  // Most votes wins; among equals (regularly sampled logs) the one nearest the refined value.
   int top = 0;
-  const double coarse = best;
+  double exact = refined;
   for (const auto& [bin, n] : votes) {
     const double off = static_cast<double>(bin) / 1000.0;
-    if (n > top || (n == top && std::abs(off - coarse) < std::abs(best - coarse))) {
+    if (n > top || (n == top && std::abs(off - refined) < std::abs(exact - refined))) {
       top = n;
-      best = off;
+      exact = off;
     }
   }
-  if (top >= 10) return best;
-  // Too few exact matches (no shared timestamps): refine the coarse value by the error itself.
-  double step = 0.05;
-  for (int round = 0; round < 3; ++round, step /= 10) {
-    const double centre = best;
-    for (int k = -10; k <= 10; ++k) {
-      const double off = centre + k * step;
-      const auto m = relationMetrics(sorted, sample, off, 5.0);
-      if (m.used < sample.size() * 8 / 10) continue;
-      const double err = m.abs_trans_m.mean + m.abs_rot_deg.mean / 10;
-      if (err < best_err) {
-        best_err = err;
-        best = off;
-      }
-    }
-  }
-  return best;
+  // Without shared timestamps (FR079's corrected log is re-stamped) the mode is a chance
+  // coincidence of regular sampling: it is kept only if the reference fits as well there.
+  if (top >= 10 && misfit(exact) <= 1.1 * refined_err) return exact;
+  return refined;
 }
 
 TrajectoryMetrics trajectoryMetrics(const std::vector<io::StampedPose>& estimate, const std::vector<io::StampedPose>& reference,

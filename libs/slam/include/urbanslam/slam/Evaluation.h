@@ -40,10 +40,11 @@ RelationMetrics relationMetrics(const std::vector<io::StampedPose>& traj, const 
                                 double time_offset_s, double max_gap_s = 1.0);
 
 // The offset to add to the trajectory's timestamps so that it matches the relations' time base.
-// Coarse: the one that minimises the relation error of `reference` (e.g. the corrected log's
-// own poses). Fine: relation times are sensor times of the original log, so the exact offset is
-// the most frequent difference between a relation time and a timestamp of the log
-// (`log_times`, e.g. its odometry times), within a second of the coarse value.
+// Coarse, then refined to 0.5 ms: the one that minimises the relation error of `reference`
+// (e.g. the corrected log's own poses). Exact: when relation times are sensor times of the log,
+// the most frequent difference between a relation time and a timestamp of the log (`log_times`,
+// e.g. its odometry times) within a second of the refined value — kept only if the reference
+// fits the relations as well there (a re-stamped log shares no times with the relations).
 // Returns 0 when the time bases already overlap.
 double findRelationTimeOffset(const std::vector<io::StampedPose>& reference, const std::vector<Relation>& rel,
                               const std::vector<double>& log_times = {});
