@@ -45,6 +45,14 @@ struct LocalOptions {
   int submap_keyframes = 5;            // the scan is matched against the last this many keyframes
   double max_correction_m = 0.5;       // larger disagreements with odometry: keep the odometry
   double max_correction_deg = 10.0;
+  // A match that explains most of the scan is trusted further than the odometry: wheel odometry
+  // misses part of fast turns and, on FR079, reports reversing as driving forwards.
+  double trusted_matched_fraction = 0.7;  // share of scan points matched for a trusted match
+  double max_trusted_correction_m = 1.5;  // trusted matches may correct the odometry this much
+  double max_trusted_correction_deg = 45.0;
+  // A match from the odometry guess matching fewer points than this (or untrusted) is retried
+  // from standing still and from the reversed translation; the one matching most points wins.
+  double retry_below_fraction = 0.8;      // 0: never retry
   double covariance_scale = 4.0;       // alignment covariance inflation (matched scans are correlated)
   double min_sigma_xy_m = 0.01;        // floors on the scan-matching uncertainty
   double min_sigma_phi_deg = 0.25;
