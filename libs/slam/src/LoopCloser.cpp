@@ -97,6 +97,30 @@ std::vector<size_t> LoopCloser::candidates(esdf::Esdf& filter, const std::vector
   return out;
 }
 
+// A wrong closure is usually a wrong local minimum (aliasing along a corridor or a facade) that
+// the drifted estimate happened to start PL-ICP in. Restarts from the result shifted along each
+// axis by ambiguity_offset_m, then twice, four and eight times that, as far as the innovation
+// gate could admit such a shift (3 sigma of the relative position): if one converges elsewhere
+// and matches clearly more points, the alignment is not the best explanation of the two scans.
+bool LoopCloser::ambiguous(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current,
+                           const alignment::AlignmentResult& a, alignment::AlignerOptions ao) {
+  const Eigen::Matrix3d s = relativeCovariance(filter, earlier, current);
+  const double reach = 3 * std::sqrt(std::max(0.0, s.topLeftCorner<2, 2>().eigenvalues().real().maxCoeff()));
+  ao.method = alignment::Method::PlIcp;
+  const auto& t = a.transform;
+  for (double d = options_.ambiguity_offset_m; d <= 8 * options_.ambiguity_offset_m && 0.5 * d <= reach; d *= 2) {
+    for (const common::Pose2& g : {common::Pose2{t.x + d, t.y, t.phi}, common::Pose2{t.x - d, t.y, t.phi},
+                                   common::Pose2{t.x, t.y + d, t.phi}, common::Pose2{t.x, t.y - d, t.phi}}) {
+      const auto b = alignment::align(keyframes[earlier].scan, keyframes[current].scan, g, ao);
+      if (!b.converged || b.rms_residual_m > options_.max_rms_m) continue;
+      const common::Pose2 e = common::between(t, b.transform);
+      if (std::hypot(e.x, e.y) < 0.25 * options_.ambiguity_offset_m) continue;  // back to the same minimum
+      if (b.matches >= (1.0 + options_.ambiguity_min_gain) * a.matches) return true;
+    }
+  }
+  return false;
+}
+
 LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current,
                                        bool commit, const Detection* detection) {
   LoopClosureRecord r;
@@ -146,6 +170,10 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
   if (!scorer_ && !detection) r.score = matched;
   if (!good(a)) {
     r.reason = "alignment";
+    return r;
+  }
+  if (options_.ambiguity_offset_m > 0 && ambiguous(filter, keyframes, earlier, current, a, ao)) {
+    r.reason = "ambiguous";
     return r;
   }
   // Innovation gate, then the information-form update.

@@ -58,6 +58,8 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("auto_local_max_deg", o.loop_closure.auto_local_max_deg, 0.0, 180.0, "deg", "auto: ... and 3 sigma of the relative heading below this");
   s.add("max_rms_m", o.loop_closure.max_rms_m, 0.001, 10.0, "m", "alignment accepted only below this RMS residual");
   s.add("min_matched_fraction", o.loop_closure.min_matched_fraction, 0.0, 1.0, "", "alignment accepted only with this share of points matched");
+  s.add("ambiguity_offset_m", o.loop_closure.ambiguity_offset_m, 0.0, 100.0, "m", "alignment accepted only when PL-ICP restarted from the result shifted by this along x and y finds no pose matching clearly more points; 0: off");
+  s.add("ambiguity_min_gain", o.loop_closure.ambiguity_min_gain, 0.0, 1.0, "", "clearly more: this share more points matched");
   s.add("min_constraint_ratio", o.loop_closure.min_constraint_ratio, 0.0, 1.0, "", "alignment accepted only when its weakest translation direction has this share of the strongest's information (corridors slide)");
   s.add("covariance_scale", o.loop_closure.covariance_scale, 0.1, 1000.0, "", "inflation of the alignment covariance");
   s.add("chi2_gate_probability", o.loop_closure.chi2_gate_probability, 0.5, 0.9999999, "", "innovation gate (chi2, 3 dof)");

@@ -9,6 +9,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "urbanslam/alignment/Aligner.h"
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/io/LaserScan.h"
 #include "urbanslam/slam/PipelineOptions.h"
@@ -24,7 +25,7 @@ struct LoopClosureRecord {
   std::string detector;              // "laser", "image" or "geometric" (alignment + gating only)
   double score = 0;                  // classifier margin, image normalised score, or alignment matched fraction
   bool accepted = false;
-  // When not accepted: classifier | alignment | gating | unconfirmed, or for image proposals that
+  // When not accepted: classifier | alignment | ambiguous | gating | unconfirmed, or for image proposals that
   // could not be verified: no_scans (a keyframe has no laser scan) | no_filter (dead reckoning).
   std::string reason;
   common::Pose2 measurement;         // aligned relative pose (from -> to)
@@ -76,6 +77,8 @@ class LoopCloser {
 
  private:
   Eigen::Matrix3d relativeCovariance(esdf::Esdf& filter, size_t i, size_t k);
+  bool ambiguous(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current,
+                 const alignment::AlignmentResult& a, alignment::AlignerOptions ao);
 
   LoopClosureOptions options_;
   KeyframeGrid grid_;

@@ -52,7 +52,7 @@ struct LocalOptions {
   double max_trusted_correction_deg = 45.0;
   // A match from the odometry guess matching fewer points than this (or untrusted) is retried
   // from standing still and from the reversed translation; the one matching most points wins.
-  double retry_below_fraction = 0.8;      // 0: never retry
+  double retry_below_fraction = 0.0;      // 0: never retry
   double covariance_scale = 4.0;       // alignment covariance inflation (matched scans are correlated)
   double min_sigma_xy_m = 0.01;        // floors on the scan-matching uncertainty
   double min_sigma_phi_deg = 0.25;
@@ -81,6 +81,12 @@ struct LoopClosureOptions {
   // ... and with the geometry constraining every direction: the weakest / strongest translation
   // eigenvalue of the alignment's information at least this. A closure along a corridor slides.
   double min_constraint_ratio = 0.1;
+  // ... and with no better minimum nearby: PL-ICP restarted from the result shifted by this
+  // much along x and y must not find another pose matching clearly more points (a corridor's
+  // repeated doors, a long facade). Checked only when the relative pose is uncertain enough
+  // for the gate to admit such a shift. 0: off.
+  double ambiguity_offset_m = 0.75;
+  double ambiguity_min_gain = 0.05;    // "clearly more": this share more points matched
   double covariance_scale = 4.0;
   double chi2_gate_probability = 0.99;   // innovation gate (3 dof); 0.99 measured better than 0.999 on Intel
   // A closure goes into the filter only once a second one, within this many keyframes, agrees
