@@ -14,8 +14,8 @@ namespace {
 // An incremental full recovery: Gauss-Newton steps from the current linearisation, each followed
 // by relinearising the factors of the poses that moved (the next recovery, full or partial,
 // then starts from the fresh linearisation without another factorisation here).
-RecoveryStats incrementalRecovery(Esdf& filter, const PoseGraphBackendOptions& opt) {
-  RecoveryStats st = filter.recover(std::max(0, opt.incremental_relinearise_passes - 1));
+RecoveryStats incrementalRecovery(Esdf& filter, const PoseGraphBackendOptions& opt, int extra_steps = 0) {
+  RecoveryStats st = filter.recover(std::max(0, opt.incremental_relinearise_passes - 1) + extra_steps);
   common::Stopwatch sw;
   const long long moved = filter.relinearise();
   st.factors_relinearised += moved;
@@ -128,7 +128,7 @@ PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBa
           if (dh > opt.full_recovery_heading_innovation_rad && pending > 0) {
             // The estimate is too stale to linearise this closure on the right branch: bring
             // it up to date first (whatever the spacing of full recoveries says).
-            const RecoveryStats st = incrementalRecovery(filter, opt);
+            const RecoveryStats st = incrementalRecovery(filter, opt, 1);  // a second step: the closure is linearised next
             res.recovery_s += st.seconds;
             res.factors_relinearised += st.factors_relinearised;
             ++res.full_recoveries;
