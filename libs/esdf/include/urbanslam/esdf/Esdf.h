@@ -55,7 +55,7 @@ struct EsdfOptions {
   int relinearise_max_passes = 20;
   // ...or until a relinearised Gauss-Newton step lowers cost() by less than this fraction (the
   // function tolerance of batch solvers; the pose-graph back end uses Ceres's default 1e-6).
-  // 0: stop only when nothing moves past the thresholds.
+  // 0: stop when nothing moves past the thresholds or a relinearised step gains nothing.
   double relinearise_cost_tolerance = 0;
 
   FillReducingOrdering ordering = FillReducingOrdering::Amd;
