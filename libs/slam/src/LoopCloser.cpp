@@ -155,18 +155,15 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
     ao.method = alignment::parseMethod(options_.method);
   }
   const common::Pose2 guess = esdf::toPose(esdf::between(xi, xk));
-  const auto matchedFraction = [](const alignment::AlignmentResult& a) {
-    return a.points_b > 0 ? static_cast<double>(a.matches) / a.points_b : 0.0;
-  };
   const auto good = [&](const alignment::AlignmentResult& a) {
-    return a.converged && a.rms_residual_m <= options_.max_rms_m && matchedFraction(a) >= options_.min_matched_fraction;
+    return a.converged && a.rms_residual_m <= options_.max_rms_m && a.matchedFraction() >= options_.min_matched_fraction;
   };
   // (Trying PL-ICP first on an uncertain guess was measured worse: it lands in wrong local
   // minima that pass the residual test — ATE 2.96 m vs 0.26 m on Intel.)
   const alignment::AlignmentResult a = alignment::align(keyframes[earlier].scan, keyframes[current].scan, guess, ao);
   r.measurement = a.transform;
   r.rms_m = a.rms_residual_m;
-  const double matched = matchedFraction(a);
+  const double matched = a.matchedFraction();
   if (!scorer_ && !detection) r.score = matched;
   if (!good(a)) {
     r.reason = "alignment";

@@ -251,26 +251,24 @@ void Pipeline::localScanMatching(const io::LaserScan& scan, common::Pose2& z, Ei
   }
   if (reference.empty()) return;  // the recent keyframes have no scans: keep the odometry
   const alignment::PointSet current = alignment::pointSetFromScan(scan, ao.scan, ao.in_vehicle_frame);
-  const auto fraction = [](const alignment::AlignmentResult& r) {
-    return r.points_b > 0 ? static_cast<double>(r.matches) / r.points_b : 0.0;
-  };
   const auto within = [&](const alignment::AlignmentResult& r, double max_m, double max_deg) {
     const common::Pose2 c = common::between(z, r.transform);
     return std::hypot(c.x, c.y) <= max_m && std::abs(c.phi) <= max_deg * kDeg;
   };
   const LocalOptions& lo = options_.local;
   const auto trusted = [&](const alignment::AlignmentResult& r) {
-    return r.converged && fraction(r) >= lo.trusted_matched_fraction && within(r, lo.max_trusted_correction_m, lo.max_trusted_correction_deg);
+    return r.converged && r.matchedFraction() >= lo.trusted_matched_fraction && within(r, lo.max_trusted_correction_m, lo.max_trusted_correction_deg);
   };
   auto a = alignment::alignPointSets(reference, current, z, ao);
-  if (lo.retry_below_fraction > 0 && (!trusted(a) || fraction(a) < lo.retry_below_fraction)) {
+  if (lo.retry_below_fraction > 0 && (!trusted(a) || a.matchedFraction() < lo.retry_below_fraction)) {
     // The odometry guess may be far off (a missed turn, reversing): PL-ICP from it can stop in
     // a wrong minimum. Other starts; the match explaining most of the scan (then the smallest
     // residual) wins.
     const auto better = [&](const alignment::AlignmentResult& b) {
       if (!b.converged) return false;
       if (!a.converged) return true;
-      return fraction(b) > fraction(a) || (fraction(b) == fraction(a) && b.rms_residual_m < a.rms_residual_m);
+      return b.matchedFraction() > a.matchedFraction() ||
+             (b.matchedFraction() == a.matchedFraction() && b.rms_residual_m < a.rms_residual_m);
     };
     for (const common::Pose2& g : {common::Pose2{0, 0, z.phi}, common::Pose2{-z.x, -z.y, z.phi}}) {
       auto b = alignment::alignPointSets(reference, current, g, ao);

@@ -47,6 +47,8 @@ struct AlignmentResult {
   double rms_residual_m = 0;
   double constraint_ratio = 0;               // translationConstraintRatio at the result
   int points_a = 0, points_b = 0;            // after the scan model's gates
+  // Share of B's points associated at the result (how much of the scan the match explains).
+  double matchedFraction() const { return points_b > 0 ? static_cast<double>(matches) / points_b : 0.0; }
 };
 
 AlignmentResult align(const io::LaserScan& a, const io::LaserScan& b, const common::Pose2& guess,
