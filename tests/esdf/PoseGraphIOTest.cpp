@@ -101,6 +101,9 @@ TEST(PoseGraphIO, MalformedInputNamesFileAndLine) {
     EXPECT_NE(std::string(e.what()).find("bad.g2o:3:"), std::string::npos) << e.what();
   }
   EXPECT_THROW(parsePoseGraph("VERTEX_SE2 0 0 zero 0\n", "x"), common::InputError);
+  EXPECT_THROW(parsePoseGraph("VERTEX_SE2 0 0 +-1 0\n", "x"), common::InputError);
+  EXPECT_THROW(parsePoseGraph("VERTEX_SE2 0 0 nan 0\n", "x"), common::InputError);
+  EXPECT_EQ(parsePoseGraph("VERTEX_SE2 0 +1.5 -2e0 0\n", "x").vertices.at(0).pose.x(), 1.5);  // signs as strtod took them
   EXPECT_THROW(parsePoseGraph("EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1 7\n", "x"), common::InputError);
   EXPECT_THROW(parsePoseGraph("EDGE_SE2 0 1 1 0 0 -1 0 0 1 0 1\n", "x"), common::InputError);
   EXPECT_THROW(parsePoseGraph("EDGE_SE2 0 1 1 0 0 1 2 0 1 0 1\n", "x"), common::InputError);  // indefinite

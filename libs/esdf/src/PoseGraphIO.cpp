@@ -61,7 +61,10 @@ bool parseNumbers(Tokens& in, double* out, int count) {
   std::string_view tok;
   for (int k = 0; k < count; ++k) {
     if (!in.next(&tok)) return false;
-    const char* first = tok.data() + (tok.front() == '+' ? 1 : 0);  // from_chars rejects '+'
+    // from_chars rejects a leading '+' that strtod took; skip one, but only before the number
+    // itself ("+-1" stays malformed).
+    const bool plus = tok.front() == '+' && tok.size() > 1 && tok[1] != '-' && tok[1] != '+';
+    const char* first = tok.data() + (plus ? 1 : 0);
     const auto [end, ec] = std::from_chars(first, tok.data() + tok.size(), out[k]);
     if (ec != std::errc() || end != tok.data() + tok.size() || !std::isfinite(out[k])) return false;
   }
