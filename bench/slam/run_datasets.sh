@@ -8,7 +8,9 @@
 # Columns (one row per dataset and system):
 #   rel_m / rel_deg  Kümmerle relation metric (mean absolute translational / rotational error, as
 #                    Cartographer computes it) where a relations file exists, over rel_n relations;
-#   ate_m            ATE RMSE against the log's reference (corrected-log poses; GPS for Victoria Park);
+#   ate_m            ATE RMSE against the log's reference (corrected-log poses; GPS for Victoria Park;
+#                    CSAIL runs on the gfs log, and its reference is the corrected log's poses
+#                    paired with the gfs scans by index: both hold the same 406 scans);
 #   loops / false    loop closures accepted / false against the reference (urbanslam only);
 #   wall_s / rtf     wall-clock time of the process and the real-time factor (log duration / wall).
 # Rows:
@@ -29,12 +31,34 @@ VP=../shared/data/victoria_park/victoria_park_ascii.zip
 command -v icp-slam >/dev/null || { echo "icp-slam not installed (Debian package mrpt-apps)" >&2; exit 2; }
 mkdir -p "$OUT"
 
-# name log ini relations(optional)
+# CSAIL's reference: the corrected log's FLASER poses at the gfs log's scan times (same scans, in
+# the same order; the corrected log's own timestamps have 6 significant digits).
+csail_reference() {  # gfs corrected out.tum
+  python3 - "$@" <<'PY'
+import gzip, math, sys
+gfs, corrected, out = sys.argv[1:4]
+times = [l.split()[-1] for l in gzip.open(gfs, 'rt') if l.startswith('LASER_READING ')]
+poses = []
+for l in gzip.open(corrected, 'rt'):
+    f = l.split()
+    if f and f[0] == 'FLASER':
+        n = int(f[1]); poses.append([float(v) for v in f[n + 2:n + 5]])
+assert len(times) == len(poses), (len(times), len(poses))
+with open(out, 'w') as o:
+    o.write('# timestamp x y z qx qy qz qw\n')
+    for t, (x, y, th) in zip(times, poses):
+        o.write(f"{t} {x} {y} 0 0 0 {math.sin(th / 2):.9f} {math.cos(th / 2):.9f}\n")
+PY
+}
+mkdir -p "$OUT/csail"
+csail_reference $D/gfs/mit-csail.corrected.gfs.gz $D/corrected_logs/csail-corrected.log.gz "$OUT/csail/reference.tum"
+
+# name log ini relations(optional, "-": none) reference(optional; default: the log)
 datasets=(
   "intel rawlogs/intel.rawlog ini/intel.ini $D/relations/intel.relations"
   "fr079 $D/corrected_logs/freiburg-079-corrected.log.gz ini/fr079.ini $D/relations/fr079.relations"
   "aces $D/corrected_logs/aces-corrected.log.gz ini/aces.ini"
-  "csail $D/corrected_logs/csail-corrected.log.gz ini/csail.ini"
+  "csail $D/gfs/mit-csail.corrected.gfs.gz ini/csail.ini $D/relations/mit-csail.relations $OUT/csail/reference.tum"
   "campus $D/corrected_logs/freiburg-campus-corrected.log.gz ini/freiburg-campus.ini"
   "victoria-park $VP ini/victoria-park.ini"
 )
@@ -55,20 +79,21 @@ PY
 }
 printf "%-14s %-15s %5s %8s %7s %7s %5s %5s %8s %8s\n" dataset system rel_n rel_m rel_deg ate_m loops false wall_s rtf
 for d in "${datasets[@]}"; do
-  read -r name log ini rel <<<"$d"
+  read -r name log ini rel ref <<<"$d"
   [[ -e $log ]] || { echo "$name: $log absent, skipped" >&2; continue; }
   o=$OUT/$name
-  R=(); [[ -n ${rel:-} ]] && R=(--relations "$rel")
+  R=(); [[ -n ${rel:-} && $rel != - ]] && R=(--relations "$rel")
+  ref=${ref:-$log}
   # urbanslam
   t0=$(now); $U run --quiet --ini "$ini" --out "$o/urbanslam" "$log" > /dev/null; t1=$(now)
   dur=$(python3 -c "import json; s=json.load(open('$o/urbanslam/stats.json')); print(s['timing']['log_duration_s'])")
-  $U eval "$o/urbanslam" "${R[@]}" --reference "$log" --json > "$o/urbanslam.eval.json"
+  $U eval "$o/urbanslam" "${R[@]}" --reference "$ref" --json > "$o/urbanslam.eval.json"
   row urbanslam "$name" "$o/urbanslam.eval.json" "$(python3 -c "print($t1 - $t0)")" "$dur"
   # urbanslam at scan rate (keyframes only)
   mkdir -p "$o/urbanslam-scan"
   cp "$o/urbanslam/trajectory_keyframes.tum" "$o/urbanslam-scan/trajectory_odometry.tum"
   [[ -f $o/urbanslam/reference.tum ]] && cp "$o/urbanslam/reference.tum" "$o/urbanslam-scan/"
-  $U eval "$o/urbanslam-scan" "${R[@]}" --max-gap 10 --reference "$log" --json > "$o/urbanslam-scan.eval.json"
+  $U eval "$o/urbanslam-scan" "${R[@]}" --max-gap 10 --reference "$ref" --json > "$o/urbanslam-scan.eval.json"
   row urbanslam@scan "$name" "$o/urbanslam-scan.eval.json" "$(python3 -c "print($t1 - $t0)")" "$dur"
   # icp-slam on the same log, as an action/sensory-frame rawlog
   p=$o/icp-slam; mkdir -p "$p"
@@ -97,6 +122,6 @@ with open(p + '/trajectory_odometry.tum', 'w') as f:
             f.write(f"{times[k]:.6f} {x} {y} 0 0 0 {math.sin(phi / 2):.9f} {math.cos(phi / 2):.9f}\n")
 PY
   [[ -f $o/urbanslam/reference.tum ]] && cp "$o/urbanslam/reference.tum" "$p/"
-  $U eval "$p" "${R[@]}" --max-gap 10 --reference "$log" --json > "$o/icp-slam.eval.json"
+  $U eval "$p" "${R[@]}" --max-gap 10 --reference "$ref" --json > "$o/icp-slam.eval.json"
   row icp-slam "$name" "$o/icp-slam.eval.json" "$(python3 -c "print($t1 - $t0)")" "$dur"
 done

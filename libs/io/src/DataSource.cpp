@@ -5,6 +5,7 @@
 #include "TextScanner.h"
 #include "urbanslam/common/Error.h"
 #include "urbanslam/io/CarmenReader.h"
+#include "urbanslam/io/GfsReader.h"
 #include "urbanslam/io/ImageFolderSource.h"
 #include "urbanslam/io/RawlogReader.h"
 #include "urbanslam/io/VictoriaParkReader.h"
@@ -31,6 +32,7 @@ LogFormat detectLogFormat(const std::string& path) {
   }
   head.resize(got);
   if (got == 0) throw InputError(path + ": empty file");
+  if (GfsReader::sniff(head)) return LogFormat::Gfs;  // before CARMEN: gfs logs also have PARAM/ODOM
   if (CarmenReader::sniff(head)) return LogFormat::Carmen;
   size_t printable = 0;
   for (unsigned char c : head) printable += (c >= 32 && c < 127) || c == '\n' || c == '\r' || c == '\t';
@@ -42,11 +44,12 @@ std::unique_ptr<DataSource> openDataSource(const std::string& path) {
   switch (detectLogFormat(path)) {
     case LogFormat::MrptRawlog: return std::make_unique<RawlogReader>(path);
     case LogFormat::Carmen: return std::make_unique<CarmenReader>(path);
+    case LogFormat::Gfs: return std::make_unique<GfsReader>(path);
     case LogFormat::VictoriaPark: return std::make_unique<VictoriaParkReader>(path);
     case LogFormat::ImageFolder: return std::make_unique<ImageFolderSource>(path);
     case LogFormat::Unknown: break;
   }
-  throw InputError(path + ": unrecognised format (expected an MRPT rawlog, a CARMEN log, a Victoria Park folder/zip or a folder of images)");
+  throw InputError(path + ": unrecognised format (expected an MRPT rawlog, a CARMEN log, a GMapping gfs log, a Victoria Park folder/zip or a folder of images)");
 }
 
 }  // namespace urbanslam::io

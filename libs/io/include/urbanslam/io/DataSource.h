@@ -25,13 +25,13 @@ class DataSource {
   std::string path_;
 };
 
-enum class LogFormat { Unknown, MrptRawlog, Carmen, VictoriaPark, ImageFolder };
+enum class LogFormat { Unknown, MrptRawlog, Carmen, Gfs, VictoriaPark, ImageFolder };
 
 // Detects the format of a file or folder. Throws common::InputError for a missing path.
 LogFormat detectLogFormat(const std::string& path);
 
 // Opens any supported input: MRPT rawlog (both layouts, gzipped or not), CARMEN log (gzipped or
-// not, raw or Freiburg-"corrected"), Victoria Park (folder with LASER.txt/DRS.txt/GPS.txt, or
+// not, raw or Freiburg-"corrected"), GMapping gfs output, Victoria Park (folder with LASER.txt/DRS.txt/GPS.txt, or
 // victoria_park_ascii.zip), a folder of images (camera only). Throws common::InputError for a missing or unrecognised input.
 std::unique_ptr<DataSource> openDataSource(const std::string& path);
 
