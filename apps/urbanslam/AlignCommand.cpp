@@ -61,7 +61,7 @@ int alignCommand(const Argv& args) {
                "Aligns laser scan B of LOG onto laser scan A (0-based indices among the log's laser scans,\n"
                "in file order) and prints the pose of B in A's vehicle frame (x, y in metres, phi in\n"
                "radians), its 3x3 covariance (x, y, phi), the iterations and the time.");
-  ap.addPositional("LOG", "any supported log (MRPT rawlog, CARMEN log, Victoria Park folder/zip)");
+  ap.addPositional("LOG", "any supported log (MRPT rawlog, CARMEN log, GMapping gfs log, Victoria Park folder/zip)");
   ap.addPositional("A", "index of the reference scan");
   ap.addPositional("B", "index of the scan to align onto A");
   ap.addOption("method", "M", "icp | plicp | crf | crf+icp (CRF-match coarse, ICP refine)", "crf+icp");

@@ -13,8 +13,8 @@ namespace urbanslam::cli {
 
 int convertCommand(const Argv& args) {
   ArgParser ap("urbanslam convert [--layout observations|frames] [--quiet] [--json] IN OUT.rawlog",
-               "Writes any supported input (MRPT rawlog, CARMEN log, Victoria Park folder/zip) as an MRPT\n"
-               "rawlog, keeping timestamps. Speed+steering become CObservationRawDAQ 'DRIVE' {speed, steering},\n"
+               "Writes any supported input (MRPT rawlog, CARMEN log, GMapping gfs log, Victoria Park folder/zip)\n"
+               "as an MRPT rawlog, keeping timestamps. Speed+steering become CObservationRawDAQ 'DRIVE' {speed, steering},\n"
                "GPS and reference poses CObservationRobotPose 'GPS_LOCAL' / 'REFERENCE'.");
   ap.addPositional("IN", "input log");
   ap.addPositional("OUT", "output rawlog (gzip-compressed)");

@@ -121,6 +121,18 @@ int evalCommand(const Argv& args) {
       j["loops_true"] = lm.true_positive;
       j["loops_false"] = lm.false_positive;
       j["loops_unverifiable"] = lm.unverifiable;
+      common::Json list = common::Json::array();
+      for (const auto& f : lm.false_closures) {
+        common::Json e = common::Json::object();
+        e["from_keyframe"] = f.from_keyframe;
+        e["to_keyframe"] = f.to_keyframe;
+        e["from_time"] = f.from_time;
+        e["to_time"] = f.to_time;
+        e["error_m"] = f.error_m;
+        e["error_deg"] = f.error_deg;
+        list.push(std::move(e));
+      }
+      j["loops_false_list"] = std::move(list);
     }
     // Plots: the aligned estimate over the reference, and the position error over time.
     laser_loop::PlotSeries ref{"reference", {}, {}, 0x808080}, est{"estimate (aligned)", {}, {}, 0x2060e0};

@@ -30,8 +30,8 @@ class ProgressObserver : public slam::PipelineObserver {
 int runCommand(const Argv& args) {
   ArgParser ap("urbanslam run [--ini FILE] [--out DIR] [--quiet] [--json] [LOG]",
                "Builds a map and trajectory from a log: MRPT rawlog (either layout, gzipped or not),\n"
-               "CARMEN log (raw or Freiburg-corrected), Victoria Park (folder or zip) or a folder of camera\n"
-               "images (one keyframe per image; image loop proposals need [loop_closure] image_detector).");
+               "CARMEN log (raw or Freiburg-corrected), GMapping gfs log, Victoria Park (folder or zip) or a\n"
+               "folder of camera images (one keyframe per image; image loop proposals need [loop_closure] image_detector).");
   ap.addPositional("LOG", "input log; default: the shipped rawlogs/intel.rawlog", false);
   ap.addOption("ini", "FILE", "configuration (see ini/default.ini for every key)", "ini/default.ini");
   ap.addOption("out", "DIR", "output folder (created if needed)", "out");

@@ -12,7 +12,7 @@ namespace {
 
 void printUsage() {
   std::cout << "usage: urbanslam <command> [options]\n\n"
-               "Large-scale 2D SLAM from MRPT rawlogs, CARMEN logs and the Victoria Park log.\n\n"
+               "Large-scale 2D SLAM from MRPT rawlogs, CARMEN and GMapping logs and the Victoria Park log.\n\n"
                "commands:\n";
   for (const auto& c : urbanslam::cli::commands()) {
     std::string n = std::string("  ") + c.name;

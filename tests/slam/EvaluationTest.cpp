@@ -83,15 +83,20 @@ TEST(Evaluation, LoopClosuresAreClassifiedAgainstTheReference) {
   const auto ref = circle();
   std::vector<slam::LoopRow> loops;
   const auto truth = common::between(ref[10].pose, ref[150].pose);
-  loops.push_back({ref[10].timestamp, ref[150].timestamp, true, truth});
-  loops.push_back({ref[10].timestamp, ref[150].timestamp, true, common::compose(truth, {2.0, 0, 0})});
-  loops.push_back({ref[10].timestamp, ref[150].timestamp, false, truth});
-  loops.push_back({-50, ref[150].timestamp, true, truth});
+  loops.push_back({10, 150, ref[10].timestamp, ref[150].timestamp, true, truth});
+  loops.push_back({11, 150, ref[10].timestamp, ref[150].timestamp, true, common::compose(truth, {2.0, 0, 0})});
+  loops.push_back({10, 150, ref[10].timestamp, ref[150].timestamp, false, truth});
+  loops.push_back({0, 150, -50, ref[150].timestamp, true, truth});
   const auto m = slam::classifyLoopClosures(loops, ref, false);
   EXPECT_EQ(m.accepted, 3u);
   EXPECT_EQ(m.true_positive, 1u);
   EXPECT_EQ(m.false_positive, 1u);
   EXPECT_EQ(m.unverifiable, 1u);
+  // The false one is listed with its keyframes and its error against the reference.
+  ASSERT_EQ(m.false_closures.size(), 1u);
+  EXPECT_EQ(m.false_closures[0].from_keyframe, 11);
+  EXPECT_NEAR(m.false_closures[0].error_m, 2.0, 1e-9);
+  EXPECT_NEAR(m.false_closures[0].error_deg, 0.0, 1e-9);
 }
 
 TEST(Evaluation, MalformedRelationsFileIsAnError) {

@@ -246,7 +246,8 @@ std::vector<LoopRow> readLoopClosuresCsv(const std::string& path) {
     while (std::getline(ss, cell, ',')) f.push_back(cell);
     if (f.size() < 11) throw common::InputError(path + ":" + std::to_string(n) + ": expected 14 columns");
     try {
-      out.push_back({std::stod(f[2]), std::stod(f[3]), f[6] == "1", {std::stod(f[8]), std::stod(f[9]), std::stod(f[10])}});
+      out.push_back({std::stol(f[0]), std::stol(f[1]), std::stod(f[2]), std::stod(f[3]), f[6] == "1",
+                     {std::stod(f[8]), std::stod(f[9]), std::stod(f[10])}});
     } catch (const std::exception&) {
       throw common::InputError(path + ":" + std::to_string(n) + ": malformed number");
     }
@@ -269,15 +270,20 @@ LoopMetrics classifyLoopClosures(const std::vector<LoopRow>& loops, const std::v
       continue;
     }
     bool ok;
+    double err_m = 0, err_deg = 0;
     if (positions_only) {
       // GPS alone has no heading, and Victoria Park's fixes jump by metres: compare distances
       // only, with 2 m of slack for the fixes themselves.
-      ok = std::abs(std::hypot(b.x - a.x, b.y - a.y) - std::hypot(l.measurement.x, l.measurement.y)) <= tol_m + 2.0;
+      err_m = std::abs(std::hypot(b.x - a.x, b.y - a.y) - std::hypot(l.measurement.x, l.measurement.y));
+      ok = err_m <= tol_m + 2.0;
     } else {
       const Pose2 err = common::between(common::between(a, b), l.measurement);
-      ok = std::hypot(err.x, err.y) <= tol_m && std::abs(err.phi) * kRad2Deg <= tol_deg;
+      err_m = std::hypot(err.x, err.y);
+      err_deg = std::abs(err.phi) * kRad2Deg;
+      ok = err_m <= tol_m && err_deg <= tol_deg;
     }
     ++(ok ? m.true_positive : m.false_positive);
+    if (!ok) m.false_closures.push_back({l.from_keyframe, l.to_keyframe, l.from_time, l.to_time, err_m, err_deg});
   }
   return m;
 }

@@ -64,14 +64,23 @@ TrajectoryMetrics trajectoryMetrics(const std::vector<io::StampedPose>& estimate
                                     bool positions_only, double max_gap_s = 1.0);
 
 struct LoopRow {
+  long from_keyframe = 0, to_keyframe = 0;
   double from_time = 0, to_time = 0;
   bool accepted = false;
   common::Pose2 measurement;
 };
 std::vector<LoopRow> readLoopClosuresCsv(const std::string& path);
 
+// A false closure and how far its measurement is from the reference's relative pose, so a user
+// can look at each one (they are listed, not only counted).
+struct FalseClosure {
+  long from_keyframe = 0, to_keyframe = 0;
+  double from_time = 0, to_time = 0;
+  double error_m = 0, error_deg = 0;  // for a positions-only reference: the distance disagreement
+};
 struct LoopMetrics {
   size_t accepted = 0, true_positive = 0, false_positive = 0, unverifiable = 0;
+  std::vector<FalseClosure> false_closures;
 };
 // An accepted closure is true when its measured relative pose agrees with the reference's
 // relative pose of the two times within the tolerances (§5.6), false otherwise.
