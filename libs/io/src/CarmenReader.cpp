@@ -29,19 +29,6 @@ bool samePose(const Pose2& a, const Pose2& b) {
          std::abs(common::wrapToPi(a.phi - b.phi)) < 1e-9;
 }
 
-// Fills ranges/valid; NaN, infinite and negative ranges are corrupt input, not no-returns.
-void readRanges(const std::vector<std::string>& f, size_t first, long n, double max_range,
-                const std::string& where, LaserScan& scan) {
-  scan.ranges.resize(static_cast<size_t>(n));
-  scan.valid.resize(static_cast<size_t>(n));
-  for (long i = 0; i < n; ++i) {
-    const double r = parseNumber(f[first + static_cast<size_t>(i)], where, "range");
-    if (r < 0) throw InputError(where + ": negative range " + f[first + static_cast<size_t>(i)]);
-    scan.ranges[static_cast<size_t>(i)] = static_cast<float>(r);
-    scan.valid[static_cast<size_t>(i)] = (r > 0 && r < max_range) ? 1 : 0;
-  }
-}
-
 // CARMEN beams start at start_angle and go counter-clockwise. We keep MRPT's symmetric beam
 // layout (beam 0 at -aperture/2) and put the asymmetry into the sensor's yaw, so scans convert
 // to CObservation2DRangeScan and back without loss.
@@ -147,15 +134,7 @@ double CarmenReader::stamp(double log_ts, bool is_scan) {
 }
 
 bool CarmenReader::next(Measurement& out) {
-  while (pending_pos_ >= pending_.size()) {
-    pending_.clear();
-    pending_pos_ = 0;
-    std::string line;
-    if (!text_->nextLine(line)) return false;
-    parseLine(line);
-  }
-  out = std::move(pending_[pending_pos_++]);
-  return true;
+  return detail::nextRecord(*text_, pending_, pending_pos_, out, [this](const std::string& l) { parseLine(l); });
 }
 
 bool CarmenReader::parseLine(const std::string& line) {
@@ -220,7 +199,7 @@ void CarmenReader::handleLaser(const std::vector<std::string>& f, const std::str
   LaserScan scan;
   scan.label = rear ? "RLASER" : "FLASER";
   scan.max_range_m = rear ? info_.rear_max_range_m : info_.front_max_range_m;
-  readRanges(f, 2, n, scan.max_range_m, where, scan);
+  detail::parseRanges(f, 2, nn, scan.max_range_m, where, scan.ranges, scan.valid);
   const Pose2 pose{parseNumber(f[nn + 2], where, "x"), parseNumber(f[nn + 3], where, "y"),
                    common::wrapToPi(parseNumber(f[nn + 4], where, "theta"))};
   const Pose2 odom{parseNumber(f[nn + 5], where, "odom_x"), parseNumber(f[nn + 6], where, "odom_y"),
@@ -250,7 +229,7 @@ void CarmenReader::handleRobotLaser(const std::vector<std::string>& f, const std
   LaserScan scan;
   scan.label = "ROBOTLASER1";
   scan.max_range_m = parseNumber(f[5], where, "maximum_range");
-  readRanges(f, 9, n, scan.max_range_m, where, scan);
+  detail::parseRanges(f, 9, nn, scan.max_range_m, where, scan.ranges, scan.valid);
   const Pose2 laser{parseNumber(f[k], where, "laser_x"), parseNumber(f[k + 1], where, "laser_y"),
                     parseNumber(f[k + 2], where, "laser_theta")};
   const Pose2 robot{parseNumber(f[k + 3], where, "robot_x"), parseNumber(f[k + 4], where, "robot_y"),

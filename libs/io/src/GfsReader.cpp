@@ -36,15 +36,7 @@ double GfsReader::progress() const { return text_->progress(); }
 std::string GfsReader::format() const { return "GMapping gfs log (raw odometry, full-precision timestamps)"; }
 
 bool GfsReader::next(Measurement& out) {
-  while (pending_pos_ >= pending_.size()) {
-    pending_.clear();
-    pending_pos_ = 0;
-    std::string line;
-    if (!text_->nextLine(line)) return false;
-    parseLine(line);
-  }
-  out = std::move(pending_[pending_pos_++]);
-  return true;
+  return detail::nextRecord(*text_, pending_, pending_pos_, out, [this](const std::string& l) { parseLine(l); });
 }
 
 // Odometry goes out once per time, in time order (a time already covered is not repeated).
@@ -84,14 +76,7 @@ bool GfsReader::parseLine(const std::string& line) {
     LaserScan scan;
     scan.label = "FLASER";
     scan.max_range_m = max_range_m_;
-    scan.ranges.resize(nn);
-    scan.valid.resize(nn);
-    for (size_t i = 0; i < nn; ++i) {
-      const double r = parseNumber(f[2 + i], where, "range");
-      if (r < 0) throw InputError(where + ": negative range " + f[2 + i]);
-      scan.ranges[i] = static_cast<float>(r);
-      scan.valid[i] = (r > 0 && r < max_range_m_) ? 1 : 0;
-    }
+    detail::parseRanges(f, 2, nn, max_range_m_, where, scan.ranges, scan.valid);
     const double res = resolutionForBeams(n);
     scan.angle_increment_rad = res;
     scan.angle_min_rad = -res * static_cast<double>(nn - 1) / 2;

@@ -198,4 +198,16 @@ long parseInteger(const std::string& field, const std::string& where, const char
   return v;
 }
 
+void parseRanges(const std::vector<std::string>& f, size_t first, size_t n, double max_range, const std::string& where,
+                 std::vector<float>& ranges, std::vector<uint8_t>& valid) {
+  ranges.resize(n);
+  valid.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const double r = parseNumber(f[first + i], where, "range");
+    if (r < 0) throw common::InputError(where + ": negative range " + f[first + i]);
+    ranges[i] = static_cast<float>(r);
+    valid[i] = (r > 0 && r < max_range) ? 1 : 0;
+  }
+}
+
 }  // namespace urbanslam::io::detail

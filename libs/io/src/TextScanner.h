@@ -49,4 +49,24 @@ void splitFields(const std::string& line, std::vector<std::string>& fields);
 double parseNumber(const std::string& field, const std::string& where, const char* what);
 long parseInteger(const std::string& field, const std::string& where, const char* what);
 
+// n laser ranges from fields[first..]: NaN, infinite and negative ranges are corrupt input (an
+// error), 0 and ranges at or beyond max_range are no-returns (valid = 0).
+void parseRanges(const std::vector<std::string>& fields, size_t first, size_t n, double max_range,
+                 const std::string& where, std::vector<float>& ranges, std::vector<uint8_t>& valid);
+
+// Line-oriented logs: a line yields any number of records, which go out one at a time in file
+// order. Parses lines with parse(line), which appends to pending, until one yields a record.
+template <class Record, class ParseLine>
+bool nextRecord(TextScanner& text, std::vector<Record>& pending, size_t& pos, Record& out, ParseLine&& parse) {
+  while (pos >= pending.size()) {
+    pending.clear();
+    pos = 0;
+    std::string line;
+    if (!text.nextLine(line)) return false;
+    parse(line);
+  }
+  out = std::move(pending[pos++]);
+  return true;
+}
+
 }  // namespace urbanslam::io::detail
