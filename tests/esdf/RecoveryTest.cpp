@@ -3,10 +3,10 @@
 
 #include <Eigen/Dense>
 
-#include "TestUtil.h"
 #include <memory>
 #include <tuple>
 
+#include "TestUtil.h"
 #include "urbanslam/esdf/EnvelopeCholesky.h"
 #include "urbanslam/esdf/Esdf.h"
 
@@ -33,14 +33,24 @@ void buildGraph(Esdf& f, std::mt19937& rng, int poses, int closures) {
   }
 }
 
+// buildGraph's graph in a filter that never relinearises, so its information form stays the
+// linear system the dense references solve.
+struct LinearGraph {
+  LinearGraph(unsigned seed, int poses, int closures) : rng(seed), f(options()) { buildGraph(f, rng, poses, closures); }
+  static EsdfOptions options() {
+    EsdfOptions o;
+    o.relinearise = false;
+    return o;
+  }
+  std::mt19937 rng;
+  Esdf f;
+};
+
 Mat3 blk(const Eigen::MatrixXd& m, int i, int j) { return m.block<3, 3>(3 * i, 3 * j); }
 
 TEST(Recovery, FullRecoveryEqualsDenseSolve) {
-  std::mt19937 rng(30);
-  EsdfOptions o;
-  o.relinearise = false;
-  Esdf f(o);
-  buildGraph(f, rng, 80, 10);
+  LinearGraph g(30, 80, 10);
+  Esdf& f = g.f;
   const Eigen::MatrixXd lambda = f.state().denseInformation();
   const Eigen::VectorXd mu_ref = lambda.ldlt().solve(f.state().denseEta());
   f.recover();
@@ -48,11 +58,8 @@ TEST(Recovery, FullRecoveryEqualsDenseSolve) {
 }
 
 TEST(Recovery, PartialRecoveryEqualsDenseConditionalSolve) {
-  std::mt19937 rng(31);
-  EsdfOptions o;
-  o.relinearise = false;
-  Esdf f(o);
-  buildGraph(f, rng, 60, 8);
+  LinearGraph g(31, 60, 8);
+  Esdf& f = g.f;
   const int first = 40, n = f.size();
   const Eigen::MatrixXd lambda = f.state().denseInformation();
   const Eigen::VectorXd eta = f.state().denseEta(), mu = f.state().denseMean();
@@ -67,11 +74,8 @@ TEST(Recovery, PartialRecoveryEqualsDenseConditionalSolve) {
 TEST(Recovery, EnvelopeCholeskySolvesEveryWindowLikeDenseLlt) {
   // Windows with links leaving them (ignored), short in-window loops and, for first = 0, a link
   // from the newest to the oldest pose (the dense worst case of the envelope).
-  std::mt19937 rng(33);
-  EsdfOptions o;
-  o.relinearise = false;
-  Esdf f(o);
-  buildGraph(f, rng, 50, 15);
+  LinearGraph g(33, 50, 15);
+  Esdf& f = g.f;
   f.observeRelative(0, 49, between(f.mean(0), f.mean(49)), kLoopInfo);
   const Eigen::MatrixXd lambda = f.state().denseInformation();
   for (int first : {0, 1, 17, 35, 49}) {
@@ -129,11 +133,8 @@ TEST(Recovery, MarginalsAndPairsEqualDenseInverse) {
 double minEigen(const Mat6& m) { return Eigen::SelfAdjointEigenSolver<Mat6>(m).eigenvalues().minCoeff(); }
 
 TEST(Recovery, ConservativeCovarianceIsExactWithoutNewInformationAndAnUpperBoundWithIt) {
-  std::mt19937 rng(33);
-  EsdfOptions o;
-  o.relinearise = false;
-  Esdf f(o);
-  buildGraph(f, rng, 50, 6);
+  LinearGraph g(33, 50, 6);
+  Esdf& f = g.f;
   f.recover();  // factor of 50 poses
   // Dead reckoning beyond the factor: conservative is exact.
   for (int k = 50; k < 65; ++k) f.augmentRelative(k - 1, Vec3(1, 0, 0.05), kOdoInfo);

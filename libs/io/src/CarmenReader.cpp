@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "CarmenBeams.h"
 #include "TextScanner.h"
 #include "urbanslam/common/Error.h"
 
@@ -11,33 +12,14 @@ using common::InputError;
 using common::Pose2;
 using detail::parseInteger;
 using detail::parseNumber;
+using detail::resolutionForBeams;
+using detail::setBeamGeometry;
 
 namespace {
-
-constexpr double kDeg = M_PI / 180.0;
-
-// Angular resolution of a FLASER/RLASER with n beams over the usual 180° (SICK LMS modes).
-double resolutionForBeams(long n) {
-  if (n == 180 || n == 181) return 1.0 * kDeg;
-  if (n == 360 || n == 361) return 0.5 * kDeg;
-  if (n == 720 || n == 721) return 0.25 * kDeg;
-  return n > 1 ? M_PI / static_cast<double>(n - 1) : M_PI;
-}
 
 bool samePose(const Pose2& a, const Pose2& b) {
   return std::abs(a.x - b.x) < 1e-9 && std::abs(a.y - b.y) < 1e-9 &&
          std::abs(common::wrapToPi(a.phi - b.phi)) < 1e-9;
-}
-
-// CARMEN beams start at start_angle and go counter-clockwise. We keep MRPT's symmetric beam
-// layout (beam 0 at -aperture/2) and put the asymmetry into the sensor's yaw, so scans convert
-// to CObservation2DRangeScan and back without loss.
-void setGeometry(LaserScan& scan, double start_angle, double resolution, const Pose2& mount) {
-  const double n = static_cast<double>(scan.ranges.size());
-  const double aperture = resolution * (n - 1);
-  scan.angle_increment_rad = resolution;
-  scan.angle_min_rad = -aperture / 2;
-  scan.sensor_pose = {mount.x, mount.y, common::wrapToPi(mount.phi + start_angle + aperture / 2)};
 }
 
 }  // namespace
@@ -207,7 +189,7 @@ void CarmenReader::handleLaser(const std::vector<std::string>& f, const std::str
   ++scans_;
   scan.timestamp = stamp(parseNumber(f[nn + 8], where, "timestamp"), true);
   const Pose2 mount = rear ? Pose2{info_.rear_offset_m, 0, M_PI} : Pose2{info_.front_offset_m, 0, 0};
-  setGeometry(scan, -M_PI / 2, resolutionForBeams(n), mount);
+  setBeamGeometry(scan, -M_PI / 2, resolutionForBeams(n), mount);
   emitScan(std::move(scan), pose, odom);
   last_was_scan_ = !rear;
   last_scan_pose_ = pose;
@@ -236,7 +218,7 @@ void CarmenReader::handleRobotLaser(const std::vector<std::string>& f, const std
                     common::wrapToPi(parseNumber(f[k + 5], where, "robot_theta"))};
   ++scans_;
   scan.timestamp = stamp(parseNumber(f[k + 12], where, "timestamp"), true);
-  setGeometry(scan, parseNumber(f[2], where, "start_angle"), parseNumber(f[4], where, "resolution"),
+  setBeamGeometry(scan, parseNumber(f[2], where, "start_angle"), parseNumber(f[4], where, "resolution"),
               common::between(robot, laser));
   emitScan(std::move(scan), robot, robot);
   last_was_scan_ = true;

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "CarmenBeams.h"
 #include "TextScanner.h"
 #include "urbanslam/common/Error.h"
 
@@ -11,13 +12,6 @@ using common::InputError;
 using common::Pose2;
 using detail::parseInteger;
 using detail::parseNumber;
-
-namespace {
-
-// The beams of a gfs scan span 180° from the right, like CARMEN's FLASER (SICK LMS modes).
-double resolutionForBeams(long n) { return n > 1 ? M_PI / static_cast<double>(n - 1) : M_PI; }
-
-}  // namespace
 
 bool GfsReader::sniff(const std::string& head) {
   // PARAM and ODOM also start CARMEN logs; these tags are GMapping's own.
@@ -77,9 +71,7 @@ bool GfsReader::parseLine(const std::string& line) {
     scan.label = "FLASER";
     scan.max_range_m = max_range_m_;
     detail::parseRanges(f, 2, nn, max_range_m_, where, scan.ranges, scan.valid);
-    const double res = resolutionForBeams(n);
-    scan.angle_increment_rad = res;
-    scan.angle_min_rad = -res * static_cast<double>(nn - 1) / 2;
+    detail::setBeamGeometry(scan, -M_PI / 2, detail::resolutionForBeams(n), Pose2{});
     scan.timestamp = parseNumber(f[nn + 5], where, "timestamp");
     // The scan's pose is the odometry at its time: it completes the held ODOM line of that time.
     const Pose2 pose{parseNumber(f[nn + 2], where, "x"), parseNumber(f[nn + 3], where, "y"),
