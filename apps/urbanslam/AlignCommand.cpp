@@ -11,6 +11,7 @@
 #include "ArgParser.h"
 #include "Commands.h"
 #include "urbanslam/alignment/Aligner.h"
+#include "urbanslam/alignment/FreeSpace.h"
 #include "urbanslam/common/Error.h"
 #include "urbanslam/common/Json.h"
 #include "urbanslam/io/DataSource.h"
@@ -125,6 +126,9 @@ int alignCommand(const Argv& args) {
   }
 
   const alignment::AlignmentResult r = alignment::align(sa, sb, guess, options);
+  // Negative evidence next to the positive (matches): the share of points in the other scan's
+  // free space, as the loop closer tests it (default options).
+  const double conflict = alignment::mutualFreeSpaceConflict(sa, sb, r.transform);
 
   if (ap.flag("json")) {
     common::Json j = common::Json::object();
@@ -148,12 +152,14 @@ int alignCommand(const Argv& args) {
     j["rms_residual_m"] = r.rms_residual_m;
     j["points_a"] = r.points_a;
     j["points_b"] = r.points_b;
+    j["free_space_conflict"] = conflict;
     if (ref_a && ref_b) {
       const common::Pose2 rel = common::between(pose_a, pose_b);
       common::Json ref = common::Json::object();
       ref["x"] = rel.x;
       ref["y"] = rel.y;
       ref["phi"] = rel.phi;
+      ref["free_space_conflict"] = alignment::mutualFreeSpaceConflict(sa, sb, rel);
       j["reference"] = ref;
     }
     std::cout << j.dump() << "\n";
@@ -175,11 +181,13 @@ int alignCommand(const Argv& args) {
   std::cout << line;
   std::printf("iterations %d, time %.2f ms, %d matches, rms residual %.3f m\n", r.iterations, r.time_ms,
               r.matches, r.rms_residual_m);
+  std::printf("free-space conflict %.3f (share of points where the other scan saw through)\n", conflict);
   if (r.converged) std::printf("converged\n");
   else std::printf("NOT converged: %s\n", r.failure_reason.c_str());
   if (ref_a && ref_b) {
     const common::Pose2 rel = common::between(pose_a, pose_b);
-    std::printf("reference (log's corrected poses): x %.4f m  y %.4f m  phi %.5f rad\n", rel.x, rel.y, rel.phi);
+    std::printf("reference (log's corrected poses): x %.4f m  y %.4f m  phi %.5f rad, free-space conflict %.3f\n", rel.x,
+                rel.y, rel.phi, alignment::mutualFreeSpaceConflict(sa, sb, rel));
   }
   return 0;
 }

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "urbanslam/alignment/Aligner.h"
+#include "urbanslam/alignment/FreeSpace.h"
 #include "urbanslam/esdf/Gating.h"
 #include "urbanslam/esdf/PoseOps.h"
 #include "urbanslam/slam/Pipeline.h"
@@ -141,6 +142,10 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
   }
   // Alignment from the current estimate of the relative pose.
   const esdf::Vec3 xi = filter.mean(static_cast<int>(earlier)), xk = filter.mean(static_cast<int>(current));
+  {
+    const Eigen::Matrix3d s = relativeCovariance(filter, earlier, current);
+    r.prior_sigma_m = std::sqrt(std::max(0.0, s.topLeftCorner<2, 2>().eigenvalues().real().maxCoeff()));
+  }
   alignment::AlignerOptions ao;
   ao.min_constraint_ratio = options_.min_constraint_ratio;
   if (options_.method == "auto") {
@@ -171,6 +176,14 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
   }
   if (options_.ambiguity_offset_m > 0 && ambiguous(filter, keyframes, earlier, current, a, ao)) {
     r.reason = "ambiguous";
+    return r;
+  }
+  alignment::FreeSpaceOptions fo;
+  fo.margin_m = options_.free_space_margin_m;
+  fo.no_return_free_m = options_.free_space_no_return_m;
+  r.free_space_conflict = alignment::mutualFreeSpaceConflict(keyframes[earlier].scan, keyframes[current].scan, a.transform, fo);
+  if (r.free_space_conflict > options_.max_free_space_conflict) {
+    r.reason = "free_space";
     return r;
   }
   // Innovation gate, then the information-form update.

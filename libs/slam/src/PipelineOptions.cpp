@@ -60,6 +60,9 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("min_matched_fraction", o.loop_closure.min_matched_fraction, 0.0, 1.0, "", "alignment accepted only with this share of points matched");
   s.add("ambiguity_offset_m", o.loop_closure.ambiguity_offset_m, 0.0, 100.0, "m", "alignment accepted only when PL-ICP restarted from the result shifted by this along x and y finds no pose matching clearly more points; 0: off");
   s.add("ambiguity_min_gain", o.loop_closure.ambiguity_min_gain, 0.0, 1.0, "", "clearly more: this share more points matched");
+  s.add("max_free_space_conflict", o.loop_closure.max_free_space_conflict, 0.0, 1.0, "", "alignment accepted only when at most this share of either scan's points lies in the other scan's free space; 1: off");
+  s.add("free_space_no_return_m", o.loop_closure.free_space_no_return_m, 0.0, 1000.0, "m", "free-space test: a beam without a return (or beyond max_range_m) saw free space this far; 0: says nothing");
+  s.add("free_space_margin_m", o.loop_closure.free_space_margin_m, 0.0, 10.0, "m", "a point is in the other scan's free space when this much (+5 % of the range) in front of where its beam ended");
   s.add("min_constraint_ratio", o.loop_closure.min_constraint_ratio, 0.0, 1.0, "", "alignment accepted only when its weakest translation direction has this share of the strongest's information (corridors slide)");
   s.add("covariance_scale", o.loop_closure.covariance_scale, 0.1, 1000.0, "", "inflation of the alignment covariance");
   s.add("chi2_gate_probability", o.loop_closure.chi2_gate_probability, 0.5, 0.9999999, "", "innovation gate (chi2, 3 dof)");

@@ -25,12 +25,14 @@ struct LoopClosureRecord {
   std::string detector;              // "laser", "image" or "geometric" (alignment + gating only)
   double score = 0;                  // classifier margin, image normalised score, or alignment matched fraction
   bool accepted = false;
-  // When not accepted: classifier | alignment | ambiguous | gating | unconfirmed, or for image proposals that
+  // When not accepted: classifier | alignment | ambiguous | free_space | gating | unconfirmed, or for image proposals that
   // could not be verified: no_scans (a keyframe has no laser scan) | no_filter (dead reckoning).
   std::string reason;
   common::Pose2 measurement;         // aligned relative pose (from -> to)
   Eigen::Matrix3d information = Eigen::Matrix3d::Identity();  // as added to the filter
   double rms_m = 0, mahalanobis2 = 0, gate_threshold = 0;
+  double free_space_conflict = 0;    // alignment::mutualFreeSpaceConflict at the measurement
+  double prior_sigma_m = 0;          // largest std. deviation of the relative position before the closure
 };
 
 // Optional appearance test of a candidate pair before alignment (the laser classifier).

@@ -87,6 +87,11 @@ struct LoopClosureOptions {
   // for the gate to admit such a shift. 0: off.
   double ambiguity_offset_m = 0.75;
   double ambiguity_min_gain = 0.05;    // "clearly more": this share more points matched
+  // ... and with the two scans agreeing on free space: at most this share of either scan's
+  // points may lie where the other scan's beams passed through (1: off).
+  double max_free_space_conflict = 0.2;
+  double free_space_margin_m = 0.3;    // a point conflicts this far (+5 % of the range) inside free space
+  double free_space_no_return_m = 0;   // a beam without a return saw free space this far (0: unknown)
   double covariance_scale = 4.0;
   double chi2_gate_probability = 0.99;   // innovation gate (3 dof); 0.99 measured better than 0.999 on Intel
   // A closure goes into the filter only once a second one, within this many keyframes, agrees
