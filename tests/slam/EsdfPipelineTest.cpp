@@ -92,6 +92,9 @@ TEST(EsdfPipeline, WrongPlaceClosureIsGatedOut) {
   keyframes[k].scan = keyframes[i].scan;
   slam::LoopClosureOptions lo;
   lo.method = "crf+icp";  // finds the (wrong) perfect match from metres away
+  lo.min_constraint_ratio = 0;       // the other refusals off: this is about the gate
+  lo.ambiguity_offset_m = 0;
+  lo.max_free_space_conflict = 1;
   slam::LoopCloser closer(lo);
   const size_t factors_before = f.factorCount();
   const slam::LoopClosureRecord r = closer.tryClose(f, keyframes, i, k);

@@ -80,7 +80,7 @@ struct LoopClosureOptions {
   double min_matched_fraction = 0.5;   // ... and with this share of points matched
   // ... and with the geometry constraining every direction: the weakest / strongest translation
   // eigenvalue of the alignment's information at least this. A closure along a corridor slides.
-  double min_constraint_ratio = 0.1;
+  double min_constraint_ratio = 0.15;
   // ... and with no better minimum nearby: PL-ICP restarted from the result shifted by this
   // much along x and y must not find another pose matching clearly more points (a corridor's
   // repeated doors, a long facade). Checked only when the relative pose is uncertain enough
