@@ -108,3 +108,29 @@ TEST(FreeSpace, EmptyAndNaNScansTestNothing) {
   for (auto& r : nan.ranges) r = std::numeric_limits<float>::quiet_NaN();
   EXPECT_EQ(alignment::freeSpaceConflict(nan, a, {}).tested, 0);
 }
+
+// Where beam 0 points must not matter: the same 360° scan starting at -180° and at 0°.
+TEST(FreeSpace, FullCircleScanStartingAtZero) {
+  const World w = alignment::test::roomWorld();
+  const common::Pose2 pa{-3, 0, 0}, pb{-1, 0.5, 0.2};
+  alignment::test::ScanSpec full;
+  full.beams = 361;
+  full.fov_rad = 2 * M_PI;  // beam 0 at -180°, beam 360 again at +180°
+  auto a = alignment::test::simulateScan(w, pa, full);
+  a.ranges.pop_back();
+  a.valid.pop_back();
+  io::LaserScan rotated = a;  // beam j at j degrees
+  for (size_t j = 0; j < 360; ++j) {
+    rotated.ranges[j] = a.ranges[(j + 180) % 360];
+    rotated.valid[j] = a.valid[(j + 180) % 360];
+  }
+  rotated.angle_min_rad = 0;
+  const auto b = alignment::test::simulateScan(w, pb);
+  const common::Pose2 wrong{1.0, 1.5, -0.4};
+  const auto c1 = alignment::freeSpaceConflict(a, b, wrong), c2 = alignment::freeSpaceConflict(rotated, b, wrong);
+  EXPECT_GT(c1.tested, 300);
+  EXPECT_GT(c1.conflicts, 0);
+  // Only points at the seam beams (no neighbour on one side: behind in a, ahead in rotated) differ.
+  EXPECT_NEAR(c2.tested, c1.tested, 10);
+  EXPECT_NEAR(c2.conflicts, c1.conflicts, 10);
+}

@@ -16,7 +16,10 @@ FreeSpaceConflict freeSpaceConflict(const io::LaserScan& a, const io::LaserScan&
     const common::Pose2 q = common::compose(to_sensor_a, common::Pose2{p.x, p.y, 0});
     const double r = std::hypot(q.x, q.y);
     if (!(r >= options.min_range_m)) continue;
-    const double beam = std::round((std::atan2(q.y, q.x) - a.angle_min_rad) / a.angle_increment_rad);
+    // Bearing from beam 0, in [0, 2 pi): scans may start anywhere (-pi/2, -pi, 0 for 360° ones).
+    double from_first = std::remainder(std::atan2(q.y, q.x) - a.angle_min_rad, 2 * M_PI);
+    if (from_first < 0) from_first += 2 * M_PI;
+    const double beam = std::round(from_first / a.angle_increment_rad);
     if (beam < 1 || beam > static_cast<double>(n) - 2) continue;  // outside A's field of view
     const size_t i = static_cast<size_t>(beam);
     // The free range along this bearing: the shortest of the beam and its neighbours, so a point
