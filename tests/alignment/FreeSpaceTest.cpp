@@ -69,14 +69,24 @@ TEST(FreeSpace, WrongAlignmentConflictsAsTheWorldSays) {
   }
 }
 
-// Points behind what A saw (occluded for A) are no evidence against the match.
+// Points behind what A saw (occluded for A) are no evidence against the match: B, beside A,
+// sees the far wall behind a pillar that hides it from A. Those points lie in A's view, on
+// beams that returned (from the pillar), beyond where the beams ended.
 TEST(FreeSpace, OccludedPointsDoNotConflict) {
   World w = alignment::test::roomWorld();
-  const common::Pose2 pa{-3, 0, 0}, pb{-3, 0, M_PI};  // B looks the other way from the same spot
-  alignment::test::addBox(w, -2, -0.5, -1.8, 0.5);   // a pillar in front of A only
+  alignment::test::addBox(w, -1.2, -0.6, -0.8, 0.6);  // the pillar, 2 m ahead of A
+  const common::Pose2 pa{-3, 0, 0}, pb{-3, 2.0, -0.3};
   const auto a = alignment::test::simulateScan(w, pa), b = alignment::test::simulateScan(w, pb);
-  // B placed a metre further back: its points are either behind A or outside A's view.
-  const auto c = alignment::freeSpaceConflict(a, b, {-1, 0, M_PI});
+  const common::Pose2 truth = common::between(pa, pb);
+  // How many of B's points A cannot see: within the pillar's bearings from A, beyond the pillar.
+  int occluded = 0;
+  for (const io::Point2& p : io::scanToPoints(b, true)) {
+    const common::Pose2 q = common::compose(truth, common::Pose2{p.x, p.y, 0});
+    if (q.x > 2.3 && std::abs(std::atan2(q.y, q.x)) < std::atan2(0.5, 2.2)) ++occluded;
+  }
+  ASSERT_GT(occluded, 10) << "the scene does not hide part of B's view from A";
+  const auto c = alignment::freeSpaceConflict(a, b, truth);
+  EXPECT_GT(c.tested, occluded);
   EXPECT_EQ(c.conflicts, 0);
 }
 

@@ -13,6 +13,13 @@
 
 namespace urbanslam::slam {
 
+namespace {
+// Standard deviation of a covariance's position part along its worst direction.
+double largestPositionSigma(const Eigen::Matrix3d& cov) {
+  return std::sqrt(std::max(0.0, cov.topLeftCorner<2, 2>().eigenvalues().real().maxCoeff()));
+}
+}  // namespace
+
 void KeyframeGrid::insert(size_t index, double x, double y) {
   cells_[key(static_cast<long>(std::floor(x / cell_m_)), static_cast<long>(std::floor(y / cell_m_)))].push_back(index);
 }
@@ -68,7 +75,7 @@ std::vector<size_t> LoopCloser::candidates(esdf::Esdf& filter, const std::vector
   // Initial set: earlier keyframes within the search radius, widened by the current pose's own
   // 3-sigma position uncertainty (conservative covariance: no refactorisation).
   const esdf::Mat3 c = filter.marginalCovariance(static_cast<int>(current), esdf::CovarianceMode::Conservative);
-  const double sigma = std::sqrt(std::max(0.0, c.topLeftCorner<2, 2>().eigenvalues().real().maxCoeff()));
+  const double sigma = largestPositionSigma(c);
   const double radius = options_.search_radius_m + 3 * sigma;
   std::vector<size_t> near;
   grid_.query(cur.pose.x, cur.pose.y, radius, near);
@@ -105,8 +112,7 @@ std::vector<size_t> LoopCloser::candidates(esdf::Esdf& filter, const std::vector
 // and matches clearly more points, the alignment is not the best explanation of the two scans.
 bool LoopCloser::ambiguous(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current,
                            const alignment::AlignmentResult& a, alignment::AlignerOptions ao) {
-  const Eigen::Matrix3d s = relativeCovariance(filter, earlier, current);
-  const double reach = 3 * std::sqrt(std::max(0.0, s.topLeftCorner<2, 2>().eigenvalues().real().maxCoeff()));
+  const double reach = 3 * largestPositionSigma(relativeCovariance(filter, earlier, current));
   ao.method = alignment::Method::PlIcp;
   const auto& t = a.transform;
   for (double d = options_.ambiguity_offset_m; d <= 8 * options_.ambiguity_offset_m && 0.5 * d <= reach; d *= 2) {
@@ -142,10 +148,7 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
   }
   // Alignment from the current estimate of the relative pose.
   const esdf::Vec3 xi = filter.mean(static_cast<int>(earlier)), xk = filter.mean(static_cast<int>(current));
-  {
-    const Eigen::Matrix3d s = relativeCovariance(filter, earlier, current);
-    r.prior_sigma_m = std::sqrt(std::max(0.0, s.topLeftCorner<2, 2>().eigenvalues().real().maxCoeff()));
-  }
+  r.prior_sigma_m = largestPositionSigma(relativeCovariance(filter, earlier, current));
   alignment::AlignerOptions ao;
   ao.min_constraint_ratio = options_.min_constraint_ratio;
   if (options_.method == "auto") {
