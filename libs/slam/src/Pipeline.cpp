@@ -261,16 +261,20 @@ void Pipeline::localScanMatching(const io::LaserScan& scan, common::Pose2& z, Ei
   };
   auto a = alignment::alignPointSets(reference, current, z, ao);
   if (lo.retry_below_fraction > 0 && (!trusted(a) || a.matchedFraction() < lo.retry_below_fraction)) {
-    // The odometry guess may be far off (a missed turn, reversing): PL-ICP from it can stop in
-    // a wrong minimum. Other starts; the match explaining most of the scan (then the smallest
-    // residual) wins.
+    // The odometry guess may be far off (a missed turn, reversing, a false turn): PL-ICP from it
+    // can stop in a wrong minimum. Other starts; the match explaining most of the scan (then the
+    // smallest residual) wins.
     const auto better = [&](const alignment::AlignmentResult& b) {
       if (!b.converged) return false;
       if (!a.converged) return true;
       return b.matchedFraction() > a.matchedFraction() ||
              (b.matchedFraction() == a.matchedFraction() && b.rms_residual_m < a.rms_residual_m);
     };
-    for (const common::Pose2& g : {common::Pose2{0, 0, z.phi}, common::Pose2{-z.x, -z.y, z.phi}}) {
+    // Outdoors the wheels slip on kerbs and grass and the odometry turns 10-20° that the
+    // vehicle did not (Freiburg campus), so the odometry's translation without its turn is a
+    // start too.
+    const common::Pose2 starts[] = {{0, 0, z.phi}, {-z.x, -z.y, z.phi}, {z.x, z.y, 0}};
+    for (const common::Pose2& g : starts) {
       auto b = alignment::alignPointSets(reference, current, g, ao);
       if (better(b)) a = std::move(b);
     }
