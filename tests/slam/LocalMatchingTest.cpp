@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <vector>
 
 #include "TestPaths.h"
 #include "urbanslam/slam/Pipeline.h"
@@ -11,10 +12,9 @@ using namespace urbanslam;
 
 namespace {
 
-// Keyframes taken between t0 and t1 whose increment from the previous keyframe is more than
-// 0.5 m off the log's corrected poses (the reference), after running the pipeline (loop closing
-// off) to t1.
-int wrongIncrements(const std::string& log, slam::PipelineOptions o, double t0, double t1) {
+// The errors of the keyframe increments ending between t0 and t1 against the log's corrected
+// poses (the reference), after running the pipeline (loop closing off) to t1.
+std::vector<common::Pose2> incrementErrors(const std::string& log, slam::PipelineOptions o, double t0, double t1) {
   o.loop_closure.enabled = false;
   slam::Pipeline p(o);
   auto src = io::openDataSource(log);
@@ -24,37 +24,27 @@ int wrongIncrements(const std::string& log, slam::PipelineOptions o, double t0, 
   std::map<double, common::Pose2> ref;
   for (const auto& r : p.referenceTrajectory()) ref[r.timestamp] = r.pose;
   const auto& kf = p.keyframes();
-  int wrong = 0;
+  std::vector<common::Pose2> errors;
   for (size_t k = 1; k < kf.size(); ++k) {
     if (kf[k].timestamp < t0 || kf[k].timestamp > t1) continue;
     const auto a = ref.find(kf[k - 1].timestamp), b = ref.find(kf[k].timestamp);
     if (a == ref.end() || b == ref.end()) continue;
-    const common::Pose2 e = common::between(common::between(a->second, b->second), common::between(kf[k - 1].pose, kf[k].pose));
-    if (std::hypot(e.x, e.y) > 0.5) ++wrong;
+    errors.push_back(common::between(common::between(a->second, b->second), common::between(kf[k - 1].pose, kf[k].pose)));
   }
+  return errors;
+}
+
+// How many of those increments are more than 0.5 m off.
+int wrongIncrements(const std::string& log, const slam::PipelineOptions& o, double t0, double t1) {
+  int wrong = 0;
+  for (const auto& e : incrementErrors(log, o, t0, t1)) wrong += std::hypot(e.x, e.y) > 0.5 ? 1 : 0;
   return wrong;
 }
 
-// The largest heading error [deg] of the keyframe increments ending between t0 and t1, against
-// the log's corrected poses, after running the pipeline (loop closing off) to t1.
-double worstHeadingError(const std::string& log, slam::PipelineOptions o, double t0, double t1) {
-  o.loop_closure.enabled = false;
-  slam::Pipeline p(o);
-  auto src = io::openDataSource(log);
-  while (p.step(*src) && p.stats().last_timestamp <= t1) {
-  }
-  p.finish();
-  std::map<double, common::Pose2> ref;
-  for (const auto& r : p.referenceTrajectory()) ref[r.timestamp] = r.pose;
-  const auto& kf = p.keyframes();
+// The largest heading error of those increments [deg].
+double worstHeadingError(const std::string& log, const slam::PipelineOptions& o, double t0, double t1) {
   double worst = 0;
-  for (size_t k = 1; k < kf.size(); ++k) {
-    if (kf[k].timestamp < t0 || kf[k].timestamp > t1) continue;
-    const auto a = ref.find(kf[k - 1].timestamp), b = ref.find(kf[k].timestamp);
-    if (a == ref.end() || b == ref.end()) continue;
-    const common::Pose2 e = common::between(common::between(a->second, b->second), common::between(kf[k - 1].pose, kf[k].pose));
-    worst = std::max(worst, std::abs(e.phi) * 180 / M_PI);
-  }
+  for (const auto& e : incrementErrors(log, o, t0, t1)) worst = std::max(worst, std::abs(e.phi) * 180 / M_PI);
   return worst;
 }
 
