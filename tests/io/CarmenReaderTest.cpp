@@ -216,3 +216,29 @@ TEST(CarmenReader, RepeatedTimestampsFallBackToTheScanIndex) {
   for (size_t i = 0; i < r.scans.size(); ++i) EXPECT_DOUBLE_EQ(r.scans[i].timestamp, static_cast<double>(i + 1));
   EXPECT_NE(reader.format().find("scan index"), std::string::npos);
 }
+
+// The Freiburg corrected logs print 6 significant digits, so after 1000 s the Intel log's odometry
+// bursts share one printed time. The reader spreads such lines, in file order, over the 10 ms
+// the printed value stands for; a scan keeps the time of the reading it was logged with.
+TEST(CarmenReader, ReadingsSharingAPrintedTimeAreSpreadOverItsStep) {
+  const auto odom = [](double x, const std::string& t) { return "ODOM " + std::to_string(x) + " 0 0 0 0 0 " + t + " h " + t + "\n"; };
+  std::string rear = flaser(3, "1.0", 2670.16);
+  rear.replace(0, 6, "RLASER");
+  const std::string text = odom(0.0, "2670.15") + odom(0.1, "2670.16") + odom(0.2, "2670.16") + flaser(3, "1.0", 2670.16) +
+                           rear + odom(0.3, "2670.16") + odom(0.4, "2670.17");
+  io::CarmenReader reader(writeText("burst", text));
+  ASSERT_TRUE(reader.info().has_timestamps);
+  const ReadBack r = readAll(reader);
+  ASSERT_EQ(r.odometry.size(), 5u);
+  ASSERT_EQ(r.scans.size(), 2u);
+  EXPECT_DOUBLE_EQ(r.odometry[0].timestamp, 2670.15);  // alone at its printed time: unchanged
+  EXPECT_DOUBLE_EQ(r.odometry[4].timestamp, 2670.17);
+  // Three instants at "2670.16": the middle of each third of [2670.155, 2670.165).
+  EXPECT_NEAR(r.odometry[1].timestamp, 2670.155 + 0.01 / 6, 1e-9);
+  EXPECT_NEAR(r.odometry[2].timestamp, 2670.16, 1e-9);
+  EXPECT_NEAR(r.odometry[3].timestamp, 2670.165 - 0.01 / 6, 1e-9);
+  // The front and rear scans stay at the instant of the odometry line before them.
+  EXPECT_EQ(r.scans[0].timestamp, r.odometry[2].timestamp);
+  EXPECT_EQ(r.scans[1].timestamp, r.odometry[2].timestamp);
+  EXPECT_NEAR(r.raw_at_scan[0].x, 0.2, 1e-9);  // and the order of the file is kept
+}

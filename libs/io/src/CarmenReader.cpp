@@ -1,6 +1,8 @@
 #include "urbanslam/io/CarmenReader.h"
 
 #include <cmath>
+#include <cstdlib>
+#include <variant>
 
 #include "CarmenBeams.h"
 #include "TextScanner.h"
@@ -20,6 +22,16 @@ namespace {
 bool samePose(const Pose2& a, const Pose2& b) {
   return std::abs(a.x - b.x) < 1e-9 && std::abs(a.y - b.y) < 1e-9 &&
          std::abs(common::wrapToPi(a.phi - b.phi)) < 1e-9;
+}
+
+// The step of a number as printed: "2670.16" -> 0.01, "1.13487e+09" -> 10, "42" -> 1.
+double printedResolution(const std::string& token) {
+  const size_t e = token.find_first_of("eE");
+  const std::string mantissa = token.substr(0, e);
+  const size_t dot = mantissa.find('.');
+  const long decimals = dot == std::string::npos ? 0 : static_cast<long>(mantissa.size() - dot - 1);
+  const long exponent = e == std::string::npos ? 0 : std::strtol(token.c_str() + e + 1, nullptr, 10);
+  return std::pow(10.0, static_cast<double>(exponent - decimals));
 }
 
 }  // namespace
@@ -115,8 +127,63 @@ double CarmenReader::stamp(double log_ts, bool is_scan) {
   return static_cast<double>(scans_ + (is_scan ? 0 : 1));
 }
 
+// Logs written with 6 significant digits (the Freiburg corrected logs) print times after 1000 s
+// to 10 ms, and the Intel log's odometry arrives in bursts: up to 11 readings, 0.57 m of travel,
+// share one printed time. Such a run of lines is held back until the time changes and spread
+// evenly, in file order, over the interval the printed value stands for (t +- step/2), so the
+// trajectory is ordered in time and can be interpolated at the raw log's microsecond times
+// (Intel relation error 0.0562 -> 0.0481 m).
 bool CarmenReader::next(Measurement& out) {
-  return detail::nextRecord(*text_, pending_, pending_pos_, out, [this](const std::string& l) { parseLine(l); });
+  while (ready_pos_ >= ready_.size()) {
+    ready_.clear();
+    ready_pos_ = 0;
+    std::string line;
+    if (!text_->nextLine(line)) {
+      releaseRun();
+      if (ready_.empty()) return false;
+      break;
+    }
+    pending_.clear();
+    parseLine(line);
+    if (pending_.empty()) continue;
+    const double t = timestampOf(pending_.front());
+    const bool same = !run_.empty() && t == run_stamp_ && run_.size() < kMaxRunLines;
+    if (!run_.empty() && !same) releaseRun();
+    if (run_.empty()) {
+      run_stamp_ = t;
+      run_step_ = line_step_;
+    }
+    // A scan shares the instant of the reading before it: corrected logs stamp each FLASER with
+    // the time of the ODOM line it was paired with, and a RLASER with its FLASER's time.
+    if (same && line_is_scan_) {
+      for (auto& m : pending_) run_.back().push_back(std::move(m));
+    } else {
+      run_.push_back(std::move(pending_));
+    }
+    pending_ = {};
+    if (!info_.has_timestamps) releaseRun();  // scan-index times are not printed values
+  }
+  out = std::move(ready_[ready_pos_++]);
+  return true;
+}
+
+void CarmenReader::releaseRun() {
+  const size_t k = run_.size();
+  for (size_t i = 0; i < k; ++i) {
+    const double t = run_stamp_ - run_step_ / 2 + run_step_ * (static_cast<double>(i) + 0.5) / static_cast<double>(k);
+    for (auto& m : run_[i]) {
+      if (k > 1 && info_.has_timestamps && run_step_ > 0) std::visit([t](auto& v) { v.timestamp = t; }, m);
+      ready_.push_back(std::move(m));
+    }
+  }
+  run_.clear();
+}
+
+double CarmenReader::lineStamp(const std::string& token, const std::string& where, bool is_scan) {
+  const double ts = parseNumber(token, where, "timestamp");
+  line_step_ = printedResolution(token);
+  line_is_scan_ = is_scan;
+  return stamp(ts, is_scan);
 }
 
 bool CarmenReader::parseLine(const std::string& line) {
@@ -140,7 +207,7 @@ void CarmenReader::handleOdom(const std::vector<std::string>& f, const std::stri
   if (f.size() < 8) throw InputError(where + ": truncated ODOM line (" + std::to_string(f.size()) + " fields, need 8)");
   const Pose2 p{parseNumber(f[1], where, "x"), parseNumber(f[2], where, "y"),
                 common::wrapToPi(parseNumber(f[3], where, "theta"))};
-  const double ts = parseNumber(f[7], where, "timestamp");
+  const double ts = lineStamp(f[7], where, false);
   const bool anchor = last_was_scan_ && samePose(p, last_scan_pose_);
   last_was_scan_ = false;
   if (anchor && have_odom_) {
@@ -156,7 +223,7 @@ void CarmenReader::handleOdom(const std::vector<std::string>& f, const std::stri
   }
   last_odom_line_ = p;
   have_odom_ = true;
-  pending_.emplace_back(OdometryReading{stamp(ts, false), raw_});
+  pending_.emplace_back(OdometryReading{ts, raw_});
 }
 
 void CarmenReader::emitScan(LaserScan scan, const Pose2& log_pose, const Pose2& odom_pose) {
@@ -187,7 +254,7 @@ void CarmenReader::handleLaser(const std::vector<std::string>& f, const std::str
   const Pose2 odom{parseNumber(f[nn + 5], where, "odom_x"), parseNumber(f[nn + 6], where, "odom_y"),
                    common::wrapToPi(parseNumber(f[nn + 7], where, "odom_theta"))};
   ++scans_;
-  scan.timestamp = stamp(parseNumber(f[nn + 8], where, "timestamp"), true);
+  scan.timestamp = lineStamp(f[nn + 8], where, true);
   const Pose2 mount = rear ? Pose2{info_.rear_offset_m, 0, M_PI} : Pose2{info_.front_offset_m, 0, 0};
   setBeamGeometry(scan, -M_PI / 2, resolutionForBeams(n), mount);
   emitScan(std::move(scan), pose, odom);
@@ -217,7 +284,7 @@ void CarmenReader::handleRobotLaser(const std::vector<std::string>& f, const std
   const Pose2 robot{parseNumber(f[k + 3], where, "robot_x"), parseNumber(f[k + 4], where, "robot_y"),
                     common::wrapToPi(parseNumber(f[k + 5], where, "robot_theta"))};
   ++scans_;
-  scan.timestamp = stamp(parseNumber(f[k + 12], where, "timestamp"), true);
+  scan.timestamp = lineStamp(f[k + 12], where, true);
   setBeamGeometry(scan, parseNumber(f[2], where, "start_angle"), parseNumber(f[4], where, "resolution"),
               common::between(robot, laser));
   emitScan(std::move(scan), robot, robot);

@@ -45,12 +45,21 @@ class CarmenReader : public DataSource {
   void handleRobotLaser(const std::vector<std::string>& f, const std::string& where);
   void handleParam(const std::vector<std::string>& f);
   double stamp(double log_ts, bool is_scan);
+  double lineStamp(const std::string& token, const std::string& where, bool is_scan);
+  void releaseRun();
   void emitScan(LaserScan scan, const common::Pose2& log_pose, const common::Pose2& odom_pose);
 
   CarmenInfo info_;
   std::unique_ptr<detail::TextScanner> text_;
-  std::vector<Measurement> pending_;  // a line can yield several measurements
-  size_t pending_pos_ = 0;
+  std::vector<Measurement> pending_;  // what the current line yields (a line can yield several)
+  // Lines sharing one printed time, held until the time changes (see next()).
+  static constexpr size_t kMaxRunLines = 4096;  // bounds memory on logs whose time never moves
+  std::vector<std::vector<Measurement>> run_;
+  double run_stamp_ = 0, run_step_ = 0;
+  double line_step_ = 0;                 // printed resolution of the current line's time
+  bool line_is_scan_ = false;            // the current line is a laser line
+  std::vector<Measurement> ready_;       // released measurements, handed out in order
+  size_t ready_pos_ = 0;
   std::vector<std::string> fields_;
 
   // Raw odometry reconstruction.
