@@ -225,11 +225,11 @@ TEST(CarmenReader, ReadingsSharingAPrintedTimeAreSpreadOverItsStep) {
   std::string rear = flaser(3, "1.0", 2670.16);
   rear.replace(0, 6, "RLASER");
   const std::string text = odom(0.0, "2670.15") + odom(0.1, "2670.16") + odom(0.2, "2670.16") + flaser(3, "1.0", 2670.16) +
-                           rear + odom(0.3, "2670.16") + odom(0.4, "2670.17");
+                           rear + odom(0.3, "2670.16") + odom(0.4, "2670.17") + odom(0.5, "2670.2") + odom(0.6, "2670.2");
   io::CarmenReader reader(writeText("burst", text));
   ASSERT_TRUE(reader.info().has_timestamps);
   const ReadBack r = readAll(reader);
-  ASSERT_EQ(r.odometry.size(), 5u);
+  ASSERT_EQ(r.odometry.size(), 7u);
   ASSERT_EQ(r.scans.size(), 2u);
   EXPECT_DOUBLE_EQ(r.odometry[0].timestamp, 2670.15);  // alone at its printed time: unchanged
   EXPECT_DOUBLE_EQ(r.odometry[4].timestamp, 2670.17);
@@ -241,4 +241,7 @@ TEST(CarmenReader, ReadingsSharingAPrintedTimeAreSpreadOverItsStep) {
   EXPECT_EQ(r.scans[0].timestamp, r.odometry[2].timestamp);
   EXPECT_EQ(r.scans[1].timestamp, r.odometry[2].timestamp);
   EXPECT_NEAR(r.raw_at_scan[0].x, 0.2, 1e-9);  // and the order of the file is kept
+  // %g drops trailing zeros: "2670.2" is 2670.20 to the log's 6 digits, so a 10 ms step too.
+  EXPECT_NEAR(r.odometry[5].timestamp, 2670.1975, 1e-9);
+  EXPECT_NEAR(r.odometry[6].timestamp, 2670.2025, 1e-9);
 }

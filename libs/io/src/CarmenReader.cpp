@@ -1,5 +1,6 @@
 #include "urbanslam/io/CarmenReader.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <variant>
@@ -24,7 +25,7 @@ bool samePose(const Pose2& a, const Pose2& b) {
          std::abs(common::wrapToPi(a.phi - b.phi)) < 1e-9;
 }
 
-// The step of a number as printed: "2670.16" -> 0.01, "1.13487e+09" -> 10, "42" -> 1.
+// The step of a number as printed: "2670.16" -> 0.01, "1.13487e+09" -> 1e4, "42" -> 1.
 double printedResolution(const std::string& token) {
   const size_t e = token.find_first_of("eE");
   const std::string mantissa = token.substr(0, e);
@@ -32,6 +33,25 @@ double printedResolution(const std::string& token) {
   const long decimals = dot == std::string::npos ? 0 : static_cast<long>(mantissa.size() - dot - 1);
   const long exponent = e == std::string::npos ? 0 : std::strtol(token.c_str() + e + 1, nullptr, 10);
   return std::pow(10.0, static_cast<double>(exponent - decimals));
+}
+
+// Significant digits as printed: "2670.16" -> 6, "0.0250" -> 3.
+int significantDigits(const std::string& token) {
+  int n = 0;
+  bool leading = true;
+  for (char c : token.substr(0, token.find_first_of("eE"))) {
+    if (c < '0' || c > '9') continue;
+    if (leading && c == '0') continue;
+    leading = false;
+    ++n;
+  }
+  return n;
+}
+
+// A fixed-point format keeps trailing zeros ("5.20"); %g drops them ("5.2").
+bool hasTrailingZero(const std::string& token) {
+  const std::string mantissa = token.substr(0, token.find_first_of("eE"));
+  return mantissa.find('.') != std::string::npos && mantissa.back() == '0';
 }
 
 }  // namespace
@@ -74,6 +94,7 @@ void CarmenReader::prescan() {
         info_.corrected = true;
       prev_odom = p;
       have_prev_odom = true;
+      if (f.size() >= 8) noteStampFormat(f[7]);
     }
     after_scan = false;
     if ((f[0] == "FLASER" || f[0] == "RLASER") && f.size() >= 2) {
@@ -84,8 +105,10 @@ void CarmenReader::prescan() {
                      parseNumber(f[static_cast<size_t>(n) + 3], where, "y"),
                      parseNumber(f[static_cast<size_t>(n) + 4], where, "theta")};
         after_scan = f[0] == "FLASER";
-        const double ts = parseNumber(f[static_cast<size_t>(n) + 8], where, "timestamp");
+        const std::string& token = f[static_cast<size_t>(n) + 8];
+        const double ts = parseNumber(token, where, "timestamp");
         if (ts != 0) any_ts = true;
+        noteStampFormat(token);
         if (f[0] == "FLASER") {  // front and rear scans of one instant legitimately share a time
           repeated_ts += ts == last_scan_ts ? 1 : 0;
           last_scan_ts = ts;
@@ -179,9 +202,17 @@ void CarmenReader::releaseRun() {
   run_.clear();
 }
 
+void CarmenReader::noteStampFormat(const std::string& token) {
+  stamp_fixed_point_ = stamp_fixed_point_ || hasTrailingZero(token);
+  stamp_digits_ = std::max(stamp_digits_, significantDigits(token));
+}
+
 double CarmenReader::lineStamp(const std::string& token, const std::string& where, bool is_scan) {
   const double ts = parseNumber(token, where, "timestamp");
   line_step_ = printedResolution(token);
+  // %g drops trailing zeros: with 6 significant digits "2162.6" is 2162.60, a 10 ms step.
+  if (!stamp_fixed_point_ && stamp_digits_ > 0 && ts != 0)
+    line_step_ = std::min(line_step_, std::pow(10.0, std::floor(std::log10(std::abs(ts))) + 1 - stamp_digits_));
   line_is_scan_ = is_scan;
   return stamp(ts, is_scan);
 }

@@ -47,6 +47,7 @@ class CarmenReader : public DataSource {
   double stamp(double log_ts, bool is_scan);
   double lineStamp(const std::string& token, const std::string& where, bool is_scan);
   void releaseRun();
+  void noteStampFormat(const std::string& token);
   void emitScan(LaserScan scan, const common::Pose2& log_pose, const common::Pose2& odom_pose);
 
   CarmenInfo info_;
@@ -58,6 +59,9 @@ class CarmenReader : public DataSource {
   double run_stamp_ = 0, run_step_ = 0;
   double line_step_ = 0;                 // printed resolution of the current line's time
   bool line_is_scan_ = false;            // the current line is a laser line
+  // How the log prints its times (prescan): fixed-point keeps trailing zeros, %g does not.
+  bool stamp_fixed_point_ = false;
+  int stamp_digits_ = 0;                 // most significant digits seen
   std::vector<Measurement> ready_;       // released measurements, handed out in order
   size_t ready_pos_ = 0;
   std::vector<std::string> fields_;
