@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "TestPaths.h"
+#include "urbanslam/common/Error.h"
 #include "urbanslam/io/DataSource.h"
 #include "urbanslam/io/MapOutputs.h"
 
@@ -126,6 +127,30 @@ TEST(MapOutputs, SimpleMapLoadsInMrpt) {
   const auto& [pose, sf] = sm.get(10);
   EXPECT_NEAR(pose->getMeanVal().x(), e.reference[10].pose.x, 1e-9);
   EXPECT_EQ(sf->size(), 1u);
+}
+
+// `eval` reads the keyframe scans back from the .simplemap: same poses, ranges and validity, and
+// an empty keyframe scan stays an empty entry, so entry k is still keyframe k.
+TEST(MapOutputs, SimpleMapReadsBackScansAndPoses) {
+  Excerpt e = loadExcerpt();
+  e.scans[3] = io::LaserScan{};  // a keyframe without a scan
+  const auto d = test::scratchDir("simplemap_read");
+  io::writeSimpleMap((d / "m.simplemap").string(), e.posed());
+  const auto back = io::readSimpleMap((d / "m.simplemap").string());
+  ASSERT_EQ(back.size(), e.scans.size());
+  EXPECT_TRUE(back[3].scan.ranges.empty());
+  for (size_t i : {0u, 10u, 79u}) {
+    EXPECT_NEAR(back[i].pose.x, e.reference[i].pose.x, 1e-9);
+    EXPECT_NEAR(back[i].pose.y, e.reference[i].pose.y, 1e-9);
+    EXPECT_NEAR(common::wrapToPi(back[i].pose.phi - e.reference[i].pose.phi), 0, 1e-9);
+    ASSERT_EQ(back[i].scan.ranges.size(), e.scans[i].ranges.size());
+    for (size_t k = 0; k < e.scans[i].ranges.size(); ++k) {
+      EXPECT_EQ(back[i].scan.valid[k], e.scans[i].valid[k]) << "scan " << i << " beam " << k;
+      if (e.scans[i].valid[k]) EXPECT_NEAR(back[i].scan.ranges[k], e.scans[i].ranges[k], 1e-4);
+    }
+    EXPECT_NEAR(back[i].scan.angle_increment_rad, e.scans[i].angle_increment_rad, 1e-7);
+  }
+  EXPECT_THROW(io::readSimpleMap((d / "missing.simplemap").string()), common::InputError);
 }
 
 TEST(MapOutputs, TumRoundTripAndGridYaml) {

@@ -1,5 +1,5 @@
 // The outputs MRPT writes for us: .simplemap (RawLogViewer, observations2map and MRPT's
-// localisation apps read it) and the occupancy grid PNG.
+// localisation apps read it; `eval` reads it back for the keyframe scans) and the occupancy grid PNG.
 #include <mrpt/maps/COccupancyGridMap2D.h>
 #include <mrpt/maps/CSimpleMap.h>
 #include <mrpt/obs/CSensoryFrame.h>
@@ -28,6 +28,30 @@ void writeSimpleMap(const std::string& path, const std::vector<PosedScan>& scans
   common::writeAtomically(path, [&](const std::string& tmp) {
     if (!sm.saveToFile(tmp)) throw common::InputError(path + ": cannot write");
   });
+}
+
+std::vector<KeyframeScan> readSimpleMap(const std::string& path) {
+  mrpt::maps::CSimpleMap sm;
+  bool ok = false;
+  try {
+    ok = sm.loadFromFile(path);
+  } catch (const std::exception& e) {
+    throw common::InputError(path + ": not a readable .simplemap (" + e.what() + ")");
+  }
+  if (!ok) throw common::InputError(path + ": cannot read the .simplemap");
+  std::vector<KeyframeScan> out(sm.size());
+  for (size_t i = 0; i < sm.size(); ++i) {
+    const auto [pdf, sf] = sm.get(i);
+    if (pdf) {
+      const mrpt::poses::CPose3D p = pdf->getMeanVal();
+      out[i].pose = {p.x(), p.y(), p.yaw()};
+    }
+    const auto obs = sf ? sf->getObservationByClass<mrpt::obs::CObservation2DRangeScan>() : nullptr;
+    // A keyframe without returns was written as an empty scan: keep it empty, not an error.
+    if (obs && obs->getScanSize() > 0)
+      out[i].scan = detail::fromMrptScan(*obs, path + ": entry " + std::to_string(i));
+  }
+  return out;
 }
 
 std::pair<int, int> writeOccupancyGrid(const std::string& prefix, const std::vector<PosedScan>& scans,

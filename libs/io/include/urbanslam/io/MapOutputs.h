@@ -40,6 +40,13 @@ void writeXyz(const std::string& path, const std::vector<MapPoint>& pts);  // "x
 
 // MRPT CSimpleMap: one (pose, sensory frame with the scan) per keyframe.
 void writeSimpleMap(const std::string& path, const std::vector<PosedScan>& scans);
+// Reads it back: the scan of each entry, in order (an entry without a 2D scan gives an empty
+// one), and its pose. Throws common::InputError naming the file.
+struct KeyframeScan {
+  common::Pose2 pose;
+  LaserScan scan;
+};
+std::vector<KeyframeScan> readSimpleMap(const std::string& path);
 
 struct OccupancyGridOptions {
   double resolution_m = 0.05;
