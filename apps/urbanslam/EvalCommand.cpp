@@ -8,7 +8,9 @@
 #include "urbanslam/common/Error.h"
 #include "urbanslam/common/Json.h"
 #include "urbanslam/io/DataSource.h"
+#include "urbanslam/io/MapOutputs.h"
 #include "urbanslam/laser_loop/LinePlot.h"
+#include "urbanslam/slam/ClosureEvidence.h"
 #include "urbanslam/slam/Evaluation.h"
 
 namespace urbanslam::cli {
@@ -38,6 +40,14 @@ std::vector<io::StampedPose> loadReference(const std::string& path, bool& positi
   throw common::InputError(path + ": carries no reference trajectory (no reference poses, no GPS)");
 }
 
+common::Json poseJson(const common::Pose2& p) {
+  common::Json j = common::Json::object();
+  j["x"] = p.x;
+  j["y"] = p.y;
+  j["phi"] = p.phi;
+  return j;
+}
+
 }  // namespace
 
 int evalCommand(const Argv& args) {
@@ -48,7 +58,9 @@ int evalCommand(const Argv& args) {
                "    the time offset between the run and the relations is found from the reference trajectory\n"
                "    (--reference, or reference.tum in RUN_DIR) when their time bases differ;\n"
                "  --reference: ATE/RPE against a TUM trajectory or a log with a reference (corrected CARMEN log,\n"
-               "    or GPS: positions only), and loop closures classified true/false.\n"
+               "    or GPS: positions only), and loop closures classified true/false. Each false one is\n"
+               "    weighed on its two keyframe scans (RUN_DIR/map.simplemap): PL-ICP started at the\n"
+               "    reference's relative pose ends at the run's (verdict run), stays (reference) or neither.\n"
                "Plots: RUN_DIR/eval_trajectory.png, RUN_DIR/eval_error.png.");
   ap.addPositional("RUN_DIR", "output folder of urbanslam run");
   ap.addOption("relations", "FILE", "Freiburg relations file (t1 t2 x y z roll pitch yaw)");
@@ -121,6 +133,13 @@ int evalCommand(const Argv& args) {
       j["loops_true"] = lm.true_positive;
       j["loops_false"] = lm.false_positive;
       j["loops_unverifiable"] = lm.unverifiable;
+      // The keyframe scans (map.simplemap) say whether each false closure or the reference is
+      // what they support; a positions-only reference (GPS) has no relative pose to test.
+      std::vector<io::KeyframeScan> keyframes;
+      const fs::path simplemap = dir / "map.simplemap";
+      const bool weigh = !positions_only && !lm.false_closures.empty() && fs::exists(simplemap);
+      if (weigh) keyframes = io::readSimpleMap(simplemap.string());
+      size_t favour_run = 0, favour_reference = 0;
       common::Json list = common::Json::array();
       for (const auto& f : lm.false_closures) {
         common::Json e = common::Json::object();
@@ -130,9 +149,27 @@ int evalCommand(const Argv& args) {
         e["to_time"] = f.to_time;
         e["error_m"] = f.error_m;
         e["error_deg"] = f.error_deg;
+        const auto in_map = [&](long k) { return k >= 0 && static_cast<size_t>(k) < keyframes.size(); };
+        if (weigh && in_map(f.from_keyframe) && in_map(f.to_keyframe)) {
+          const auto ev = slam::weighClosure(keyframes[static_cast<size_t>(f.from_keyframe)].scan,
+                                             keyframes[static_cast<size_t>(f.to_keyframe)].scan, f.measurement, f.reference);
+          common::Json s = common::Json::object();
+          s["verdict"] = ev.verdict;
+          s["from_reference"] = poseJson(ev.from_reference);
+          s["matched_fraction"] = ev.matched_fraction;
+          s["run_conflict"] = ev.run_conflict;
+          s["reference_conflict"] = ev.reference_conflict;
+          e["scans"] = std::move(s);
+          favour_run += ev.verdict == "run" ? 1 : 0;
+          favour_reference += ev.verdict == "reference" ? 1 : 0;
+        }
         list.push(std::move(e));
       }
       j["loops_false_list"] = std::move(list);
+      if (weigh) {
+        j["loops_false_scans_favour_run"] = favour_run;
+        j["loops_false_scans_favour_reference"] = favour_reference;
+      }
     }
     // Plots: the aligned estimate over the reference, and the position error over time.
     laser_loop::PlotSeries ref{"reference", {}, {}, 0x808080}, est{"estimate (aligned)", {}, {}, 0x2060e0};

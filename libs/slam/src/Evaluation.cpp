@@ -271,19 +271,20 @@ LoopMetrics classifyLoopClosures(const std::vector<LoopRow>& loops, const std::v
     }
     bool ok;
     double err_m = 0, err_deg = 0;
+    const Pose2 rel = common::between(a, b);
     if (positions_only) {
       // GPS alone has no heading, and Victoria Park's fixes jump by metres: compare distances
       // only, with 2 m of slack for the fixes themselves.
       err_m = std::abs(std::hypot(b.x - a.x, b.y - a.y) - std::hypot(l.measurement.x, l.measurement.y));
       ok = err_m <= tol_m + 2.0;
     } else {
-      const Pose2 err = common::between(common::between(a, b), l.measurement);
+      const Pose2 err = common::between(rel, l.measurement);
       err_m = std::hypot(err.x, err.y);
       err_deg = std::abs(err.phi) * kRad2Deg;
       ok = err_m <= tol_m && err_deg <= tol_deg;
     }
     ++(ok ? m.true_positive : m.false_positive);
-    if (!ok) m.false_closures.push_back({l.from_keyframe, l.to_keyframe, l.from_time, l.to_time, err_m, err_deg});
+    if (!ok) m.false_closures.push_back({l.from_keyframe, l.to_keyframe, l.from_time, l.to_time, err_m, err_deg, l.measurement, rel});
   }
   return m;
 }

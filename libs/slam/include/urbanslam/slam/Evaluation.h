@@ -77,6 +77,8 @@ struct FalseClosure {
   long from_keyframe = 0, to_keyframe = 0;
   double from_time = 0, to_time = 0;
   double error_m = 0, error_deg = 0;  // for a positions-only reference: the distance disagreement
+  common::Pose2 measurement;          // the run's relative pose (B in A's frame)
+  common::Pose2 reference;            // the reference's (position-only references: heading 0)
 };
 struct LoopMetrics {
   size_t accepted = 0, true_positive = 0, false_positive = 0, unverifiable = 0;
