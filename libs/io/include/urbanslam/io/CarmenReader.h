@@ -1,6 +1,7 @@
 #pragma once
 // CARMEN logs read directly, keeping their timestamps (MRPT's carmen2rawlog loses them and
-// gives 180-beam logs a 90° field of view).
+// gives 180-beam logs a 90° field of view). Lines that share one printed time are spread over
+// the step that time stands for (see CarmenReader::next).
 //
 // Freiburg "corrected" logs hold GMapping's corrected pose in FLASER and re-anchor ODOM at each
 // corrected scan pose (the ODOM line right after a FLASER repeats its pose). Raw odometry is
