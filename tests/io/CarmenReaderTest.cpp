@@ -245,3 +245,17 @@ TEST(CarmenReader, ReadingsSharingAPrintedTimeAreSpreadOverItsStep) {
   EXPECT_NEAR(r.odometry[5].timestamp, 2670.1975, 1e-9);
   EXPECT_NEAR(r.odometry[6].timestamp, 2670.2025, 1e-9);
 }
+
+// A fixed-point log ("%.2f": trailing zeros kept) has one step for every time, however many
+// digits the number has: "5.25" stands for [5.245, 5.255), not for 5.25 to 6 digits.
+TEST(CarmenReader, FixedPointTimesKeepTheirOwnStep) {
+  const auto odom = [](double x, const std::string& t) { return "ODOM " + std::to_string(x) + " 0 0 0 0 0 " + t + " h " + t + "\n"; };
+  const std::string text = odom(0.0, "5.20") + odom(0.1, "5.25") + odom(0.2, "5.25") + odom(0.3, "2670.16") +
+                           flaser(3, "1.0", 2670.16);
+  io::CarmenReader reader(writeText("fixed", text));
+  ASSERT_TRUE(reader.info().has_timestamps);
+  const ReadBack r = readAll(reader);
+  ASSERT_EQ(r.odometry.size(), 4u);
+  EXPECT_NEAR(r.odometry[1].timestamp, 5.2475, 1e-9);
+  EXPECT_NEAR(r.odometry[2].timestamp, 5.2525, 1e-9);
+}
