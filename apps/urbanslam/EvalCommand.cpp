@@ -169,6 +169,8 @@ int evalCommand(const Argv& args) {
       if (weigh) {
         j["loops_false_scans_favour_run"] = favour_run;
         j["loops_false_scans_favour_reference"] = favour_reference;
+      } else if (!positions_only && !lm.false_closures.empty()) {
+        j["loops_false_scans_skipped"] = "no map.simplemap in RUN_DIR ([output] write_simplemap = false)";
       }
     }
     // Plots: the aligned estimate over the reference, and the position error over time.
