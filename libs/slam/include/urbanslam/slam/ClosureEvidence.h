@@ -27,6 +27,8 @@ constexpr double kSamePoseM = 0.1;
 constexpr double kSamePoseDeg = 1.0;
 
 // `run` and `reference` are poses of B's vehicle frame in A's, as loop_closures.csv stores them.
+// PL-ICP runs with the aligner's default options, not the run's [loop_closure] ones: an
+// independent check of the closure, not a repeat of the run's own acceptance test.
 ClosureEvidence weighClosure(const io::LaserScan& a, const io::LaserScan& b, const common::Pose2& run,
                              const common::Pose2& reference);
 
