@@ -12,6 +12,9 @@
 #                    CSAIL runs on the gfs log, and its reference is the corrected log's poses
 #                    paired with the gfs scans by index: both hold the same 406 scans);
 #   loops / false    loop closures accepted / false against the reference (urbanslam only);
+#   fav_run          of the false ones, those whose two keyframe scans favour the run: PL-ICP
+#                    started at the reference's relative pose ends at the run's measurement
+#                    (`eval`'s weighing; details per closure in urbanslam.eval.json);
 #   wall_s / rtf     wall-clock time of the process and the real-time factor (log duration / wall).
 # Rows:
 #   urbanslam       the trajectory at every odometry reading (what `run` writes);
@@ -71,13 +74,15 @@ system, name, ev, wall, dur = sys.argv[1:6]
 j = json.load(open(ev)); r = j.get('relations', {})
 # Closures exist (loop_closures.csv) only in urbanslam's own run folder.
 loops, false = (j.get('loops_accepted'), j.get('loops_false')) if system == 'urbanslam' else (None, None)
+# False closures whose two scans, aligned from the reference's relative pose, end at the run's.
+fav = j.get('loops_false_scans_favour_run', 0 if false == 0 else None) if system == 'urbanslam' else None
 f = lambda v, fmt: (fmt % v) if v is not None else '-'
 ate = j.get('ate_rmse_m') if j.get('matched', 0) > 0 else None
 print(f"{name:14s} {system:15s} {f(r.get('used'), '%5d'):>5s} {f(r.get('abs_trans_mean_m'), '%8.4f'):>8s} {f(r.get('abs_rot_mean_deg'), '%7.3f'):>7s} "
-      f"{f(ate, '%7.3f'):>7s} {f(loops, '%5d'):>5s} {f(false, '%5d'):>5s} {float(wall):8.2f} {float(dur) / float(wall):8.1f}")
+      f"{f(ate, '%7.3f'):>7s} {f(loops, '%5d'):>5s} {f(false, '%5d'):>5s} {f(fav, '%7d'):>7s} {float(wall):8.2f} {float(dur) / float(wall):8.1f}")
 PY
 }
-printf "%-14s %-15s %5s %8s %7s %7s %5s %5s %8s %8s\n" dataset system rel_n rel_m rel_deg ate_m loops false wall_s rtf
+printf "%-14s %-15s %5s %8s %7s %7s %5s %5s %7s %8s %8s\n" dataset system rel_n rel_m rel_deg ate_m loops false fav_run wall_s rtf
 for d in "${datasets[@]}"; do
   read -r name log ini rel ref <<<"$d"
   [[ -e $log ]] || { echo "$name: $log absent, skipped" >&2; continue; }
