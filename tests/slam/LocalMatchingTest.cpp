@@ -96,9 +96,9 @@ TEST(LocalMatching, MatchThatEveryStartReachesIsTrusted) {
   if (log.empty()) GTEST_SKIP() << "../shared/data (Freiburg corrected logs) not present";
   const slam::PipelineOptions o = slam::loadPipelineOptions(test::repoPath("ini/fr079.ini"));
   ASSERT_TRUE(o.local.trust_agreeing_starts);
-  slam::PipelineOptions majority_only = o;
-  majority_only.local.trust_agreeing_starts = false;
-  EXPECT_EQ(wrongIncrements(log, majority_only, 308, 309), 1);
+  slam::PipelineOptions without_rule = o;
+  without_rule.local.trust_agreeing_starts = false;
+  EXPECT_EQ(wrongIncrements(log, without_rule, 308, 309), 1);
   EXPECT_EQ(wrongIncrements(log, o, 308, 309), 0);
   EXPECT_LE(wrongIncrements(log, o, 302, 309), 1);  // 306.3 s: no start finds the reversing pose
 }
