@@ -98,7 +98,7 @@ bool Pipeline::stepOnce(io::DataSource& source) {
     have_first_ts_ = true;
   }
   stats_.last_timestamp = t;
-  const size_t last_kf = keyframes_.empty() ? kNone : keyframes_.size() - 1;
+  const size_t last_anchor = anchors_.empty() ? kNone : anchors_.size() - 1;
   if (auto* scan = std::get_if<io::LaserScan>(&m)) {
     ++stats_.scans;
     onScan(std::move(*scan), source.progress());
@@ -106,13 +106,13 @@ bool Pipeline::stepOnce(io::DataSource& source) {
     ++stats_.odometry;
     if (options_.motion.model != "steering") {
       motion_.addOdometry(*od);
-      odometry_.push_back({od->timestamp, motion_.odometryPose(), last_kf});
+      odometry_.push_back({od->timestamp, motion_.odometryPose(), last_anchor});
     }
   } else if (const auto* dr = std::get_if<io::DriveReading>(&m)) {
     ++stats_.drive;
     if (options_.motion.model != "odometry") {
       motion_.addDrive(*dr);
-      odometry_.push_back({dr->timestamp, motion_.odometryPose(), last_kf});
+      odometry_.push_back({dr->timestamp, motion_.odometryPose(), last_anchor});
     }
   } else if (const auto* ref = std::get_if<io::ReferencePose>(&m)) {
     ++stats_.reference;
@@ -169,6 +169,8 @@ void Pipeline::onScan(io::LaserScan scan, double progress) {
     common::Stopwatch kw;
     addKeyframe(std::move(scan));
     stats_.keyframe_ms.push_back(kw.milliseconds());
+  } else if (options_.local.scan_matching && options_.local.match_every_scan && !scan.ranges.empty() && keyframes_.back().hasScan()) {
+    anchorScan(scan);
   }
   const double ms = sw.milliseconds();
   stats_.step_ms.push_back(ms);
@@ -213,7 +215,8 @@ void Pipeline::addKeyframe(io::LaserScan scan) {
   }
   // Odometry readings taken at this scan's time belong to the new keyframe: the trajectory at
   // the scan time is the keyframe's estimate, not the odometry prediction from the last one.
-  for (auto it = odometry_.rbegin(); it != odometry_.rend() && it->timestamp == kf.timestamp; ++it) it->keyframe = k;
+  anchors_.push_back({kf.timestamp, k, common::Pose2{}, motion_.odometryPose()});
+  for (auto it = odometry_.rbegin(); it != odometry_.rend() && it->timestamp == kf.timestamp; ++it) it->anchor = anchors_.size() - 1;
   if (options_.local.scan_matching) {
     alignment::AlignerOptions ao;
     recent_sets_.push_back(alignment::pointSetFromScan(kf.scan, ao.scan, ao.in_vehicle_frame));
@@ -238,6 +241,34 @@ void Pipeline::addKeyframe(io::LaserScan scan) {
 }
 
 void Pipeline::localScanMatching(const io::LaserScan& scan, common::Pose2& z, Eigen::Matrix3d& cov) {
+  common::Pose2 pose;
+  Eigen::Matrix3d a_cov;
+  if (!matchSubmap(scan, z, pose, a_cov)) {
+    ++stats_.scan_matches_rejected;
+    return;
+  }
+  ++stats_.scan_matches_used;
+  z = pose;
+  cov = options_.local.covariance_scale * a_cov;
+  const double sxy = options_.local.min_sigma_xy_m, sphi = options_.local.min_sigma_phi_deg * kDeg;
+  cov(0, 0) = std::max(cov(0, 0), sxy * sxy);
+  cov(1, 1) = std::max(cov(1, 1), sxy * sxy);
+  cov(2, 2) = std::max(cov(2, 2), sphi * sphi);
+}
+
+void Pipeline::anchorScan(const io::LaserScan& scan) {
+  // A scan between keyframes: its submap match places it relative to the last keyframe, for the
+  // trajectory at odometry times only (the filter keeps one pose per keyframe).
+  common::Pose2 pose;
+  Eigen::Matrix3d cov;
+  if (!matchSubmap(scan, motion_.increment(), pose, cov)) return;
+  ++stats_.scans_anchored;
+  anchors_.push_back({scan.timestamp, keyframes_.size() - 1, pose, motion_.odometryPose()});
+  // Odometry readings taken at the scan's time hang from it (as from a keyframe).
+  for (auto it = odometry_.rbegin(); it != odometry_.rend() && it->timestamp == scan.timestamp; ++it) it->anchor = anchors_.size() - 1;
+}
+
+bool Pipeline::matchSubmap(const io::LaserScan& scan, const common::Pose2& z, common::Pose2& pose, Eigen::Matrix3d& cov) const {
   alignment::AlignerOptions ao;
   ao.method = alignment::parseMethod(options_.local.method);
   // Reference: the points of the last few keyframes in the frame of the last one (a local
@@ -249,7 +280,7 @@ void Pipeline::localScanMatching(const io::LaserScan& scan, common::Pose2& z, Ei
     const auto t = alignment::transformed(recent_sets_[i - first], common::between(keyframes_.back().pose, keyframes_[i].pose));
     reference.insert(reference.end(), t.begin(), t.end());
   }
-  if (reference.empty()) return;  // the recent keyframes have no scans: keep the odometry
+  if (reference.empty()) return false;  // the recent keyframes have no scans: keep the odometry
   const alignment::PointSet current = alignment::pointSetFromScan(scan, ao.scan, ao.in_vehicle_frame);
   const auto within = [&](const alignment::AlignmentResult& r, double max_m, double max_deg) {
     const common::Pose2 c = common::between(z, r.transform);
@@ -291,17 +322,10 @@ void Pipeline::localScanMatching(const io::LaserScan& scan, common::Pose2& z, Ei
     });
   }
   const bool trust = trusted(a) || (unanimous && within(a, lo.max_trusted_correction_m, lo.max_trusted_correction_deg));
-  if (!a.converged || !(trust || within(a, lo.max_correction_m, lo.max_correction_deg))) {
-    ++stats_.scan_matches_rejected;
-    return;
-  }
-  ++stats_.scan_matches_used;
-  z = a.transform;
-  cov = options_.local.covariance_scale * a.cov;
-  const double sxy = options_.local.min_sigma_xy_m, sphi = options_.local.min_sigma_phi_deg * kDeg;
-  cov(0, 0) = std::max(cov(0, 0), sxy * sxy);
-  cov(1, 1) = std::max(cov(1, 1), sxy * sxy);
-  cov(2, 2) = std::max(cov(2, 2), sphi * sphi);
+  if (!a.converged || !(trust || within(a, lo.max_correction_m, lo.max_correction_deg))) return false;
+  pose = a.transform;
+  cov = a.cov;
+  return true;
 }
 
 void Pipeline::reportClosure(const LoopClosureRecord& r) {
@@ -418,19 +442,21 @@ void Pipeline::recoverAll() {
 std::vector<io::StampedPose> Pipeline::odometryTrajectory() const {
   std::vector<io::StampedPose> out;
   out.reserve(odometry_.size());
-  const auto via = [&](size_t k, const common::Pose2& odom) {
-    return common::compose(keyframes_[k].pose, common::between(keyframe_odom_[k], odom));
+  const auto anchorPose = [&](const ScanAnchor& a) { return common::compose(keyframes_[a.keyframe].pose, a.offset); };
+  const auto via = [&](size_t i, const common::Pose2& odom) {
+    return common::compose(anchorPose(anchors_[i]), common::between(anchors_[i].odom, odom));
   };
   for (const auto& s : odometry_) {
-    if (keyframes_.empty()) break;
+    if (anchors_.empty()) break;
     // Before the first keyframe the map frame is the odometry frame of that keyframe.
-    const size_t a = s.keyframe == kNone || s.keyframe >= keyframes_.size() ? 0 : s.keyframe;
+    const size_t a = s.anchor == kNone || s.anchor >= anchors_.size() ? 0 : s.anchor;
     common::Pose2 p = via(a, s.odom);
-    // Between two keyframes, the odometry drift is spread over the interval: the pose from the
-    // earlier keyframe forwards and from the later one backwards, blended by time.
+    // Between two anchors (keyframes or matched scans), the odometry drift is spread over the
+    // interval: the pose from the earlier anchor forwards and from the later one backwards,
+    // blended by time.
     const size_t b = a + 1;
-    if (s.keyframe != kNone && b < keyframes_.size()) {
-      const double ta = keyframes_[a].timestamp, tb = keyframes_[b].timestamp;
+    if (s.anchor != kNone && b < anchors_.size()) {
+      const double ta = anchors_[a].timestamp, tb = anchors_[b].timestamp;
       if (tb > ta) {
         const double f = std::clamp((s.timestamp - ta) / (tb - ta), 0.0, 1.0);
         p = common::interpolate(p, via(b, s.odom), f);

@@ -38,6 +38,7 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("max_trusted_correction_deg", o.local.max_trusted_correction_deg, 0.0, 180.0, "deg", "a trusted scan match may turn the odometry this much");
   s.add("retry_below_fraction", o.local.retry_below_fraction, 0.0, 1.0, "", "a scan match with fewer points matched (or untrusted) is retried from standing still, from the reversed odometry and from the odometry without its turn; 0: never");
   s.add("trust_agreeing_starts", o.local.trust_agreeing_starts, "a retried scan match that every start ends at is trusted (up to max_trusted_correction) even below trusted_matched_fraction");
+  s.add("match_every_scan", o.local.match_every_scan, "also match the scans between keyframes with the submap; the trajectory at odometry times follows them (the map holds keyframes only)");
   s.add("covariance_scale", o.local.covariance_scale, 0.1, 1000.0, "", "inflation of the alignment covariance");
   s.add("min_sigma_xy_m", o.local.min_sigma_xy_m, 0.0, 1.0, "m", "floor on the scan-matching position sigma");
   s.add("min_sigma_phi_deg", o.local.min_sigma_phi_deg, 0.0, 10.0, "deg", "floor on the scan-matching heading sigma");

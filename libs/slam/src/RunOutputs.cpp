@@ -119,6 +119,7 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   c["map_points"] = pts.size();
   c["scan_matches_used"] = s.scan_matches_used;
   c["scan_matches_rejected"] = s.scan_matches_rejected;
+  c["scans_anchored"] = s.scans_anchored;
   c["loop_closures_tried"] = s.closures_tried;
   c["loop_closures_accepted"] = s.closures_accepted;
   c["loop_closures_rejected"] = s.closures_rejected;

@@ -54,6 +54,9 @@ struct LocalOptions {
   // from standing still and from the reversed translation; the one matching most points wins.
   double retry_below_fraction = 0.0;      // 0: never retry
   bool trust_agreeing_starts = true;      // a retried match that every start reaches is trusted
+  // The scans between keyframes are matched with the submap too, and the trajectory at odometry
+  // times follows them (the filter and the map still hold keyframes only).
+  bool match_every_scan = true;
   double covariance_scale = 4.0;       // alignment covariance inflation (matched scans are correlated)
   double min_sigma_xy_m = 0.01;        // floors on the scan-matching uncertainty
   double min_sigma_phi_deg = 0.25;
