@@ -225,7 +225,6 @@ void Pipeline::addKeyframe(io::LaserScan scan) {
   if (laser_detector_) laser_detector_->addKeyframe(kf.scan);  // features once per keyframe
   have_scan_keyframe_ = have_scan_keyframe_ || kf.hasScan();
   keyframes_.push_back(std::move(kf));
-  keyframe_odom_.push_back(motion_.odometryPose());
   motion_.reset();
   const Keyframe& added = keyframes_.back();
   closer_.addToIndex(added);

@@ -137,7 +137,6 @@ class Pipeline {
   PipelineOptions options_;
   std::vector<PipelineObserver*> observers_;
   std::vector<Keyframe> keyframes_;
-  std::vector<common::Pose2> keyframe_odom_;  // odometry pose at each keyframe
   std::vector<OdometrySample> odometry_;
   std::vector<ScanAnchor> anchors_;
   std::vector<io::StampedPose> reference_;
