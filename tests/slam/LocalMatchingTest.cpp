@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -14,18 +15,29 @@ using namespace urbanslam;
 
 namespace {
 
-// The errors of the keyframe increments ending between t0 and t1 against the log's corrected
-// poses (the reference), after running the pipeline (loop closing off) to t1.
-std::vector<common::Pose2> incrementErrors(const std::string& log, slam::PipelineOptions o, double t0, double t1) {
+// The pipeline run on the log to t1 with loop closing off, and the log's corrected poses (the
+// reference) by time.
+struct LocalRun {
+  std::unique_ptr<slam::Pipeline> pipeline;
+  std::map<double, common::Pose2> reference;
+};
+
+LocalRun runWithoutClosures(const std::string& log, slam::PipelineOptions o, double t1) {
   o.loop_closure.enabled = false;
-  slam::Pipeline p(o);
+  LocalRun run{std::make_unique<slam::Pipeline>(o), {}};
   auto src = io::openDataSource(log);
-  while (p.step(*src) && p.stats().last_timestamp <= t1) {
+  while (run.pipeline->step(*src) && run.pipeline->stats().last_timestamp <= t1) {
   }
-  p.finish();
-  std::map<double, common::Pose2> ref;
-  for (const auto& r : p.referenceTrajectory()) ref[r.timestamp] = r.pose;
-  const auto& kf = p.keyframes();
+  run.pipeline->finish();
+  for (const auto& r : run.pipeline->referenceTrajectory()) run.reference[r.timestamp] = r.pose;
+  return run;
+}
+
+// The errors of the keyframe increments ending between t0 and t1 against the reference.
+std::vector<common::Pose2> incrementErrors(const std::string& log, const slam::PipelineOptions& o, double t0, double t1) {
+  const LocalRun run = runWithoutClosures(log, o, t1);
+  const auto& ref = run.reference;
+  const auto& kf = run.pipeline->keyframes();
   std::vector<common::Pose2> errors;
   for (size_t k = 1; k < kf.size(); ++k) {
     if (kf[k].timestamp < t0 || kf[k].timestamp > t1) continue;
@@ -48,6 +60,32 @@ double worstHeadingError(const std::string& log, const slam::PipelineOptions& o,
   double worst = 0;
   for (const auto& e : incrementErrors(log, o, t0, t1)) worst = std::max(worst, std::abs(e.phi) * 180 / M_PI);
   return worst;
+}
+
+// Mean error [m, deg] of the trajectory at the scan times that are not keyframes, each relative
+// to the keyframe before it, against the log's corrected poses (to t1, loop closing off).
+std::pair<double, double> betweenKeyframeError(const std::string& log, const slam::PipelineOptions& o, double t1) {
+  const LocalRun run = runWithoutClosures(log, o, t1);
+  const auto& ref = run.reference;
+  std::map<double, common::Pose2> ours, kf;
+  for (const auto& s : run.pipeline->odometryTrajectory()) ours[s.timestamp] = s.pose;
+  for (const auto& k : run.pipeline->keyframes()) kf[k.timestamp] = k.pose;
+  double sum_m = 0, sum_deg = 0;
+  int n = 0;
+  for (const auto& [t, ref_pose] : ref) {
+    if (kf.count(t) || t > t1) continue;
+    auto k = kf.upper_bound(t);
+    if (k == kf.begin()) continue;
+    --k;
+    const auto rk = ref.find(k->first);
+    const auto o_at = ours.find(t);
+    if (rk == ref.end() || o_at == ours.end()) continue;
+    const common::Pose2 e = common::between(common::between(rk->second, ref_pose), common::between(k->second, o_at->second));
+    sum_m += std::hypot(e.x, e.y);
+    sum_deg += std::abs(e.phi) * 180 / M_PI;
+    ++n;
+  }
+  return {n ? sum_m / n : 0.0, n ? sum_deg / n : 0.0};
 }
 
 }  // namespace
@@ -104,41 +142,6 @@ TEST(LocalMatching, MatchThatEveryStartReachesIsTrusted) {
   EXPECT_EQ(wrongIncrements(log, o, 308, 309), 0);
   EXPECT_LE(wrongIncrements(log, o, 302, 309), 1);  // 306.3 s: no start finds the reversing pose
 }
-
-namespace {
-
-// Mean error [m, deg] of the trajectory at the scan times that are not keyframes, each relative
-// to the keyframe before it, against the log's corrected poses (FR079 to t1, loop closing off).
-std::pair<double, double> betweenKeyframeError(const std::string& log, slam::PipelineOptions o, double t1) {
-  o.loop_closure.enabled = false;
-  slam::Pipeline p(o);
-  auto src = io::openDataSource(log);
-  while (p.step(*src) && p.stats().last_timestamp <= t1) {
-  }
-  p.finish();
-  std::map<double, common::Pose2> ours, kf;
-  for (const auto& s : p.odometryTrajectory()) ours[s.timestamp] = s.pose;
-  for (const auto& k : p.keyframes()) kf[k.timestamp] = k.pose;
-  std::map<double, common::Pose2> ref;
-  for (const auto& r : p.referenceTrajectory()) ref[r.timestamp] = r.pose;
-  double sum_m = 0, sum_deg = 0;
-  int n = 0;
-  for (const auto& [t, ref_pose] : ref) {
-    if (kf.count(t) || t > t1) continue;
-    auto k = kf.upper_bound(t);
-    if (k == kf.begin()) continue;
-    --k;
-    const auto rk = ref.find(k->first), o_at = ours.find(t);
-    if (rk == ref.end() || o_at == ours.end()) continue;
-    const common::Pose2 e = common::between(common::between(rk->second, ref_pose), common::between(k->second, o_at->second));
-    sum_m += std::hypot(e.x, e.y);
-    sum_deg += std::abs(e.phi) * 180 / M_PI;
-    ++n;
-  }
-  return {n ? sum_m / n : 0.0, n ? sum_deg / n : 0.0};
-}
-
-}  // namespace
 
 // FR079 keeps a scan every 0.2 s, a keyframe every 0.5 m / 10°: three scans in four are not
 // keyframes. Matched with the submap, they carry the trajectory at odometry times between

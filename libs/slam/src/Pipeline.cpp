@@ -213,10 +213,8 @@ void Pipeline::addKeyframe(io::LaserScan scan) {
     for (size_t i = k > static_cast<size_t>(options_.estimator.recent_window) ? k - options_.estimator.recent_window : 0; i < k; ++i)
       keyframes_[i].pose = esdf::toPose(esdf_->mean(static_cast<int>(i)));
   }
-  // Odometry readings taken at this scan's time belong to the new keyframe: the trajectory at
-  // the scan time is the keyframe's estimate, not the odometry prediction from the last one.
-  anchors_.push_back({kf.timestamp, k, common::Pose2{}, motion_.odometryPose()});
-  for (auto it = odometry_.rbegin(); it != odometry_.rend() && it->timestamp == kf.timestamp; ++it) it->anchor = anchors_.size() - 1;
+  // The keyframe is an anchor of the trajectory at odometry times (offset identity).
+  addAnchor({kf.timestamp, k, common::Pose2{}, motion_.odometryPose()});
   if (options_.local.scan_matching) {
     alignment::AlignerOptions ao;
     recent_sets_.push_back(alignment::pointSetFromScan(kf.scan, ao.scan, ao.in_vehicle_frame));
@@ -262,9 +260,14 @@ void Pipeline::anchorScan(const io::LaserScan& scan) {
   Eigen::Matrix3d cov;
   if (!matchSubmap(scan, motion_.increment(), pose, cov)) return;
   ++stats_.scans_anchored;
-  anchors_.push_back({scan.timestamp, keyframes_.size() - 1, pose, motion_.odometryPose()});
-  // Odometry readings taken at the scan's time hang from it (as from a keyframe).
-  for (auto it = odometry_.rbegin(); it != odometry_.rend() && it->timestamp == scan.timestamp; ++it) it->anchor = anchors_.size() - 1;
+  addAnchor({scan.timestamp, keyframes_.size() - 1, pose, motion_.odometryPose()});
+}
+
+void Pipeline::addAnchor(const ScanAnchor& anchor) {
+  anchors_.push_back(anchor);
+  // Odometry readings taken at the scan's time hang from it: the trajectory at that time is the
+  // scan's pose, not the odometry prediction from the anchor before.
+  for (auto it = odometry_.rbegin(); it != odometry_.rend() && it->timestamp == anchor.timestamp; ++it) it->anchor = anchors_.size() - 1;
 }
 
 bool Pipeline::matchSubmap(const io::LaserScan& scan, const common::Pose2& z, common::Pose2& pose, Eigen::Matrix3d& cov) const {

@@ -118,6 +118,7 @@ class Pipeline {
   // keyframe's frame and the alignment covariance, or false when the match is refused.
   bool matchSubmap(const io::LaserScan& scan, const common::Pose2& z, common::Pose2& pose, Eigen::Matrix3d& cov) const;
   void anchorScan(const io::LaserScan& scan);
+  void addAnchor(const ScanAnchor& anchor);
   void searchLoopClosures(size_t current);
   // Camera images (PipelineImages.cpp): attachment to keyframes, Tree of Words proposals.
   void onCameraImage(const io::CameraImage& image, double progress);
