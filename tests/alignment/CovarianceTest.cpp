@@ -74,8 +74,8 @@ TEST(Covariance, LineVarianceScalesWithSensorNoise) {
   const uc::Pose2 t = uc::between({-3, 0, 0.2}, {-2.2, 0.4, 0.35});
   ua::CovarianceOptions o;
   o.scale_by_residuals = false;
-  const auto Cl = ua::lineVarianceCovariance(ua::pointSetFromScan(sa, lo), ua::pointSetFromScan(sb, lo), t, o);
-  const auto Ch = ua::lineVarianceCovariance(ua::pointSetFromScan(sa, hi), ua::pointSetFromScan(sb, hi), t, o);
+  const auto Cl = ua::lineVarianceCovariance(ua::IndexedReference(ua::pointSetFromScan(sa, lo)), ua::pointSetFromScan(sb, lo), t, o);
+  const auto Ch = ua::lineVarianceCovariance(ua::IndexedReference(ua::pointSetFromScan(sa, hi)), ua::pointSetFromScan(sb, hi), t, o);
   EXPECT_GT(Ch.trace(), 4 * Cl.trace());
 }
 

@@ -24,6 +24,15 @@ AlignmentResult align(const io::LaserScan& a, const io::LaserScan& b, const Pose
 AlignmentResult alignPointSets(const PointSet& a, const PointSet& b, const Pose2& guess,
                                const AlignerOptions& options) {
   common::Stopwatch sw;
+  AlignmentResult r = alignPointSets(IndexedReference(a), b, guess, options);
+  r.time_ms = sw.milliseconds();
+  return r;
+}
+
+AlignmentResult alignPointSets(const IndexedReference& indexed, const PointSet& b, const Pose2& guess,
+                               const AlignerOptions& options) {
+  common::Stopwatch sw;
+  const PointSet& a = indexed.points();
   AlignmentResult out;
   out.transform = guess;
   out.points_a = static_cast<int>(a.size());
@@ -44,10 +53,10 @@ AlignmentResult alignPointSets(const PointSet& a, const PointSet& b, const Pose2
   RegistrationResult reg;
   bool point_to_line = false;
   switch (options.method) {
-    case Method::Icp: reg = icp(a, b, guess, options.icp); break;
+    case Method::Icp: reg = icpWithIndex(a, indexed.index(), {}, b, guess, options.icp); break;
     case Method::PlIcp:
       point_to_line = true;
-      reg = plIcp(a, b, guess, options.icp);
+      reg = icpWithIndex(a, indexed.index(), indexed.normals(options.icp.normals), b, guess, options.icp);
       break;
     case Method::Crf: reg = crfMatch(a, b, guess, options.crf); break;
     case Method::CrfIcp: {
@@ -69,17 +78,13 @@ AlignmentResult alignPointSets(const PointSet& a, const PointSet& b, const Pose2
       for (const auto& h : diag.hypotheses) addStart(h);
       addStart(guess);
       point_to_line = options.refine_point_to_line;
-      std::vector<Eigen::Vector2d> ref_pts;
-      ref_pts.reserve(a.size());
-      for (const auto& q : a) ref_pts.push_back(q.p);
-      const NearestNeighbours index(std::move(ref_pts));
-      const std::vector<LineNormal> normals =
-          point_to_line ? computeLineNormals(a, options.icp.normals) : std::vector<LineNormal>{};
+      const std::vector<LineNormal> none;
+      const std::vector<LineNormal>& normals = point_to_line ? indexed.normals(options.icp.normals) : none;
       bool have = false;
       int total_iterations = coarse.iterations;
       double best_count = -1;
       for (const auto& st : starts) {
-        RegistrationResult r = icpWithIndex(a, index, normals, b, st, options.icp);
+        RegistrationResult r = icpWithIndex(a, indexed.index(), normals, b, st, options.icp);
         total_iterations += r.iterations;
         if (!r.converged) {
           if (!have) reg = r;
@@ -112,8 +117,8 @@ AlignmentResult alignPointSets(const PointSet& a, const PointSet& b, const Pose2
 
   if (reg.converged) {
     common::Stopwatch csw;
-    out.cov = alignmentCovariance(a, b, reg.transform, options.icp, point_to_line, options.covariance);
-    out.constraint_ratio = translationConstraintRatio(a, b, reg.transform, options.covariance);
+    out.cov = alignmentCovariance(indexed, b, reg.transform, options.icp, point_to_line, options.covariance);
+    out.constraint_ratio = translationConstraintRatio(indexed, b, reg.transform, options.covariance);
     out.covariance_time_ms = csw.milliseconds();
     if (out.constraint_ratio < options.min_constraint_ratio) {
       std::ostringstream os;

@@ -21,12 +21,9 @@ struct Pair {
   Eigen::Vector2d dm;  // d m / d phi
 };
 
-std::vector<Pair> associations(const PointSet& reference, const PointSet& moving,
+std::vector<Pair> associations(const IndexedReference& reference, const PointSet& moving,
                                const Pose2& transform, double gate) {
-  std::vector<Eigen::Vector2d> pts;
-  pts.reserve(reference.size());
-  for (const auto& q : reference) pts.push_back(q.p);
-  NearestNeighbours index(std::move(pts));
+  const NearestNeighbours& index = reference.index();
   const Rigid2 T = Rigid2::fromPose(transform);
   const double c = std::cos(transform.phi), s = std::sin(transform.phi);
   std::vector<Pair> out;
@@ -35,7 +32,7 @@ std::vector<Pair> associations(const PointSet& reference, const PointSet& moving
     const Eigen::Vector2d m = T * b;
     int j = 0;
     double d2 = 0;
-    if (!index.nearest(m, &j, &d2) || d2 > gate * gate) continue;
+    if (!index.nearestWithin(m, gate * gate, &j, &d2)) continue;
     out.push_back({static_cast<int>(i), j, m, Eigen::Vector2d(-s * b.x() - c * b.y(), c * b.x() - s * b.y())});
   }
   return out;
@@ -63,11 +60,12 @@ double sweepSpacing(const PointSet& ref, int j) {
 
 }  // namespace
 
-Eigen::Matrix3d lineVarianceCovariance(const PointSet& reference, const PointSet& moving,
+Eigen::Matrix3d lineVarianceCovariance(const IndexedReference& indexed, const PointSet& moving,
                                        const Pose2& transform, const CovarianceOptions& options) {
-  const auto pairs = associations(reference, moving, transform, options.association_gate_m);
+  const auto pairs = associations(indexed, moving, transform, options.association_gate_m);
   if (pairs.size() < 3) return largeCovariance(options);
-  const auto normals = computeLineNormals(reference, options.normals);
+  const PointSet& reference = indexed.points();
+  const auto& normals = indexed.normals(options.normals);
   const Rigid2 T = Rigid2::fromPose(transform);
   Eigen::Matrix3d info = Eigen::Matrix3d::Zero();
   double chi2 = 0;
@@ -101,12 +99,13 @@ Eigen::Matrix3d lineVarianceCovariance(const PointSet& reference, const PointSet
   return symmetric(cov);
 }
 
-Eigen::Matrix3d hessianCovariance(const PointSet& reference, const PointSet& moving,
+Eigen::Matrix3d hessianCovariance(const IndexedReference& indexed, const PointSet& moving,
                                   const Pose2& transform, const CovarianceOptions& options) {
-  const auto pairs = associations(reference, moving, transform, options.association_gate_m);
+  const auto pairs = associations(indexed, moving, transform, options.association_gate_m);
   if (pairs.size() < 3) return largeCovariance(options);
-  std::vector<LineNormal> normals;
-  if (options.hessian_point_to_line) normals = computeLineNormals(reference, options.normals);
+  const PointSet& reference = indexed.points();
+  const std::vector<LineNormal> none;
+  const auto& normals = options.hessian_point_to_line ? indexed.normals(options.normals) : none;
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
   double sse = 0;
   int n = 0;
@@ -133,14 +132,13 @@ Eigen::Matrix3d hessianCovariance(const PointSet& reference, const PointSet& mov
   return symmetric(info.inverse());
 }
 
-Eigen::Matrix3d samplingCovariance(const PointSet& reference, const PointSet& moving,
+Eigen::Matrix3d samplingCovariance(const IndexedReference& indexed, const PointSet& moving,
                                    const Pose2& transform, const IcpOptions& icp, bool point_to_line,
                                    const CovarianceOptions& options) {
-  std::vector<Eigen::Vector2d> pts;
-  for (const auto& q : reference) pts.push_back(q.p);
-  NearestNeighbours index(std::move(pts));
-  std::vector<LineNormal> normals;
-  if (point_to_line) normals = computeLineNormals(reference, icp.normals);
+  const PointSet& reference = indexed.points();
+  const NearestNeighbours& index = indexed.index();
+  const std::vector<LineNormal> none;
+  const auto& normals = point_to_line ? indexed.normals(icp.normals) : none;
   std::mt19937 rng(options.seed);
   std::normal_distribution<double> nd(0.0, 1.0);
   std::vector<Eigen::Vector3d> results;
@@ -168,6 +166,12 @@ Eigen::Matrix3d samplingCovariance(const PointSet& reference, const PointSet& mo
 Eigen::Matrix3d alignmentCovariance(const PointSet& reference, const PointSet& moving,
                                     const Pose2& transform, const IcpOptions& icp, bool point_to_line,
                                     const CovarianceOptions& options) {
+  return alignmentCovariance(IndexedReference(reference), moving, transform, icp, point_to_line, options);
+}
+
+Eigen::Matrix3d alignmentCovariance(const IndexedReference& reference, const PointSet& moving,
+                                    const Pose2& transform, const IcpOptions& icp, bool point_to_line,
+                                    const CovarianceOptions& options) {
   switch (options.method) {
     case CovarianceMethod::LineVariance: return lineVarianceCovariance(reference, moving, transform, options);
     case CovarianceMethod::Hessian: return hessianCovariance(reference, moving, transform, options);
@@ -179,9 +183,14 @@ Eigen::Matrix3d alignmentCovariance(const PointSet& reference, const PointSet& m
 
 double translationConstraintRatio(const PointSet& reference, const PointSet& moving,
                                   const Pose2& transform, const CovarianceOptions& options) {
+  return translationConstraintRatio(IndexedReference(reference), moving, transform, options);
+}
+
+double translationConstraintRatio(const IndexedReference& reference, const PointSet& moving,
+                                  const Pose2& transform, const CovarianceOptions& options) {
   const auto pairs = associations(reference, moving, transform, options.association_gate_m);
   if (pairs.size() < 3) return 0.0;
-  const auto normals = computeLineNormals(reference, options.normals);
+  const auto& normals = reference.normals(options.normals);
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
   for (const auto& pr : pairs) {
     if (normals[pr.ref].valid) {

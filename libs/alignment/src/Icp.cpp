@@ -119,7 +119,7 @@ RegistrationResult icpWithIndex(const PointSet& reference, const NearestNeighbou
       const Eigen::Vector2d m = T * q.p;
       int j = 0;
       double d2 = 0;
-      if (!index.nearest(m, &j, &d2) || d2 > g * g) continue;
+      if (!index.nearestWithin(m, g * g, &j, &d2)) continue;
       double e = std::sqrt(d2);
       if (point_to_line && normals[j].valid) e = std::abs(normals[j].n.dot(m - reference[j].p));
       src.push_back(q.p);

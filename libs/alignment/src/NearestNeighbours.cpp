@@ -1,5 +1,8 @@
 #include "urbanslam/alignment/NearestNeighbours.h"
 
+#include <cmath>
+#include <limits>
+
 #include <nanoflann.hpp>
 
 namespace urbanslam::alignment {
@@ -37,6 +40,24 @@ bool NearestNeighbours::nearest(const Eigen::Vector2d& query, int* index, double
   double d2 = 0;
   const double q[2] = {query.x(), query.y()};
   if (impl_->tree->knnSearch(q, 1, &idx, &d2) == 0) return false;
+  *index = static_cast<int>(idx);
+  *distance_sq = d2;
+  return true;
+}
+
+bool NearestNeighbours::nearestWithin(const Eigen::Vector2d& query, double max_distance_sq, int* index,
+                                      double* distance_sq) const {
+  if (!impl_->tree) return false;
+  uint32_t idx = 0;
+  double d2 = 0;
+  nanoflann::KNNResultSet<double, uint32_t> result(1);
+  result.init(&idx, &d2);
+  // The result set's worst distance is the search bound; the leaf test is strict, so the bound
+  // is the next double above the limit to keep a point exactly at it.
+  d2 = std::nextafter(max_distance_sq, std::numeric_limits<double>::infinity());
+  const double q[2] = {query.x(), query.y()};
+  impl_->tree->findNeighbors(result, q, nanoflann::SearchParams());
+  if (result.size() == 0) return false;
   *index = static_cast<int>(idx);
   *distance_sq = d2;
   return true;

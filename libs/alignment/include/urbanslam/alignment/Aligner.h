@@ -17,6 +17,7 @@
 #include "urbanslam/alignment/AlignmentCovariance.h"
 #include "urbanslam/alignment/CrfMatch.h"
 #include "urbanslam/alignment/Icp.h"
+#include "urbanslam/alignment/IndexedReference.h"
 #include "urbanslam/alignment/ScanModel.h"
 #include "urbanslam/io/LaserScan.h"
 
@@ -54,6 +55,10 @@ struct AlignmentResult {
 AlignmentResult align(const io::LaserScan& a, const io::LaserScan& b, const common::Pose2& guess,
                       const AlignerOptions& options);
 AlignmentResult alignPointSets(const PointSet& a, const PointSet& b, const common::Pose2& guess,
+                               const AlignerOptions& options);
+// The same with A's kd-tree and normals built beforehand, for many alignments against one
+// reference (every start of a retried match, every scan against one submap).
+AlignmentResult alignPointSets(const IndexedReference& a, const PointSet& b, const common::Pose2& guess,
                                const AlignerOptions& options);
 
 Method parseMethod(const std::string& name);  // icp | plicp | crf | crf+icp; throws invalid_argument

@@ -22,6 +22,7 @@
 #include <Eigen/Core>
 
 #include "urbanslam/alignment/Icp.h"
+#include "urbanslam/alignment/IndexedReference.h"
 #include "urbanslam/alignment/LineNormals.h"
 #include "urbanslam/alignment/PointSet.h"
 
@@ -44,15 +45,18 @@ struct CovarianceOptions {
 };
 
 // Covariance of `transform` (the pose of `moving` in `reference`'s frame), order (x, y, phi).
-Eigen::Matrix3d lineVarianceCovariance(const PointSet& reference, const PointSet& moving,
+Eigen::Matrix3d lineVarianceCovariance(const IndexedReference& reference, const PointSet& moving,
                                        const common::Pose2& transform, const CovarianceOptions& options);
-Eigen::Matrix3d hessianCovariance(const PointSet& reference, const PointSet& moving,
+Eigen::Matrix3d hessianCovariance(const IndexedReference& reference, const PointSet& moving,
                                   const common::Pose2& transform, const CovarianceOptions& options);
-Eigen::Matrix3d samplingCovariance(const PointSet& reference, const PointSet& moving,
+Eigen::Matrix3d samplingCovariance(const IndexedReference& reference, const PointSet& moving,
                                    const common::Pose2& transform, const IcpOptions& icp,
                                    bool point_to_line, const CovarianceOptions& options);
 
 // Dispatch on options.method (the ICP options are used by Sampling only).
+Eigen::Matrix3d alignmentCovariance(const IndexedReference& reference, const PointSet& moving,
+                                    const common::Pose2& transform, const IcpOptions& icp,
+                                    bool point_to_line, const CovarianceOptions& options);
 Eigen::Matrix3d alignmentCovariance(const PointSet& reference, const PointSet& moving,
                                     const common::Pose2& transform, const IcpOptions& icp,
                                     bool point_to_line, const CovarianceOptions& options);
@@ -60,6 +64,8 @@ Eigen::Matrix3d alignmentCovariance(const PointSet& reference, const PointSet& m
 // How well the geometry constrains the translation: ratio of the smallest to the largest
 // eigenvalue of the translational point-to-line information (with the rotation marginalised).
 // Near 0 for a corridor (free along its axis), near 1 for a room corner. 0 without associations.
+double translationConstraintRatio(const IndexedReference& reference, const PointSet& moving,
+                                  const common::Pose2& transform, const CovarianceOptions& options);
 double translationConstraintRatio(const PointSet& reference, const PointSet& moving,
                                   const common::Pose2& transform, const CovarianceOptions& options);
 

@@ -19,6 +19,10 @@ class NearestNeighbours {
   size_t size() const;
   // Index of the nearest point and its squared distance; false when the set is empty.
   bool nearest(const Eigen::Vector2d& query, int* index, double* distance_sq) const;
+  // The same, but only within max_distance_sq (inclusive): false when no point is that close.
+  // The same answer as nearest() followed by the distance test, found faster because the search
+  // prunes every branch beyond the bound (ICP's gate leaves most unmatched points far away).
+  bool nearestWithin(const Eigen::Vector2d& query, double max_distance_sq, int* index, double* distance_sq) const;
   // Up to k nearest, closest first.
   size_t knn(const Eigen::Vector2d& query, size_t k, std::vector<int>* indices,
              std::vector<double>* distances_sq) const;

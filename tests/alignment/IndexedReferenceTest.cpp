@@ -1,0 +1,92 @@
+// The prebuilt reference (kd-tree + normals) and the bounded nearest-neighbour search must give
+// exactly what the unshared path gives: they exist for speed only.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "alignment/SyntheticScan.h"
+#include "urbanslam/alignment/Aligner.h"
+#include "urbanslam/alignment/IndexedReference.h"
+#include "urbanslam/alignment/NearestNeighbours.h"
+
+namespace ua = urbanslam::alignment;
+namespace uc = urbanslam::common;
+
+TEST(NearestNeighbours, BoundedSearchAgreesWithBruteForce) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-5, 5);
+  std::vector<Eigen::Vector2d> pts(500);
+  for (auto& p : pts) p = {u(rng), u(rng)};
+  pts.push_back(pts[7]);  // a duplicate: ties must not confuse the bound
+  const ua::NearestNeighbours index(pts);
+  for (int k = 0; k < 2000; ++k) {
+    const Eigen::Vector2d q(u(rng) * 1.4, u(rng) * 1.4);
+    const double bound = k % 3 == 0 ? 0.01 : (k % 3 == 1 ? 0.1 : 4.0);
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& p : pts) best = std::min(best, (p - q).squaredNorm());
+    int j = -1;
+    double d2 = -1;
+    const bool found = index.nearestWithin(q, bound, &j, &d2);
+    ASSERT_EQ(found, best <= bound) << k;
+    if (found) {
+      EXPECT_EQ(d2, best);
+      EXPECT_EQ((pts[j] - q).squaredNorm(), best);
+    }
+  }
+  // A point exactly at the bound is within it (the bound is inclusive, as ICP's gate test was).
+  const Eigen::Vector2d q = pts[0] + Eigen::Vector2d(0.05, 0);
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& p : pts) best = std::min(best, (p - q).squaredNorm());
+  int j = -1;
+  double d2 = -1;
+  ASSERT_TRUE(index.nearestWithin(q, best, &j, &d2));
+  EXPECT_EQ(d2, best);
+  EXPECT_FALSE(index.nearestWithin(q, std::nextafter(best, 0.0), &j, &d2));
+}
+
+TEST(IndexedReference, SameResultAsAligningThePointSets) {
+  const auto world = ua::test::roomWorld();
+  ua::test::ScanSpec spec;
+  const auto a = ua::test::simulateScan(world, {0, 0, 0}, spec);
+  spec.seed = 5;
+  const auto b = ua::test::simulateScan(world, {0.4, -0.2, 0.15}, spec);
+  for (const auto method : {ua::Method::Icp, ua::Method::PlIcp, ua::Method::CrfIcp}) {
+    ua::AlignerOptions o;
+    o.method = method;
+    const auto pa = ua::pointSetFromScan(a, o.scan, o.in_vehicle_frame);
+    const auto pb = ua::pointSetFromScan(b, o.scan, o.in_vehicle_frame);
+    const ua::IndexedReference ref(pa);
+    // Several alignments against one reference, as the pipeline's retries do.
+    for (const uc::Pose2 guess : {uc::Pose2{0.3, -0.1, 0.1}, uc::Pose2{0, 0, 0}, uc::Pose2{0.6, 0, 0.3}}) {
+      const auto plain = ua::alignPointSets(pa, pb, guess, o);
+      const auto shared = ua::alignPointSets(ref, pb, guess, o);
+      ASSERT_TRUE(plain.converged) << ua::methodName(method);
+      EXPECT_EQ(plain.transform.x, shared.transform.x);
+      EXPECT_EQ(plain.transform.y, shared.transform.y);
+      EXPECT_EQ(plain.transform.phi, shared.transform.phi);
+      EXPECT_EQ(plain.matches, shared.matches);
+      EXPECT_TRUE(plain.cov == shared.cov) << ua::methodName(method);
+      EXPECT_EQ(plain.constraint_ratio, shared.constraint_ratio);
+    }
+  }
+}
+
+TEST(IndexedReference, NormalsPerOptionsStayValid) {
+  const auto a = ua::test::simulateScan(ua::test::roomWorld(), {0, 0, 0});
+  const ua::IndexedReference ref(ua::pointSetFromScan(a, {}, true));
+  ua::LineNormalOptions loose;
+  loose.line_tolerance_m = 0.2;
+  const auto& first = ref.normals({});
+  const auto& second = ref.normals(loose);  // a second set must not move the first
+  const auto expect_first = ua::computeLineNormals(ref.points(), {});
+  const auto expect_second = ua::computeLineNormals(ref.points(), loose);
+  ASSERT_EQ(first.size(), expect_first.size());
+  ASSERT_EQ(second.size(), expect_second.size());
+  for (size_t i = 0; i < first.size(); ++i) {
+    EXPECT_EQ(first[i].piece, expect_first[i].piece);
+    EXPECT_EQ(second[i].piece, expect_second[i].piece);
+  }
+  EXPECT_EQ(&ref.normals({}), &first);  // cached, not recomputed
+}
