@@ -270,19 +270,32 @@ void Pipeline::addAnchor(const ScanAnchor& anchor) {
   for (auto it = odometry_.rbegin(); it != odometry_.rend() && it->timestamp == anchor.timestamp; ++it) it->anchor = anchors_.size() - 1;
 }
 
+const alignment::IndexedReference* Pipeline::localSubmap() const {
+  // The points of the last few keyframes in the frame of the last one (a local submap, as
+  // KISS-ICP and Cartographer match against), so one poor scan does not make the odometry jump
+  // and the drift between keyframes shrinks.
+  const size_t n = keyframes_.size(), first = n - std::min(n, recent_sets_.size());
+  std::vector<common::Pose2> offsets;
+  for (size_t i = first; i < n; ++i) offsets.push_back(common::between(keyframes_.back().pose, keyframes_[i].pose));
+  const auto same = [](const common::Pose2& a, const common::Pose2& b) { return a.x == b.x && a.y == b.y && a.phi == b.phi; };
+  if (submap_.keyframes == n && submap_.offsets.size() == offsets.size() &&
+      std::equal(offsets.begin(), offsets.end(), submap_.offsets.begin(), same))
+    return submap_.reference.get();
+  alignment::PointSet points;
+  for (size_t i = first; i < n; ++i) {
+    const auto t = alignment::transformed(recent_sets_[i - first], offsets[i - first]);
+    points.insert(points.end(), t.begin(), t.end());
+  }
+  submap_ = {n, std::move(offsets), points.empty() ? nullptr : std::make_shared<alignment::IndexedReference>(std::move(points))};
+  return submap_.reference.get();
+}
+
 bool Pipeline::matchSubmap(const io::LaserScan& scan, const common::Pose2& z, common::Pose2& pose, Eigen::Matrix3d& cov) const {
   alignment::AlignerOptions ao;
   ao.method = alignment::parseMethod(options_.local.method);
-  // Reference: the points of the last few keyframes in the frame of the last one (a local
-  // submap, as KISS-ICP and Cartographer match against), so one poor scan does not make the
-  // odometry jump and the drift between keyframes shrinks.
-  alignment::PointSet reference;
-  const size_t n = keyframes_.size(), first = n - std::min(n, recent_sets_.size());
-  for (size_t i = first; i < n; ++i) {
-    const auto t = alignment::transformed(recent_sets_[i - first], common::between(keyframes_.back().pose, keyframes_[i].pose));
-    reference.insert(reference.end(), t.begin(), t.end());
-  }
-  if (reference.empty()) return false;  // the recent keyframes have no scans: keep the odometry
+  const alignment::IndexedReference* submap = localSubmap();
+  if (!submap) return false;  // the recent keyframes have no scans: keep the odometry
+  const alignment::IndexedReference& reference = *submap;
   const alignment::PointSet current = alignment::pointSetFromScan(scan, ao.scan, ao.in_vehicle_frame);
   const auto within = [&](const alignment::AlignmentResult& r, double max_m, double max_deg) {
     const common::Pose2 c = common::between(z, r.transform);

@@ -19,6 +19,9 @@
 #include "urbanslam/slam/PipelineOptions.h"
 #include "urbanslam/vision_loop/BagOfWords.h"
 
+namespace urbanslam::alignment {
+class IndexedReference;
+}
 namespace urbanslam::esdf {
 class Esdf;
 }
@@ -117,6 +120,10 @@ class Pipeline {
   // the guess z, with the retries and the trust rules of [local]: the scan's pose in the last
   // keyframe's frame and the alignment covariance, or false when the match is refused.
   bool matchSubmap(const io::LaserScan& scan, const common::Pose2& z, common::Pose2& pose, Eigen::Matrix3d& cov) const;
+  // The local submap with its kd-tree and normals, rebuilt only when a keyframe is added or the
+  // submap's keyframes move relative to each other (a closure): the scans between two keyframes
+  // share it. Null when the recent keyframes have no points.
+  const alignment::IndexedReference* localSubmap() const;
   void anchorScan(const io::LaserScan& scan);
   void addAnchor(const ScanAnchor& anchor);
   void searchLoopClosures(size_t current);
@@ -153,6 +160,12 @@ class Pipeline {
   KeyframeImageAssigner images_;
   std::deque<LoopClosureRecord> pending_;  // passed alignment + gate, awaiting confirmation
   std::deque<alignment::PointSet> recent_sets_;  // point sets of the last keyframes (local submap)
+  struct LocalSubmap {
+    size_t keyframes = 0;                    // keyframes_.size() when built
+    std::vector<common::Pose2> offsets;      // each recent keyframe in the last one's frame
+    std::shared_ptr<const alignment::IndexedReference> reference;
+  };
+  mutable LocalSubmap submap_;
   LoopCloser closer_;
   bool have_first_ts_ = false;
   bool have_scan_keyframe_ = false;  // camera-only logs make a keyframe of every image until a scan comes
