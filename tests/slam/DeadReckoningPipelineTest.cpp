@@ -1,7 +1,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <map>
+#include <set>
 
 #include "TestPaths.h"
 #include "urbanslam/slam/Pipeline.h"
@@ -101,7 +103,8 @@ TEST(DeadReckoningPipeline, RangeLimitsInvalidateBeams) {
 // The Intel log writes some odometry readings out of time order; the odometry-time trajectory
 // (trajectory_odometry.tum) is in time order all the same, as TUM readers expect.
 TEST(DeadReckoningPipeline, OdometryTrajectoryIsInTimeOrder) {
-  size_t out_of_order = 0, readings = 0;
+  size_t out_of_order = 0;
+  std::set<double> stamps;
   {
     auto src = io::openDataSource(kExcerpt);
     io::Measurement m;
@@ -110,7 +113,7 @@ TEST(DeadReckoningPipeline, OdometryTrajectoryIsInTimeOrder) {
       if (auto* o = std::get_if<io::OdometryReading>(&m)) {
         out_of_order += o->timestamp < last ? 1 : 0;
         last = o->timestamp;
-        ++readings;
+        stamps.insert(o->timestamp);
       }
   }
   ASSERT_GT(out_of_order, 0u) << "the excerpt no longer holds out-of-order readings: the test would prove nothing";
@@ -121,6 +124,54 @@ TEST(DeadReckoningPipeline, OdometryTrajectoryIsInTimeOrder) {
   auto src = io::openDataSource(kExcerpt);
   p.run(*src);
   const auto traj = p.odometryTrajectory();
-  EXPECT_EQ(traj.size(), readings);
-  for (size_t i = 1; i < traj.size(); ++i) ASSERT_LE(traj[i - 1].timestamp, traj[i].timestamp) << "reading " << i;
+  EXPECT_EQ(traj.size(), stamps.size());  // one pose per distinct timestamp
+  for (size_t i = 1; i < traj.size(); ++i) ASSERT_LT(traj[i - 1].timestamp, traj[i].timestamp) << "reading " << i;
+}
+
+// The Freiburg campus log has no timestamps (all 0): the reader times scan k at k seconds and
+// every odometry reading before it at the same time. The trajectory must still be a function of
+// time, and at a scan's time it must be that scan's pose, not the first reading of the interval
+// (a metre earlier on the campus).
+TEST(DeadReckoningPipeline, ReadingsSharingAScanTimeGiveTheScanPose) {
+  const auto dir = test::scratchDir("shared_stamps");
+  const std::string log = (dir / "shared-stamps.log").string();
+  {
+    std::ofstream out(log);
+    double x = 0, y = 0, th = 0;
+    for (int k = 1; k <= 30; ++k) {
+      const int t = 0;  // as in the campus log
+      for (int r = 0; r < 6; ++r) {
+        x += 0.1 * std::cos(th);
+        y += 0.1 * std::sin(th);
+        th += 0.02;
+        out << "ODOM " << x << " " << y << " " << th << " 0.5 0.1 0 " << t << " test " << t << "\n";
+      }
+      out << "FLASER 180";
+      for (int b = 0; b < 180; ++b) out << " " << 3.0 + 0.01 * b;
+      out << " " << x << " " << y << " " << th << " " << x << " " << y << " " << th << " " << t << " test " << t << "\n";
+    }
+  }
+  slam::PipelineOptions o;
+  o.estimator.type = "dead_reckoning";
+  o.local.scan_matching = false;
+  o.keyframes.min_translation_m = 0.5;
+  slam::Pipeline p(o);
+  auto src = io::openDataSource(log);
+  p.run(*src);
+  ASSERT_GE(p.keyframes().size(), 20u);
+  const auto traj = p.odometryTrajectory();
+  ASSERT_EQ(traj.size(), 30u);  // 180 readings on 30 distinct stamps
+  std::map<double, common::Pose2> at;
+  for (size_t i = 0; i < traj.size(); ++i) {
+    if (i > 0) {
+      ASSERT_LT(traj[i - 1].timestamp, traj[i].timestamp);
+    }
+    at[traj[i].timestamp] = traj[i].pose;
+  }
+  for (const auto& k : p.keyframes()) {
+    ASSERT_TRUE(at.count(k.timestamp)) << k.timestamp;
+    EXPECT_NEAR(at[k.timestamp].x, k.pose.x, 1e-9) << k.timestamp;
+    EXPECT_NEAR(at[k.timestamp].y, k.pose.y, 1e-9) << k.timestamp;
+    EXPECT_NEAR(common::wrapToPi(at[k.timestamp].phi - k.pose.phi), 0, 1e-9) << k.timestamp;
+  }
 }

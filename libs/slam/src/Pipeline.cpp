@@ -482,6 +482,13 @@ std::vector<io::StampedPose> Pipeline::odometryTrajectory() const {
   // In time order for TUM readers: the Intel log writes about one odometry reading in 20 out of
   // time order.
   std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.timestamp < b.timestamp; });
+  // One pose per timestamp: the Freiburg campus log stamps all the odometry readings between two
+  // scans with the next scan's time (up to 15 readings, a metre apart), and a reader looking up
+  // that time would get whichever it finds first. The last one read is the state at that time;
+  // when a scan has that time it is the scan's own pose (readings stamped with a scan's time hang
+  // from its anchor and come before it).
+  const auto last = std::unique(out.rbegin(), out.rend(), [](const auto& a, const auto& b) { return a.timestamp == b.timestamp; });
+  out.erase(out.begin(), last.base());
   return out;
 }
 
