@@ -5,6 +5,7 @@
 
 #include <Eigen/Dense>
 
+#include "urbanslam/alignment/IndexedReference.h"
 #include "urbanslam/alignment/NearestNeighbours.h"
 
 namespace urbanslam::alignment {
@@ -55,13 +56,6 @@ double kernelWeight(RobustKernel kernel, double e, double k) {
 
 bool finitePose(const Pose2& p) {
   return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.phi);
-}
-
-std::vector<Eigen::Vector2d> positions(const PointSet& s) {
-  std::vector<Eigen::Vector2d> out;
-  out.reserve(s.size());
-  for (const auto& q : s) out.push_back(q.p);
-  return out;
 }
 
 }  // namespace
@@ -221,15 +215,14 @@ RegistrationResult icpWithIndex(const PointSet& reference, const NearestNeighbou
 
 RegistrationResult icp(const PointSet& reference, const PointSet& moving, const Pose2& guess,
                        const IcpOptions& options) {
-  NearestNeighbours index(positions(reference));
-  return icpWithIndex(reference, index, {}, moving, guess, options);
+  const IndexedReference ref(reference);
+  return icpWithIndex(ref.points(), ref.index(), {}, moving, guess, options);
 }
 
 RegistrationResult plIcp(const PointSet& reference, const PointSet& moving, const Pose2& guess,
                          const IcpOptions& options) {
-  NearestNeighbours index(positions(reference));
-  std::vector<LineNormal> normals = computeLineNormals(reference, options.normals);
-  return icpWithIndex(reference, index, normals, moving, guess, options);
+  const IndexedReference ref(reference);
+  return icpWithIndex(ref.points(), ref.index(), ref.normals(options.normals), moving, guess, options);
 }
 
 }  // namespace urbanslam::alignment

@@ -286,7 +286,7 @@ const alignment::IndexedReference* Pipeline::localSubmap() const {
     const auto t = alignment::transformed(recent_sets_[i - first], offsets[i - first]);
     points.insert(points.end(), t.begin(), t.end());
   }
-  submap_ = {n, std::move(offsets), points.empty() ? nullptr : std::make_shared<alignment::IndexedReference>(std::move(points))};
+  submap_ = {n, std::move(offsets), points.empty() ? nullptr : std::make_unique<alignment::IndexedReference>(std::move(points))};
   return submap_.reference.get();
 }
 
@@ -482,9 +482,9 @@ std::vector<io::StampedPose> Pipeline::odometryTrajectory() const {
   // In time order for TUM readers: the Intel log writes about one odometry reading in 20 out of
   // time order.
   std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.timestamp < b.timestamp; });
-  // One pose per timestamp: the Freiburg campus log stamps all the odometry readings between two
-  // scans with the next scan's time (up to 15 readings, a metre apart), and a reader looking up
-  // that time would get whichever it finds first. The last one read is the state at that time;
+  // One pose per timestamp: the Freiburg campus log has no timestamps, so the reader gives every
+  // odometry reading between two scans the next scan's time (up to 15 readings, a metre apart),
+  // and a reader of the file looking that time up would get whichever it finds first. The last one read is the state at that time;
   // when a scan has that time it is the scan's own pose (readings stamped with a scan's time hang
   // from its anchor and come before it).
   const auto last = std::unique(out.rbegin(), out.rend(), [](const auto& a, const auto& b) { return a.timestamp == b.timestamp; });

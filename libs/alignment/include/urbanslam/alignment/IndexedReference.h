@@ -20,7 +20,6 @@ class IndexedReference {
   IndexedReference& operator=(const IndexedReference&) = delete;
 
   const PointSet& points() const { return points_; }
-  size_t size() const { return points_.size(); }
   const NearestNeighbours& index() const { return index_; }
   // One normal per point (LineNormals.h), computed on first use for each set of options (ICP and
   // the covariance may use different ones). Not thread-safe: one alignment at a time.

@@ -163,7 +163,7 @@ class Pipeline {
   struct LocalSubmap {
     size_t keyframes = 0;                    // keyframes_.size() when built
     std::vector<common::Pose2> offsets;      // each recent keyframe in the last one's frame
-    std::shared_ptr<const alignment::IndexedReference> reference;
+    std::unique_ptr<const alignment::IndexedReference> reference;
   };
   mutable LocalSubmap submap_;
   LoopCloser closer_;
