@@ -484,9 +484,9 @@ std::vector<io::StampedPose> Pipeline::odometryTrajectory() const {
   std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.timestamp < b.timestamp; });
   // One pose per timestamp: the Freiburg campus log has no timestamps, so the reader gives every
   // odometry reading between two scans the next scan's time (up to 15 readings, a metre apart),
-  // and a reader of the file looking that time up would get whichever it finds first. The last one read is the state at that time;
-  // when a scan has that time it is the scan's own pose (readings stamped with a scan's time hang
-  // from its anchor and come before it).
+  // and a reader of the file looking that time up would get whichever it finds first. The last
+  // one read is the state at that time; when a scan has that time it is the scan's own pose
+  // (readings stamped with a scan's time hang from its anchor and come before it).
   const auto last = std::unique(out.rbegin(), out.rend(), [](const auto& a, const auto& b) { return a.timestamp == b.timestamp; });
   out.erase(out.begin(), last.base());
   return out;
