@@ -36,6 +36,8 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("trusted_matched_fraction", o.local.trusted_matched_fraction, 0.0, 1.0, "", "a scan match with this share of points matched is trusted over the odometry up to max_trusted_correction");
   s.add("max_trusted_correction_m", o.local.max_trusted_correction_m, 0.0, 10.0, "m", "a trusted scan match may move the odometry this much");
   s.add("max_trusted_correction_deg", o.local.max_trusted_correction_deg, 0.0, 180.0, "deg", "a trusted scan match may turn the odometry this much");
+  s.add("fine_start_gate_m", o.local.fine_start_gate_m, 0.0, 10.0, "m", "also align from the odometry with this first association gate (the default 4 m reaches the right basin from a poor guess, but clutter can drag a good one along a wall); 0: off");
+  s.add("fine_start_min_gain", o.local.fine_start_min_gain, 0.0, 1.0, "", "the narrow-gate match is kept unless the wide-gate one matches this share more of the scan's points");
   s.add("retry_below_fraction", o.local.retry_below_fraction, 0.0, 1.0, "", "a scan match with fewer points matched (or untrusted) is retried from standing still, from the reversed odometry and from the odometry without its turn; 0: never");
   s.add("trust_agreeing_starts", o.local.trust_agreeing_starts, "a retried scan match that every start ends at is trusted (up to max_trusted_correction) even below trusted_matched_fraction");
   s.add("match_every_scan", o.local.match_every_scan, "also match the scans between keyframes with the submap; the trajectory at odometry times follows them (the map holds keyframes only)");

@@ -50,6 +50,12 @@ struct LocalOptions {
   double trusted_matched_fraction = 0.7;  // share of scan points matched for a trusted match
   double max_trusted_correction_m = 1.5;  // trusted matches may correct the odometry this much
   double max_trusted_correction_deg = 45.0;
+  // PL-ICP's first association gate is wide (4 m) so that it reaches the right basin from a
+  // poor guess; from a good one clutter can drag it along a wall. A second alignment from the
+  // odometry with this narrow first gate is kept unless the wide-gate one matches
+  // fine_start_min_gain more of the scan.
+  double fine_start_gate_m = 1.0;         // 0: off
+  double fine_start_min_gain = 0.05;
   // A match from the odometry guess matching fewer points than this (or untrusted) is retried
   // from standing still and from the reversed translation; the one matching most points wins.
   double retry_below_fraction = 0.0;      // 0: never retry
