@@ -61,10 +61,14 @@ int evalCommand(const Argv& args) {
                "    or GPS: positions only), and loop closures classified true/false. Each false one is\n"
                "    weighed on its two keyframe scans (RUN_DIR/map.simplemap): PL-ICP started at the\n"
                "    reference's relative pose ends at the run's (verdict run), stays (reference) or neither.\n"
+               "  relations.by_scans: the relation error by where both times fall among the run's scans (--scans):\n"
+               "    at_scans, one_interval (inside one interval between two scans: odometry only), other; each\n"
+               "    with n, abs_trans_mean_m and share_m (its error sum over all relations; the shares add up).\n"
                "Plots: RUN_DIR/eval_trajectory.png, RUN_DIR/eval_error.png.");
   ap.addPositional("RUN_DIR", "output folder of urbanslam run");
   ap.addOption("relations", "FILE", "Freiburg relations file (t1 t2 x y z roll pitch yaw)");
   ap.addOption("reference", "FILE", "reference trajectory: TUM file or a log that carries one");
+  ap.addOption("scans", "FILE", "TUM file whose times are the scans the run placed, for the relations' breakdown (default: RUN_DIR/trajectory_scans.tum, else trajectory_keyframes.tum); give another run's to compare two runs on the same classes");
   ap.addOption("time-offset", "S", "seconds added to the run's timestamps for --relations (default: found)");
   ap.addOption("max-gap", "S", "a relation is used only when the trajectory poses around each of its times are at most this far apart [s] (sparse trajectories need more)", "1");
   ap.addOption("loop-tolerance-m", "M", "a closure is true when its measurement agrees with the reference within this", "0.5");
@@ -109,6 +113,27 @@ int evalCommand(const Argv& args) {
     r["abs_rot_std_deg"] = m.abs_rot_deg.std;
     r["sqr_rot_mean_deg2"] = m.sqr_rot_deg2.mean;
     r["sqr_rot_std_deg2"] = m.sqr_rot_deg2.std;
+    // Where the error comes from: relations at scans, inside one interval between scans (only
+    // the odometry there), and the rest; the three shares add up to abs_trans_mean_m.
+    fs::path scans_path = ap.has("scans") ? fs::path(ap.option("scans")) : dir / "trajectory_scans.tum";
+    if (!ap.has("scans") && !fs::exists(scans_path)) scans_path = dir / "trajectory_keyframes.tum";
+    if (fs::exists(scans_path) || ap.has("scans")) {
+      std::vector<double> scan_times;
+      for (const auto& p : io::readTum(scans_path.string())) scan_times.push_back(p.timestamp);
+      const auto by = slam::relationsByScans(estimate, rel, offset, scan_times, max_gap);
+      common::Json& b = r["by_scans"];
+      b["scans"] = scans_path.string();
+      const auto cls = [](const slam::RelationClass& c) {
+        common::Json o = common::Json::object();
+        o["n"] = c.n;
+        o["abs_trans_mean_m"] = c.abs_trans_mean_m;
+        o["share_m"] = c.share_m;
+        return o;
+      };
+      b["at_scans"] = cls(by.at_scans);
+      b["one_interval"] = cls(by.one_interval);
+      b["other"] = cls(by.other);
+    }
     if (!reference.empty()) {
       const auto mr = slam::relationMetrics(reference, rel, offset, 5.0);  // reference poses are sparse
       r["reference_abs_trans_mean_m"] = mr.abs_trans_m.mean;

@@ -98,4 +98,10 @@ TEST(BadInput, EvalArguments) {
   expectBadInput("eval " + d.string(), "give --relations FILE and/or --reference FILE");
   expectBadInput("eval " + d.string() + rel + " --max-gap 0", "--max-gap: must be a positive number of seconds");
   expectBadInput("eval " + (d / "no-run").string() + rel, "trajectory_odometry.tum: missing (not a run folder?)");
+  // A run folder and relations that evaluate, with a --scans file that is not there.
+  const fs::path run = d / "run";
+  fs::create_directories(run);
+  writeFile(run / "trajectory_odometry.tum", "0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n2 2 0 0 0 0 0 1\n");
+  const std::string ok_rel = " --relations " + writeFile(d / "r.relations", "0.5 1.5 1 0 0 0 0 0\n") + " --time-offset 0";
+  expectBadInput("eval " + run.string() + ok_rel + " --scans " + (d / "nowhere.tum").string(), "nowhere.tum");
 }

@@ -1,12 +1,16 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include "CliRunner.h"
+#include "urbanslam/io/MapOutputs.h"
 
 using namespace urbanslam::test;
+namespace io = urbanslam::io;
 namespace fs = std::filesystem;
 
 TEST(Cli, EverySubcommandHasHelp) {
@@ -61,7 +65,7 @@ TEST(Cli, RunOnTheShippedRawlogWritesEveryOutput) {
   EXPECT_EQ(r.out.front(), '{');
   EXPECT_EQ(r.out.find('\n'), r.out.size() - 1);
   EXPECT_NE(r.out.find("\"keyframes\":"), std::string::npos);
-  for (const char* f : {"trajectory_keyframes.tum", "trajectory_odometry.tum", "reference.tum", "map.ply", "map.pcd",
+  for (const char* f : {"trajectory_keyframes.tum", "trajectory_odometry.tum", "trajectory_scans.tum", "reference.tum", "map.ply", "map.pcd",
                         "map.simplemap", "grid.png", "grid.yaml", "config.ini", "stats.json"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
   // No temporary files left behind.
@@ -70,6 +74,30 @@ TEST(Cli, RunOnTheShippedRawlogWritesEveryOutput) {
   // The resolved config written beside the outputs is itself a valid ini.
   EXPECT_EQ(runCli("check-ini " + (out / "config.ini").string()).code, 0);
   for (const char* f : {"pose_graph.g2o", "loop_closures.csv"}) EXPECT_TRUE(fs::exists(out / f)) << f;
+  // The scans placed by matching are every keyframe and the matched scans between them, and
+  // the trajectory at odometry times passes through each one at its time.
+  const auto kf = io::readTum((out / "trajectory_keyframes.tum").string());
+  const auto scans = io::readTum((out / "trajectory_scans.tum").string());
+  const auto odo = io::readTum((out / "trajectory_odometry.tum").string());
+  EXPECT_GT(scans.size(), kf.size());
+  const auto at = [](const std::vector<io::StampedPose>& t, double time) {
+    return std::find_if(t.begin(), t.end(), [&](const io::StampedPose& p) { return std::abs(p.timestamp - time) < 1e-6; });
+  };
+  for (const auto& k : kf) {
+    const auto s = at(scans, k.timestamp);
+    ASSERT_NE(s, scans.end()) << k.timestamp;
+    EXPECT_NEAR(s->pose.x, k.pose.x, 1e-5);
+    EXPECT_NEAR(s->pose.y, k.pose.y, 1e-5);
+  }
+  size_t on_odometry = 0;
+  for (const auto& s : scans) {
+    const auto o = at(odo, s.timestamp);
+    if (o == odo.end()) continue;
+    ++on_odometry;
+    EXPECT_NEAR(o->pose.x, s.pose.x, 1e-5) << s.timestamp;
+    EXPECT_NEAR(o->pose.y, s.pose.y, 1e-5) << s.timestamp;
+  }
+  EXPECT_GT(on_odometry, scans.size() / 2);
 }
 
 TEST(Cli, ConvertWritesARawlogThatRunsTheSame) {

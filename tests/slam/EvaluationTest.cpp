@@ -61,6 +61,46 @@ TEST(Evaluation, TimeOffsetIsRecoveredFromTheReference) {
   EXPECT_EQ(slam::findRelationTimeOffset(ref, same_base), 0.0);
 }
 
+// The breakdown puts each relation in the class its times give it among the scans, and the
+// classes' shares add up to the relation metric's mean. Scans every 2 s; the relations are
+// perturbed by 0.1 m (both ends at scans), 0.2 m (inside one interval) and 0.4 m (the rest).
+TEST(Evaluation, RelationsAreSplitByWhereTheyFallAmongTheScans) {
+  const auto traj = circle();
+  const double base = 1000.0;  // the relations' time base (offset) is applied to the scans too
+  std::vector<double> scans;
+  for (size_t i = 0; i < traj.size(); i += 20) scans.push_back(traj[i].timestamp);
+  std::vector<slam::Relation> rel;
+  const auto add = [&](size_t i, size_t j, double d) {
+    rel.push_back({base + traj[i].timestamp, base + traj[j].timestamp, common::compose({d, 0, 0}, common::between(traj[i].pose, traj[j].pose))});
+  };
+  add(20, 40, 0.1);    // scans at 2 s and 4 s
+  add(60, 100, 0.1);   // 6 s and 10 s, scans in between do not matter
+  add(23, 35, 0.2);    // 2.3-3.5 s: inside the 2-4 s interval
+  add(121, 129, 0.2);  // 12.1-12.9 s
+  add(25, 45, 0.4);    // a scan (4 s) between the two ends
+  add(30, 40, 0.4);    // one end inside an interval, the other at its scan
+  add(5, 195, 0.4);    // 19.5 s: after the last scan (18 s), not inside an interval
+  add(195, 199, 0.4);
+  rel.push_back({base + 50.0, base + 51.0, {}});  // outside the trajectory: skipped, not counted
+  const auto by = slam::relationsByScans(traj, rel, base, scans);
+  EXPECT_EQ(by.at_scans.n, 2u);
+  EXPECT_EQ(by.one_interval.n, 2u);
+  EXPECT_EQ(by.other.n, 4u);
+  EXPECT_NEAR(by.at_scans.abs_trans_mean_m, 0.1, 1e-9);
+  EXPECT_NEAR(by.one_interval.abs_trans_mean_m, 0.2, 1e-9);
+  EXPECT_NEAR(by.other.abs_trans_mean_m, 0.4, 1e-9);
+  EXPECT_NEAR(by.at_scans.share_m, 0.2 / 8, 1e-9);
+  const auto m = slam::relationMetrics(traj, rel, base);
+  ASSERT_EQ(m.used, 8u);
+  EXPECT_NEAR(by.at_scans.share_m + by.one_interval.share_m + by.other.share_m, m.abs_trans_m.mean, 1e-12);
+  // An end 1 ms off a scan is at it (the default tolerance is 2 ms); 5 ms off, it is not.
+  std::vector<double> near = scans;
+  for (double& t : near) t += 0.001;
+  EXPECT_EQ(slam::relationsByScans(traj, rel, base, near).at_scans.n, 2u);
+  for (double& t : near) t += 0.004;
+  EXPECT_EQ(slam::relationsByScans(traj, rel, base, near).at_scans.n, 0u);
+}
+
 TEST(Evaluation, AteIsZeroAfterARigidMotionAndSeesNoise) {
   const auto ref = circle();
   auto est = ref;

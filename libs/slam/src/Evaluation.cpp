@@ -74,6 +74,19 @@ bool interpolatePose(const std::vector<io::StampedPose>& traj, double t, double 
   return true;
 }
 
+namespace {
+
+// Cartographer's error of one relation, (pose1⁻¹ · pose2) · expected⁻¹; false when a time falls
+// outside the (shifted, sorted) trajectory.
+bool relationError(const std::vector<io::StampedPose>& t, const Relation& r, double max_gap_s, Pose2& e) {
+  Pose2 p1, p2;
+  if (!interpolatePose(t, r.t1, max_gap_s, p1) || !interpolatePose(t, r.t2, max_gap_s, p2)) return false;
+  e = common::compose(common::between(p1, p2), common::inverse(r.expected));
+  return true;
+}
+
+}  // namespace
+
 RelationMetrics relationMetrics(const std::vector<io::StampedPose>& traj, const std::vector<Relation>& rel,
                                 double time_offset_s, double max_gap_s) {
   const auto t = shifted(traj, time_offset_s);
@@ -81,13 +94,11 @@ RelationMetrics relationMetrics(const std::vector<io::StampedPose>& traj, const 
   RelationMetrics m;
   m.time_offset_s = time_offset_s;
   for (const auto& r : rel) {
-    Pose2 p1, p2;
-    if (!interpolatePose(t, r.t1, max_gap_s, p1) || !interpolatePose(t, r.t2, max_gap_s, p2)) {
+    Pose2 e;
+    if (!relationError(t, r, max_gap_s, e)) {
       ++m.skipped;
       continue;
     }
-    // Cartographer: error = (pose1⁻¹ · pose2) · expected⁻¹.
-    const Pose2 e = common::compose(common::between(p1, p2), common::inverse(r.expected));
     const double et = std::hypot(e.x, e.y), er = std::abs(e.phi) * kRad2Deg;
     tr.push_back(et);
     tr2.push_back(et * et);
@@ -100,6 +111,40 @@ RelationMetrics relationMetrics(const std::vector<io::StampedPose>& traj, const 
   m.abs_rot_deg = meanStd(rot);
   m.sqr_rot_deg2 = meanStd(rot2);
   return m;
+}
+
+RelationsByScans relationsByScans(const std::vector<io::StampedPose>& traj, const std::vector<Relation>& rel,
+                                  double time_offset_s, const std::vector<double>& scan_times, double max_gap_s,
+                                  double at_scan_s) {
+  const auto t = shifted(traj, time_offset_s);
+  std::vector<double> s = scan_times;
+  for (double& x : s) x += time_offset_s;
+  std::sort(s.begin(), s.end());
+  const auto atScan = [&](double x) {
+    const auto it = std::lower_bound(s.begin(), s.end(), x - at_scan_s);
+    return it != s.end() && *it <= x + at_scan_s;
+  };
+  const auto oneInterval = [&](double a, double b) {
+    if (a > b) std::swap(a, b);
+    const auto first_after = std::upper_bound(s.begin(), s.end(), a + at_scan_s);  // no scan within at_scan_s of a ...
+    return first_after != s.begin() && first_after != s.end() && *(first_after - 1) < a - at_scan_s &&
+           *first_after > b + at_scan_s;  // ... none up to b either, and one on each side
+  };
+  RelationsByScans out;
+  size_t used = 0;
+  for (const auto& r : rel) {
+    Pose2 e;
+    if (!relationError(t, r, max_gap_s, e)) continue;
+    ++used;
+    RelationClass& c = atScan(r.t1) && atScan(r.t2) ? out.at_scans : oneInterval(r.t1, r.t2) ? out.one_interval : out.other;
+    ++c.n;
+    c.share_m += std::hypot(e.x, e.y);  // the sum, until divided below
+  }
+  for (RelationClass* c : {&out.at_scans, &out.one_interval, &out.other}) {
+    c->abs_trans_mean_m = c->n ? c->share_m / static_cast<double>(c->n) : 0;
+    c->share_m = used ? c->share_m / static_cast<double>(used) : 0;
+  }
+  return out;
 }
 
 double findRelationTimeOffset(const std::vector<io::StampedPose>& reference, const std::vector<Relation>& rel,

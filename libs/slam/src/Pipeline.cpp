@@ -504,6 +504,23 @@ std::vector<io::StampedPose> Pipeline::odometryTrajectory() const {
   // (readings stamped with a scan's time hang from its anchor and come before it).
   const auto last = std::unique(out.rbegin(), out.rend(), [](const auto& a, const auto& b) { return a.timestamp == b.timestamp; });
   out.erase(out.begin(), last.base());
+  // Except at a scan's own time: a reading read after the scan can carry the same stamp (the
+  // Intel log's stamps go back and forth: 2661.47, scan, 2661.07, 2661.14, 2661.47), and the pose
+  // there is the scan's, 0.18 m before that reading's.
+  const auto scans = scanTrajectory();
+  auto o = out.begin();
+  for (const auto& a : scans) {
+    o = std::lower_bound(o, out.end(), a.timestamp, [](const io::StampedPose& p, double t) { return p.timestamp < t; });
+    if (o != out.end() && o->timestamp == a.timestamp) o->pose = a.pose;
+  }
+  return out;
+}
+
+std::vector<io::StampedPose> Pipeline::scanTrajectory() const {
+  std::vector<io::StampedPose> out;
+  out.reserve(anchors_.size());
+  for (const auto& a : anchors_) out.push_back({a.timestamp, common::compose(keyframes_[a.keyframe].pose, a.offset)});
+  std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.timestamp < b.timestamp; });
   return out;
 }
 

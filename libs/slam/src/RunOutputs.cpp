@@ -60,6 +60,8 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   files.push("trajectory_keyframes.tum");
   io::writeTum(path("trajectory_odometry.tum"), p.odometryTrajectory());
   files.push("trajectory_odometry.tum");
+  io::writeTum(path("trajectory_scans.tum"), p.scanTrajectory());
+  files.push("trajectory_scans.tum");
   if (!p.referenceTrajectory().empty()) {
     io::writeTum(path("reference.tum"), p.referenceTrajectory());
     files.push("reference.tum");

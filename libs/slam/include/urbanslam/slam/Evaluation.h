@@ -39,6 +39,24 @@ bool interpolatePose(const std::vector<io::StampedPose>& traj, double t, double 
 RelationMetrics relationMetrics(const std::vector<io::StampedPose>& traj, const std::vector<Relation>& rel,
                                 double time_offset_s, double max_gap_s = 1.0);
 
+// Where the error comes from: each relation by where its two times fall among the scans the run
+// placed by scan matching (`scan_times`, in the trajectory's time base, sorted):
+//  * at_scans: both ends within at_scan_s of a scan;
+//  * one_interval: both ends strictly inside one interval between two consecutive scans (no
+//    scan at or between them), where the run has nothing but the odometry;
+//  * other: the rest (an end between scans and a scan in between, or outside the scans' span).
+// A class's share is its error sum over all used relations: the three shares add up to the mean.
+struct RelationClass {
+  size_t n = 0;
+  double abs_trans_mean_m = 0, share_m = 0;
+};
+struct RelationsByScans {
+  RelationClass at_scans, one_interval, other;
+};
+RelationsByScans relationsByScans(const std::vector<io::StampedPose>& traj, const std::vector<Relation>& rel,
+                                  double time_offset_s, const std::vector<double>& scan_times, double max_gap_s = 1.0,
+                                  double at_scan_s = 0.002);
+
 // The offset to add to the trajectory's timestamps so that it matches the relations' time base.
 // Coarse, then refined to 0.5 ms: the one that minimises the relation error of `reference`
 // (e.g. the corrected log's own poses). Exact: when relation times are sensor times of the log,

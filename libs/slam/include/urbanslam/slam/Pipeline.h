@@ -87,6 +87,10 @@ class Pipeline {
   // Estimated pose at every odometry (or drive) reading's time, from the current keyframe
   // estimates and the odometry since each keyframe.
   std::vector<io::StampedPose> odometryTrajectory() const;
+  // Estimated pose at every scan placed by scan matching: the keyframes and, with
+  // [local] match_every_scan, the scans matched between them. Between these the trajectory at
+  // odometry times has only the odometry.
+  std::vector<io::StampedPose> scanTrajectory() const;
   // The log's reference trajectory, when it has one (e.g. a corrected CARMEN log).
   const std::vector<io::StampedPose>& referenceTrajectory() const { return reference_; }
   const std::vector<LoopClosureRecord>& loopClosures() const { return closures_; }
