@@ -12,11 +12,7 @@
 #   bench/slam/relation_breakdown.sh [BUILD_DIR] [OUT_DIR]
 # OUT_DIR must hold run_datasets.sh's output (its urbanslam runs are reused); ~1 minute more.
 set -euo pipefail
-cd "$(dirname "$0")/../.."
-BUILD=${1:-build}
-OUT=${2:-$BUILD/slam_eval}
-U=$BUILD/apps/urbanslam/urbanslam
-D=../shared/data/freiburg_slam_benchmark
+source "$(dirname "$0")/paths.sh" "$@"
 [[ -x $U ]] || { echo "missing $U (build first)" >&2; exit 2; }
 
 # The dataset's ini with [local] scan_matching and [loop_closure] enabled set to false.

@@ -23,11 +23,7 @@
 #                   seconds), so the two systems are compared on equal terms;
 #   icp-slam        MRPT 2.5 icp-slam, icp-slam_demo_classic.ini (headless), one pose per scan.
 set -euo pipefail
-cd "$(dirname "$0")/../.."
-BUILD=${1:-build}
-OUT=${2:-$BUILD/slam_eval}
-U=$BUILD/apps/urbanslam/urbanslam
-D=../shared/data/freiburg_slam_benchmark
+source "$(dirname "$0")/paths.sh" "$@"
 VP=../shared/data/victoria_park/victoria_park_ascii.zip
 [[ -x $U ]] || { echo "missing $U (build first)" >&2; exit 2; }
 [[ -d $D ]] || { echo "missing $D (../shared/data)" >&2; exit 2; }
