@@ -39,7 +39,8 @@ int runCommand(const Argv& args) {
   ap.addFlag("json", "print stats.json as one JSON object on stdout");
   ap.addEpilog(
       "outputs in DIR: trajectory_keyframes.tum, trajectory_odometry.tum, trajectory_scans.tum (every\n"
-      "scan placed by matching), reference.tum (when the log has one), map.ply/.pcd/.xyz, map.simplemap, grid.png + grid.yaml, pose_graph.g2o,\n"
+      "scan placed by matching), reference.tum (when the log has one), map.ply/.pcd/.xyz,\n"
+      "map.simplemap, grid.png + grid.yaml, pose_graph.g2o,\n"
       "loop_closures.csv (every hypothesis, laser or image, and its fate), config.ini, stats.json\n"
       "(written last: its presence marks a complete run).");
   if (!ap.parse(args)) return 0;

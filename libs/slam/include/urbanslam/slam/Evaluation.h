@@ -40,7 +40,7 @@ RelationMetrics relationMetrics(const std::vector<io::StampedPose>& traj, const 
                                 double time_offset_s, double max_gap_s = 1.0);
 
 // Where the error comes from: each relation by where its two times fall among the scans the run
-// placed by scan matching (`scan_times`, in the trajectory's time base, sorted):
+// placed by scan matching (`scan_times`, in the trajectory's time base, any order):
 //  * at_scans: both ends within at_scan_s of a scan;
 //  * one_interval: both ends strictly inside one interval between two consecutive scans (no
 //    scan at or between them), where the run has nothing but the odometry;
