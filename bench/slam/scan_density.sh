@@ -5,7 +5,8 @@
 # figure comes from the raw log. Two measurements, each for keeping 1 scan in k:
 #   same poses  urbanslam's own scan poses of the full run, every k-th kept, the gaps bridged
 #               with the odometry exactly as `run` bridges them (forward from the earlier scan,
-#               backward from the later one, blended by time): the effect of density alone;
+#               backward from the later one, blended by time) at every odometry time, scored
+#               by `urbanslam eval`: the effect of density alone;
 #   rerun       `urbanslam run` on the log with the other scans relabelled RLASER, which the ini
 #               does not use (the reader still sees them, so the corrected log's odometry
 #               re-anchoring at each scan is read as before): what the system makes of it.
@@ -26,11 +27,12 @@ done
 off=$(python3 -c "import json; print(json.load(open('$OUT/fr079/urbanslam.eval.json'))['relations']['time_offset_s'])")
 KS=(1 2 3 5 10 15)
 
-# Relation error (Kümmerle, as eval computes it) of the run's scan poses thinned to every k-th.
-same_poses() {  # scans.tum odometry.tum relations offset k
+# A run folder holding the run's scan poses thinned to every k-th, bridged by the odometry at
+# every odometry time between them (for `urbanslam eval`); prints the number of scans kept.
+same_poses() {  # scans.tum odometry.tum k out_dir
   python3 - "$@" <<'PY'
-import bisect, math, sys
-scans, odom, relf, off, k = sys.argv[1], sys.argv[2], sys.argv[3], float(sys.argv[4]), int(sys.argv[5])
+import bisect, math, os, sys
+scans, odom, k, out = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4]
 def tum(path):
     t, p = [], []
     for l in open(path):
@@ -54,22 +56,18 @@ def at(t_, p_, t):  # linear interpolation in a time-sorted trajectory
 st, sp = tum(scans); ot, op = tum(odom)
 st, sp = st[::k], sp[::k]
 so = [at(ot, op, t) for t in st]
-def pose(t):
-    i = bisect.bisect_right(st, t) - 1
-    if i < 0 or i + 1 >= len(st): return None
+def pose(t):  # forward from the scan before, backward from the one after, blended by time
+    i = min(bisect.bisect_right(st, t) - 1, len(st) - 2)
     o = at(ot, op, t)
     return lerp(compose(sp[i], between(so[i], o)), compose(sp[i + 1], between(so[i + 1], o)),
                 (t - st[i]) / (st[i + 1] - st[i]))
-errors = []
-for l in open(relf):
-    v = l.split()
-    if len(v) < 8: continue
-    p, q = pose(float(v[0]) - off), pose(float(v[1]) - off)  # off: added to run times
-    if p is None or q is None: continue
-    d = between(p, q); e = (float(v[2]), float(v[3]), float(v[7]))
-    c, s = math.cos(d[2] - e[2]), math.sin(d[2] - e[2])
-    errors.append(math.hypot(d[0] - (c * e[0] - s * e[1]), d[1] - (s * e[0] + c * e[1])))
-print(len(st), len(errors), f"{sum(errors) / len(errors):.4f}")
+os.makedirs(out, exist_ok=True)
+with open(os.path.join(out, 'trajectory_odometry.tum'), 'w') as f:
+    f.write('# timestamp x y z qx qy qz qw\n')
+    for t in sorted(set(st) | {t for t in ot if st[0] <= t <= st[-1]}):
+        x, y, th = pose(t)
+        f.write(f"{t:.6f} {x:.6f} {y:.6f} 0 0 0 {math.sin(th / 2):.9f} {math.cos(th / 2):.9f}\n")
+print(len(st))
 PY
 }
 
@@ -92,7 +90,9 @@ mkdir -p "$OUT/fr079/density"
 echo "FR079, keeping 1 scan in k (Intel's corrected log: 1 in 15 of the raw log's)"
 echo " k  scans  relations  same_poses_m  rerun_m  rerun_ate_m  rerun_loops"
 for k in "${KS[@]}"; do
-  read -r n used same < <(same_poses "$run/trajectory_scans.tum" "$dr/trajectory_odometry.tum" "$REL" "$off" "$k")
+  sp=$OUT/fr079/density/same$k
+  n=$(same_poses "$run/trajectory_scans.tum" "$dr/trajectory_odometry.tum" "$k" "$sp")
+  $U eval "$sp" --relations "$REL" --time-offset "$off" --json > "$sp/eval.json"
   if [[ $k == 1 ]]; then
     j=$OUT/fr079/urbanslam.eval.json  # the full run itself
   else
@@ -103,9 +103,10 @@ for k in "${KS[@]}"; do
     j=$d/eval.json
     $U eval "$d/run" --relations "$REL" --time-offset "$off" --reference "$LOG" --json > "$j"
   fi
-  python3 - "$k" "$n" "$used" "$same" "$j" <<'PY'
+  python3 - "$k" "$n" "$sp/eval.json" "$j" <<'PY'
 import json, sys
-k, n, used, same, ev = sys.argv[1:6]
+k, n, same_ev, ev = sys.argv[1:5]
+s = json.load(open(same_ev))['relations']; used, same = s['used'], s['abs_trans_mean_m']
 j = json.load(open(ev)); r = j['relations']
 ate = j.get('ate_rmse_m'); loops = j.get('loops_accepted')
 print(f"{int(k):2d} {int(n):6d} {int(used):10d} {float(same):13.4f} {r['abs_trans_mean_m']:8.4f} "
