@@ -1,0 +1,33 @@
+#pragma once
+// The pose that maximises scan log-likelihood + motion-prior log-density over a search window,
+// found exactly by branch and bound over the likelihood grid's levels (Olson 2009; Hess et al.
+// 2016): a block of 2^h x 2^h translations at one heading is scored with the level-h grid plus
+// the prior's density at the block's pose nearest the prior (an upper bound for every pose in
+// the block), and a block is split only while its bound beats the best pose found so far.
+// Headings are enumerated at a step that moves the farthest point by about one cell.
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "urbanslam/alignment/LikelihoodGrid.h"
+#include "urbanslam/alignment/MotionPrior.h"
+
+namespace urbanslam::alignment {
+
+struct CorrelativeWindow {
+  double half_width_m = 1.0;    // translations within +-this of the prior's mean, on each axis
+  double half_angle_rad = 0.5;  // headings within +-this of the prior's mean
+};
+
+struct CorrelativeResult {
+  common::Pose2 pose;
+  double score = 0;        // scan log-likelihood + prior log-density at pose
+  double scan_score = 0;   // the scan's share of it
+  int nodes = 0;           // blocks scored (the search's cost)
+};
+
+// points: the scan's points in its own frame (thinned so they are roughly independent).
+CorrelativeResult correlativeSearch(const LikelihoodGrid& grid, const std::vector<Eigen::Vector2d>& points, const MotionPrior& prior,
+                                    const CorrelativeWindow& window);
+
+}  // namespace urbanslam::alignment

@@ -1,0 +1,63 @@
+#pragma once
+// The reference scan (or submap) as a raster of per-point log-likelihoods, for correlative
+// scan matching (Olson 2009, "Real-time correlative scan matching"): a cell holds
+// log(exp(-d²/2σ²) + κ), d the distance from the cell's centre to the nearest reference point,
+// κ the floor of a return that the reference does not explain (clutter, a moved object, a
+// place seen for the first time). The score of a candidate pose is the sum over the scan's
+// points of the cells they fall in, so a pose costs one lookup per point.
+//
+// Coarser levels for branch and bound: level h holds, for the block of 2^h x 2^h cells whose
+// lowest corner is a cell, the largest value in the block; a sum over level h bounds the score
+// of every pose whose translation lies in that block (Cartographer's precomputation grids).
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "urbanslam/alignment/PointSet.h"
+
+namespace urbanslam::alignment {
+
+struct LikelihoodGridOptions {
+  double resolution_m = 0.05;      // cell size
+  double hit_sigma_m = 0.05;       // spread of a return about the surface it hit (noise + cell size)
+  double miss_floor = 0.05;        // κ: the density of an unexplained return relative to a hit's peak
+  double max_radius_m = 40.0;      // cells farther than this from the centre (along x or y) are left out
+  int levels = 6;                  // pyramid levels above the base (blocks of 2^levels cells)
+};
+
+class LikelihoodGrid {
+ public:
+  // The reference points (in the reference's frame) around `centre`.
+  LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d& centre, const LikelihoodGridOptions& options);
+
+  double resolution() const { return resolution_; }
+  int levels() const { return static_cast<int>(level_.size()) - 1; }
+  float floorValue() const { return floor_; }
+  // The cell of a point: floor((p - origin) / resolution), unbounded.
+  Eigen::Vector2i cellOf(const Eigen::Vector2d& p) const {
+    return {static_cast<int>(std::floor((p.x() - origin_.x()) / resolution_)),
+            static_cast<int>(std::floor((p.y() - origin_.y()) / resolution_))};
+  }
+  // Level 0: the cell's value; level h: the largest value in the block of 2^h cells whose lowest
+  // corner is (i, j). The floor outside the grid.
+  float value(int level, int i, int j) const {
+    const int a = i + pad_, b = j + pad_;
+    if (a < 0 || b < 0 || a >= width_ || b >= height_) return floor_;
+    return level_[static_cast<size_t>(level)][static_cast<size_t>(b) * static_cast<size_t>(width_) + static_cast<size_t>(a)];
+  }
+  // The log-likelihood of one point at p (level 0).
+  float score(const Eigen::Vector2d& p) const {
+    const Eigen::Vector2i c = cellOf(p);
+    return value(0, c.x(), c.y());
+  }
+
+ private:
+  double resolution_;
+  Eigen::Vector2d origin_;   // corner of cell (0, 0)
+  int pad_ = 0;              // cells before cell 0 on each axis (blocks that start outside)
+  int width_ = 0, height_ = 0;
+  float floor_ = 0;
+  std::vector<std::vector<float>> level_;
+};
+
+}  // namespace urbanslam::alignment

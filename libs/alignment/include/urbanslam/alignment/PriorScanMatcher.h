@@ -1,0 +1,76 @@
+#pragma once
+// Local scan matching with the motion prior and the scan evidence weighed by their
+// uncertainties, in one formulation (Cartographer's real-time correlative matcher followed by
+// its least-squares matcher):
+//  1. correlative search (CorrelativeSearch.h): the pose maximising the scan's log-likelihood in
+//     the reference's likelihood grid plus the log-density of the odometry prior (MotionPrior.h),
+//     over a window that covers the prior's 3σ and at least the configured reach;
+//  2. refinement by Gauss-Newton from that pose: point-to-line residuals against the reference
+//     (point-to-point where a point has no line) under a Cauchy kernel, plus the prior's
+//     residual weighted by its information and by the prior's Gaussian share at the estimate;
+//  3. the covariance: the inverse of that Hessian, i.e. the posterior of the relative pose given
+//     the odometry and the scan. Where the scan leaves a direction free (a corridor) the prior
+//     holds it; a clear match far from a wrong odometry pays only the prior's bounded outlier
+//     cost.
+// The search scores the scan's points thinned to one per voxel (a cheaper search whose
+// evidence is not dominated by the many beams on the nearest wall); the refinement uses every
+// point.
+#include <string>
+
+#include <Eigen/Core>
+
+#include "urbanslam/alignment/IndexedReference.h"
+#include "urbanslam/alignment/LikelihoodGrid.h"
+#include "urbanslam/alignment/LineNormals.h"
+#include "urbanslam/alignment/PointSet.h"
+
+namespace urbanslam::alignment {
+
+struct PriorMatcherOptions {
+  LikelihoodGridOptions grid;
+  double voxel_m = 0.2;                       // the search scores one point per voxel
+  double search_window_m = 1.0;               // translation reach of the search (+-, each axis) at least
+  double search_window_deg = 30.0;            // heading reach at least
+  double max_search_window_m = 3.0;           // the prior's 3σ widens the window up to this
+  double max_search_window_deg = 90.0;
+  double odometry_outlier_probability = 1e-4; // the prior's uniform share (MotionPrior.h)
+  double point_sigma_m = 0.05;                // a return's distance to the reference surface (refinement)
+  double kernel_scale_m = 0.05;               // Cauchy kernel scale
+  double gate_m = 0.3;                        // refinement associations farther than this are ignored
+  int max_iterations = 30;
+  int min_points = 10;                        // fewer voxels: no match, the prior alone
+  LineNormalOptions normals;
+};
+
+struct PriorMatchResult {
+  bool valid = false;                 // false: too few points, the prior is the answer
+  std::string failure_reason;
+  common::Pose2 pose;                 // posterior mode: the scan's pose in the reference's frame
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Identity();  // posterior covariance (x, y, phi)
+  common::Pose2 search_pose;          // the correlative search's pose
+  double scan_log_likelihood = 0;     // at search_pose
+  double prior_weight = 1;            // the prior's Gaussian share at the result (0: odometry outvoted)
+  int voxels = 0, points = 0, matched = 0;  // thinned points, refinement points, associated at the end
+  int iterations = 0, search_nodes = 0;
+  double time_ms = 0;
+  double matchedFraction() const { return points > 0 ? static_cast<double>(matched) / points : 0.0; }
+};
+
+// The reference prepared once for many matches (all the scans against one submap).
+class MatchReference {
+ public:
+  MatchReference(PointSet points, const Eigen::Vector2d& centre, const PriorMatcherOptions& options);
+  const IndexedReference& indexed() const { return indexed_; }
+  const LikelihoodGrid& grid() const { return grid_; }
+
+ private:
+  IndexedReference indexed_;
+  LikelihoodGrid grid_;
+};
+
+// `scan` (points in its own frame) matched onto `reference`, the odometry saying prior_mean with
+// prior_cov.
+PriorMatchResult matchWithPrior(const MatchReference& reference, const PointSet& scan, const common::Pose2& prior_mean,
+                                const Eigen::Matrix3d& prior_cov, const PriorMatcherOptions& options);
+
+}  // namespace urbanslam::alignment

@@ -1,0 +1,62 @@
+#include "urbanslam/alignment/LikelihoodGrid.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace urbanslam::alignment {
+
+LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d& centre, const LikelihoodGridOptions& o)
+    : resolution_(o.resolution_m), floor_(static_cast<float>(std::log(o.miss_floor))) {
+  const double reach = 3.0 * o.hit_sigma_m;  // beyond 3σ a hit adds nothing to the floor
+  Eigen::Vector2d lo = centre, hi = centre;
+  bool any = false;
+  for (const auto& sp : reference) {
+    if (std::abs(sp.p.x() - centre.x()) > o.max_radius_m || std::abs(sp.p.y() - centre.y()) > o.max_radius_m) continue;
+    lo = any ? lo.cwiseMin(sp.p) : sp.p;
+    hi = any ? hi.cwiseMax(sp.p) : sp.p;
+    any = true;
+  }
+  lo.array() -= reach;
+  hi.array() += reach;
+  origin_ = lo;
+  const int levels = std::max(0, o.levels);
+  pad_ = (1 << levels) - 1;  // a block of the top level may start this many cells before cell 0
+  const int w = any ? static_cast<int>(std::ceil((hi.x() - lo.x()) / resolution_)) + 1 : 1;
+  const int h = any ? static_cast<int>(std::ceil((hi.y() - lo.y()) / resolution_)) + 1 : 1;
+  width_ = w + pad_;
+  height_ = h + pad_;
+  std::vector<float> base(static_cast<size_t>(width_) * static_cast<size_t>(height_), floor_);
+  const int r = static_cast<int>(std::ceil(reach / resolution_));
+  const double inv2s2 = 1.0 / (2.0 * o.hit_sigma_m * o.hit_sigma_m);
+  for (const auto& sp : reference) {
+    if (std::abs(sp.p.x() - centre.x()) > o.max_radius_m || std::abs(sp.p.y() - centre.y()) > o.max_radius_m) continue;
+    const Eigen::Vector2i c = cellOf(sp.p);
+    for (int j = c.y() - r; j <= c.y() + r; ++j)
+      for (int i = c.x() - r; i <= c.x() + r; ++i) {
+        const int a = i + pad_, b = j + pad_;
+        if (a < 0 || b < 0 || a >= width_ || b >= height_) continue;
+        const Eigen::Vector2d cell_centre = origin_ + resolution_ * Eigen::Vector2d(i + 0.5, j + 0.5);
+        const float v = static_cast<float>(std::log(std::exp(-(cell_centre - sp.p).squaredNorm() * inv2s2) + o.miss_floor));
+        float& dst = base[static_cast<size_t>(b) * static_cast<size_t>(width_) + static_cast<size_t>(a)];
+        dst = std::max(dst, v);
+      }
+  }
+  level_.push_back(std::move(base));
+  // Level h from level h-1 by doubling: the block of 2^h starting at (i, j) is four blocks of
+  // 2^(h-1) starting at (i, j), (i+s, j), (i, j+s), (i+s, j+s).
+  for (int k = 1; k <= levels; ++k) {
+    const int s = 1 << (k - 1);
+    const std::vector<float>& prev = level_.back();
+    std::vector<float> next(prev.size(), floor_);
+    const auto at = [&](int a, int b) {
+      return a < width_ && b < height_ ? prev[static_cast<size_t>(b) * static_cast<size_t>(width_) + static_cast<size_t>(a)] : floor_;
+    };
+    for (int b = 0; b < height_; ++b)
+      for (int a = 0; a < width_; ++a)
+        next[static_cast<size_t>(b) * static_cast<size_t>(width_) + static_cast<size_t>(a)] =
+            std::max(std::max(at(a, b), at(a + s, b)), std::max(at(a, b + s), at(a + s, b + s)));
+    level_.push_back(std::move(next));
+  }
+}
+
+}  // namespace urbanslam::alignment

@@ -1,0 +1,129 @@
+#include "urbanslam/alignment/PriorScanMatcher.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <unordered_set>
+
+#include "urbanslam/alignment/CorrelativeSearch.h"
+#include "urbanslam/alignment/MotionPrior.h"
+
+namespace urbanslam::alignment {
+
+MatchReference::MatchReference(PointSet points, const Eigen::Vector2d& centre, const PriorMatcherOptions& options)
+    : indexed_(std::move(points)), grid_(indexed_.points(), centre, options.grid) {}
+
+namespace {
+
+// The first point of each voxel (sweep order) represents it in the search.
+std::vector<Eigen::Vector2d> thin(const PointSet& scan, double voxel_m) {
+  std::vector<Eigen::Vector2d> out;
+  std::unordered_set<long long> seen;
+  for (const auto& sp : scan) {
+    const long long vx = static_cast<long long>(std::floor(sp.p.x() / voxel_m));
+    const long long vy = static_cast<long long>(std::floor(sp.p.y() / voxel_m));
+    if (seen.insert((vx << 32) ^ (vy & 0xffffffffLL)).second) out.push_back(sp.p);
+  }
+  return out;
+}
+
+}  // namespace
+
+PriorMatchResult matchWithPrior(const MatchReference& reference, const PointSet& scan, const common::Pose2& prior_mean,
+                                const Eigen::Matrix3d& prior_cov, const PriorMatcherOptions& o) {
+  const auto start = std::chrono::steady_clock::now();
+  PriorMatchResult out;
+  out.pose = prior_mean;
+  out.cov = prior_cov;
+  const std::vector<Eigen::Vector2d> thinned = thin(scan, o.voxel_m);
+  out.voxels = static_cast<int>(thinned.size());
+  out.points = static_cast<int>(scan.size());
+  const auto finish = [&] {
+    out.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return out;
+  };
+  if (out.voxels < o.min_points || reference.indexed().points().empty()) {
+    out.failure_reason = "too few points";
+    return finish();
+  }
+  // 1. The window: the configured reach, wider where the prior's 3σ is.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> exy(prior_cov.topLeftCorner<2, 2>());
+  const double sxy = std::sqrt(std::max(0.0, exy.eigenvalues().maxCoeff())), sphi = std::sqrt(std::max(0.0, prior_cov(2, 2)));
+  CorrelativeWindow window;
+  window.half_width_m = std::min(o.max_search_window_m, std::max(o.search_window_m, 3 * sxy));
+  window.half_angle_rad = std::min(o.max_search_window_deg, std::max(o.search_window_deg, 3 * sphi * 180 / M_PI)) * M_PI / 180;
+  const double volume = 4 * window.half_width_m * window.half_width_m * 2 * window.half_angle_rad;
+  const MotionPrior prior(prior_mean, prior_cov, o.odometry_outlier_probability, volume);
+  const CorrelativeResult coarse = correlativeSearch(reference.grid(), thinned, prior, window);
+  out.search_pose = coarse.pose;
+  out.scan_log_likelihood = coarse.scan_score;
+  out.search_nodes = coarse.nodes;
+
+  // 2. Gauss-Newton on the point-to-line residuals and the prior.
+  const PointSet& ref = reference.indexed().points();
+  const std::vector<LineNormal>& normals = reference.indexed().normals(o.normals);
+  const double info = 1.0 / (o.point_sigma_m * o.point_sigma_m), c2 = o.kernel_scale_m * o.kernel_scale_m;
+  const double gate2 = o.gate_m * o.gate_m;
+  common::Pose2 x = coarse.pose;
+  Eigen::Matrix3d H;
+  const auto linearise = [&](const common::Pose2& at, Eigen::Vector3d& g, int& matched) {
+    H.setZero();
+    g.setZero();
+    matched = 0;
+    const Eigen::Matrix2d R = Eigen::Rotation2Dd(at.phi).toRotationMatrix();
+    const Eigen::Vector2d t(at.x, at.y);
+    for (size_t i = 0; i < scan.size(); ++i) {
+      const Eigen::Vector2d rp = R * scan[i].p, q = rp + t;
+      int j = -1;
+      double d2 = 0;
+      if (!reference.indexed().index().nearestWithin(q, gate2, &j, &d2)) continue;
+      ++matched;
+      const Eigen::Vector2d dq(-rp.y(), rp.x());  // d q / d phi
+      const Eigen::Vector2d e2 = q - ref[static_cast<size_t>(j)].p;
+      const LineNormal& n = normals[static_cast<size_t>(j)];
+      if (n.valid) {
+        const double e = n.n.dot(e2);
+        const Eigen::Vector3d J(n.n.x(), n.n.y(), n.n.dot(dq));
+        const double w = info / (1.0 + e * e / c2);
+        H += w * J * J.transpose();
+        g += w * J * e;
+      } else {
+        Eigen::Matrix<double, 2, 3> J;
+        J << 1, 0, dq.x(), 0, 1, dq.y();
+        const double w = info / (1.0 + e2.squaredNorm() / c2);
+        H += w * J.transpose() * J;
+        g += w * J.transpose() * e2;
+      }
+    }
+    const Eigen::Vector3d d = prior.difference(at);
+    out.prior_weight = prior.gaussianWeight(prior.mahalanobis2(d));
+    H += out.prior_weight * prior.information();
+    g += out.prior_weight * prior.information() * d;
+  };
+  Eigen::Vector3d g;
+  int matched = 0;
+  for (out.iterations = 0; out.iterations < o.max_iterations; ++out.iterations) {
+    linearise(x, g, matched);
+    const Eigen::Vector3d step = -H.ldlt().solve(g);
+    if (!step.allFinite()) break;
+    x = {x.x + step(0), x.y + step(1), common::wrapToPi(x.phi + step(2))};
+    if (std::hypot(step(0), step(1)) < 1e-7 && std::abs(step(2)) < 1e-8) break;
+  }
+  // 3. The posterior covariance at the estimate.
+  linearise(x, g, matched);
+  const Eigen::Matrix3d cov = H.ldlt().solve(Eigen::Matrix3d::Identity());
+  if (!cov.allFinite()) {
+    out.failure_reason = "singular refinement";
+    return finish();
+  }
+  out.valid = true;
+  out.pose = x;
+  out.cov = 0.5 * (cov + cov.transpose());
+  out.matched = matched;
+  return finish();
+}
+
+}  // namespace urbanslam::alignment

@@ -1,0 +1,151 @@
+// The local matcher (odometry prior + scan evidence) against independent references: the
+// prior's box bound against a brute-force minimum, the branch and bound against an exhaustive
+// search of the same window, and matches of ray-cast scans against their true relative pose.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <random>
+
+#include "SyntheticScan.h"
+#include "urbanslam/alignment/CorrelativeSearch.h"
+#include "urbanslam/alignment/LikelihoodGrid.h"
+#include "urbanslam/alignment/MotionPrior.h"
+#include "urbanslam/alignment/PriorScanMatcher.h"
+#include "urbanslam/alignment/ScanModel.h"
+
+namespace urbanslam::alignment {
+namespace {
+
+Eigen::Matrix3d correlatedCov() {
+  Eigen::Matrix3d c;
+  c << 0.04, 0.015, 0.004, 0.015, 0.02, -0.002, 0.004, -0.002, 0.01;
+  return c;
+}
+
+TEST(MotionPrior, BoxMinimumMatchesBruteForce) {
+  const MotionPrior prior({1, 2, 0.3}, correlatedCov(), 0.01, 1.0);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int trial = 0; trial < 200; ++trial) {
+    const double x0 = u(rng), y0 = u(rng), w = 0.05 + 0.5 * (u(rng) + 1), h = 0.05 + 0.5 * (u(rng) + 1), dphi = 0.3 * u(rng);
+    double brute = 1e300;
+    for (int i = 0; i <= 200; ++i)
+      for (int j = 0; j <= 200; ++j) {
+        const Eigen::Vector3d d(x0 + w * i / 200, y0 + h * j / 200, dphi);
+        brute = std::min(brute, prior.mahalanobis2(d));
+      }
+    const double bound = prior.minMahalanobis2(x0, x0 + w, y0, y0 + h, dphi);
+    EXPECT_LE(bound, brute + 1e-9);
+    EXPECT_NEAR(bound, brute, 1e-3 * std::max(1.0, brute));
+  }
+}
+
+TEST(MotionPrior, MixtureDensityAndWeight) {
+  const Eigen::Matrix3d cov = Eigen::Vector3d(0.01, 0.01, 0.001).asDiagonal();
+  const MotionPrior prior({}, cov, 0.01, 2.0);
+  const double gauss_peak = std::log(0.99) - 1.5 * std::log(2 * M_PI) - 0.5 * std::log(cov.determinant());
+  const double m2 = 9.0;
+  EXPECT_NEAR(prior.logDensity(m2), std::log(std::exp(gauss_peak - 0.5 * m2) + 0.01 / 2.0), 1e-9);
+  EXPECT_NEAR(prior.gaussianWeight(0), 1.0, 1e-4);
+  EXPECT_LT(prior.gaussianWeight(400), 1e-6);  // 20 sigma: only the uniform share explains it
+  EXPECT_NEAR(prior.logDensity(1e6), std::log(0.01 / 2.0), 1e-9);
+}
+
+std::vector<Eigen::Vector2d> positions(const PointSet& set) {
+  std::vector<Eigen::Vector2d> out;
+  for (const auto& p : set) out.push_back(p.p);
+  return out;
+}
+
+PointSet scanPoints(const test::World& world, const common::Pose2& pose, unsigned seed = 7) {
+  test::ScanSpec spec;
+  spec.seed = seed;
+  return pointSetFromScan(test::simulateScan(world, pose, spec), ScanModelOptions{}, false);
+}
+
+TEST(CorrelativeSearch, BranchAndBoundFindsTheExhaustiveOptimum) {
+  const test::World world = test::roomWorld();
+  const PointSet ref = scanPoints(world, {0, 0, 0});
+  PointSet cur = scanPoints(world, {0.4, -0.2, 0.15}, 9);
+  std::vector<Eigen::Vector2d> pts;
+  for (size_t i = 0; i < cur.size(); i += 6) pts.push_back(cur[i].p);  // a sparse set keeps the exhaustive loop short
+  LikelihoodGridOptions go;
+  go.resolution_m = 0.1;
+  go.hit_sigma_m = 0.1;
+  const LikelihoodGrid grid(ref, Eigen::Vector2d::Zero(), go);
+  const MotionPrior prior({0.1, 0.1, 0.0}, Eigen::Vector3d(0.04, 0.04, 0.01).asDiagonal(), 0.01, 1.0);
+  CorrelativeWindow window;
+  window.half_width_m = 0.6;
+  window.half_angle_rad = 0.25;
+  const CorrelativeResult r = correlativeSearch(grid, pts, prior, window);
+  // The same score over every pose of the same lattice.
+  double max_range = grid.resolution();
+  for (const auto& p : pts) max_range = std::max(max_range, p.norm());
+  const double step = std::acos(1.0 - grid.resolution() * grid.resolution() / (2 * max_range * max_range));
+  const int k = static_cast<int>(std::ceil(window.half_angle_rad / step)), w = static_cast<int>(std::ceil(window.half_width_m / grid.resolution()));
+  double best = -1e300;
+  common::Pose2 best_pose;
+  for (int a = -k; a <= k; ++a)
+    for (int i = -w; i <= w; ++i)
+      for (int j = -w; j <= w; ++j) {
+        const common::Pose2 x{0.1 + i * grid.resolution(), 0.1 + j * grid.resolution(), a * step};
+        const Eigen::Matrix2d R = Eigen::Rotation2Dd(x.phi).toRotationMatrix();
+        double s = 0;
+        for (const auto& p : pts) s += grid.score(R * p + Eigen::Vector2d(x.x, x.y));
+        s += prior.logDensity(x);
+        if (s > best) best = s, best_pose = x;
+      }
+  EXPECT_NEAR(r.score, best, 1e-3);
+  EXPECT_NEAR(r.pose.x, best_pose.x, 1e-9);
+  EXPECT_NEAR(r.pose.y, best_pose.y, 1e-9);
+  EXPECT_NEAR(r.pose.phi, best_pose.phi, 1e-9);
+}
+
+// The scan taken at `truth` (in the reference scan's frame), matched from a prior at `odometry`.
+PriorMatchResult matchRoom(const test::World& world, const common::Pose2& truth, const common::Pose2& odometry, const Eigen::Matrix3d& cov) {
+  const PriorMatcherOptions o;
+  const MatchReference ref(scanPoints(world, {0, 0, 0}), Eigen::Vector2d::Zero(), o);
+  return matchWithPrior(ref, scanPoints(world, truth, 11), odometry, cov, o);
+}
+
+TEST(PriorScanMatcher, GoodOdometryIsRefinedToTheTruth) {
+  const common::Pose2 truth{0.45, 0.1, 0.05};
+  const auto r = matchRoom(test::roomWorld(), truth, {0.5, 0.08, 0.06}, Eigen::Vector3d(0.025 * 0.025, 0.025 * 0.025, 1e-4).asDiagonal());
+  ASSERT_TRUE(r.valid) << r.failure_reason;
+  EXPECT_NEAR(r.pose.x, truth.x, 0.01);
+  EXPECT_NEAR(r.pose.y, truth.y, 0.01);
+  EXPECT_NEAR(r.pose.phi, truth.phi, 0.003);
+  EXPECT_GT(r.prior_weight, 0.5);
+}
+
+TEST(PriorScanMatcher, ClearScanMatchBeatsWrongOdometry) {
+  // Reversing reported as driving forwards: the odometry says +0.5 m, the vehicle went -0.5 m;
+  // and a missed 25° turn. The prior's covariance knows nothing of either.
+  const Eigen::Matrix3d cov = Eigen::Vector3d(0.025 * 0.025, 0.025 * 0.025, 1e-4).asDiagonal();
+  for (const auto& [truth, odometry] : {std::pair<common::Pose2, common::Pose2>{{-0.5, 0.0, 0.0}, {0.5, 0.0, 0.0}},
+                                        std::pair<common::Pose2, common::Pose2>{{0.3, 0.2, 0.45}, {0.3, 0.2, 0.02}}}) {
+    const auto r = matchRoom(test::roomWorld(), truth, odometry, cov);
+    ASSERT_TRUE(r.valid) << r.failure_reason;
+    EXPECT_NEAR(r.pose.x, truth.x, 0.02);
+    EXPECT_NEAR(r.pose.y, truth.y, 0.02);
+    EXPECT_NEAR(r.pose.phi, truth.phi, 0.005);
+    EXPECT_LT(r.prior_weight, 0.01);  // the odometry was outvoted, not averaged in
+  }
+}
+
+TEST(PriorScanMatcher, CorridorKeepsTheOdometryAlongItsAxis) {
+  // Nothing in a straight corridor says how far the vehicle went: the odometry decides along x
+  // (with its own uncertainty), the walls decide y and the heading.
+  const common::Pose2 truth{0.6, 0.1, 0.02}, odometry{0.45, 0.2, 0.0};
+  const Eigen::Matrix3d cov = Eigen::Vector3d(0.05 * 0.05, 0.05 * 0.05, 4e-4).asDiagonal();
+  const auto r = matchRoom(test::corridorWorld(), truth, odometry, cov);
+  ASSERT_TRUE(r.valid) << r.failure_reason;
+  EXPECT_NEAR(r.pose.x, odometry.x, 0.01);
+  EXPECT_NEAR(r.pose.y, truth.y, 0.01);
+  EXPECT_NEAR(r.pose.phi, truth.phi, 0.003);
+  EXPECT_NEAR(std::sqrt(r.cov(0, 0)), 0.05, 0.005);  // along the axis: the prior's sigma
+  EXPECT_LT(std::sqrt(r.cov(1, 1)), 0.01);          // across: the walls'
+}
+
+}  // namespace
+}  // namespace urbanslam::alignment
