@@ -2,6 +2,7 @@
 // reference trajectory, and loop closures classified true/false.
 #include <filesystem>
 #include <iostream>
+#include <limits>
 
 #include "ArgParser.h"
 #include "Commands.h"
@@ -54,14 +55,17 @@ int evalCommand(const Argv& args) {
   ArgParser ap("urbanslam eval RUN_DIR (--relations FILE | --reference FILE) [--json]",
                "Evaluates the output folder of `urbanslam run`:\n"
                "  --relations: the relation metric of Kümmerle et al. 2009 as Cartographer computes it\n"
-               "    (error = (p1^-1 p2) expected^-1; abs/squared translational and rotational error, mean +/- std);\n"
+               "    (error = (p1^-1 p2) expected^-1; abs/squared translational and rotational error, mean +/- std)\n"
+               "    on the run's nodes (trajectory_scans.tum: every scan it placed) interpolated at each relation\n"
+               "    time, every relation inside the run (the others counted as skipped); relations_odometry: the\n"
+               "    same on trajectory_odometry.tum (a folder without trajectory_scans.tum: that one only);\n"
                "    the time offset between the run and the relations is found from the reference trajectory\n"
                "    (--reference, or reference.tum in RUN_DIR) when their time bases differ;\n"
                "  --reference: ATE/RPE against a TUM trajectory or a log with a reference (corrected CARMEN log,\n"
                "    or GPS: positions only), and loop closures classified true/false. Each false one is\n"
                "    weighed on its two keyframe scans (RUN_DIR/map.simplemap): PL-ICP started at the\n"
                "    reference's relative pose ends at the run's (verdict run), stays (reference) or neither.\n"
-               "  relations.by_scans: the relation error by where both times fall among the run's scans (--scans):\n"
+               "  relations_odometry.by_scans: the relation error by where both times fall among the run's scans (--scans):\n"
                "    at_scans, one_interval (inside one interval between two scans: odometry only), other; each\n"
                "    with n, abs_trans_mean_m and share_m (its error sum over all relations; the shares add up).\n"
                "Plots: RUN_DIR/eval_trajectory.png, RUN_DIR/eval_error.png.");
@@ -70,18 +74,24 @@ int evalCommand(const Argv& args) {
   ap.addOption("reference", "FILE", "reference trajectory: TUM file or a log that carries one");
   ap.addOption("scans", "FILE", "TUM file whose times are the scans the run placed, for the relations' breakdown (default: RUN_DIR/trajectory_scans.tum, else trajectory_keyframes.tum); give another run's to compare two runs on the same classes");
   ap.addOption("time-offset", "S", "seconds added to the run's timestamps for --relations (default: found)");
-  ap.addOption("max-gap", "S", "a relation is used only when the trajectory poses around each of its times are at most this far apart [s] (sparse trajectories need more)", "1");
+  ap.addOption("max-gap", "S", "a relation is used only when the trajectory poses around each of its times are at most this far apart [s]; 0: any gap", "0");
   ap.addOption("loop-tolerance-m", "M", "a closure is true when its measurement agrees with the reference within this", "0.5");
   ap.addOption("loop-tolerance-deg", "DEG", "... and this", "5");
   ap.addFlag("json", "print the figures as one JSON object");
   if (!ap.parse(args)) return 0;
   if (!ap.has("relations") && !ap.has("reference")) throw common::InputError("give --relations FILE and/or --reference FILE");
-  const double max_gap = ap.optionDouble("max-gap");
-  if (!(max_gap > 0)) throw common::InputError("--max-gap: must be a positive number of seconds");
+  const double max_gap_arg = ap.optionDouble("max-gap");
+  if (!(max_gap_arg >= 0)) throw common::InputError("--max-gap: must be a number of seconds >= 0");
+  const double max_gap = max_gap_arg > 0 ? max_gap_arg : std::numeric_limits<double>::infinity();
   const fs::path dir = ap.positional("RUN_DIR");
-  const fs::path traj_path = dir / "trajectory_odometry.tum";
+  const fs::path traj_path = dir / "trajectory_odometry.tum", nodes_path = dir / "trajectory_scans.tum";
   if (!fs::exists(traj_path)) throw common::InputError(traj_path.string() + ": missing (not a run folder?)");
   const auto estimate = io::readTum(traj_path.string());
+  // The relations score the run's nodes, the scans it placed (as Cartographer scores its own),
+  // interpolated at each relation time; a folder without them (a peer's) is scored on its one
+  // trajectory.
+  const bool have_nodes = fs::exists(nodes_path);
+  const auto nodes = have_nodes ? io::readTum(nodes_path.string()) : estimate;
 
   common::Json j = common::Json::object();
   j["run"] = dir.string();
@@ -99,23 +109,32 @@ int evalCommand(const Argv& args) {
       for (const auto& p : estimate) log_times.push_back(p.timestamp);
       offset = slam::findRelationTimeOffset(reference.empty() ? estimate : reference, rel, log_times);
     }
-    const auto m = slam::relationMetrics(estimate, rel, offset, max_gap);
-    common::Json& r = j["relations"];
-    r["file"] = ap.option("relations");
-    r["used"] = m.used;
-    r["skipped"] = m.skipped;
-    r["time_offset_s"] = offset;
-    r["abs_trans_mean_m"] = m.abs_trans_m.mean;
-    r["abs_trans_std_m"] = m.abs_trans_m.std;
-    r["sqr_trans_mean_m2"] = m.sqr_trans_m2.mean;
-    r["sqr_trans_std_m2"] = m.sqr_trans_m2.std;
-    r["abs_rot_mean_deg"] = m.abs_rot_deg.mean;
-    r["abs_rot_std_deg"] = m.abs_rot_deg.std;
-    r["sqr_rot_mean_deg2"] = m.sqr_rot_deg2.mean;
-    r["sqr_rot_std_deg2"] = m.sqr_rot_deg2.std;
-    // Where the error comes from: relations at scans, inside one interval between scans (only
-    // the odometry there), and the rest; the three shares add up to abs_trans_mean_m.
-    fs::path scans_path = ap.has("scans") ? fs::path(ap.option("scans")) : dir / "trajectory_scans.tum";
+    const auto block = [&](const std::vector<io::StampedPose>& traj, const fs::path& path) {
+      const auto m = slam::relationMetrics(traj, rel, offset, max_gap);
+      common::Json r = common::Json::object();
+      r["file"] = ap.option("relations");
+      r["trajectory"] = path.filename().string();
+      r["used"] = m.used;
+      r["skipped"] = m.skipped;
+      r["time_offset_s"] = offset;
+      r["abs_trans_mean_m"] = m.abs_trans_m.mean;
+      r["abs_trans_std_m"] = m.abs_trans_m.std;
+      r["sqr_trans_mean_m2"] = m.sqr_trans_m2.mean;
+      r["sqr_trans_std_m2"] = m.sqr_trans_m2.std;
+      r["abs_rot_mean_deg"] = m.abs_rot_deg.mean;
+      r["abs_rot_std_deg"] = m.abs_rot_deg.std;
+      r["sqr_rot_mean_deg2"] = m.sqr_rot_deg2.mean;
+      r["sqr_rot_std_deg2"] = m.sqr_rot_deg2.std;
+      if (m.used == 0) throw common::InputError(ap.option("relations") + ": no relation falls inside the run's time span (wrong dataset or offset?)");
+      return r;
+    };
+    j["relations"] = block(nodes, have_nodes ? nodes_path : traj_path);
+    if (have_nodes) j["relations_odometry"] = block(estimate, traj_path);
+    common::Json& r = j[have_nodes ? "relations_odometry" : "relations"];
+    // Where the odometry-time trajectory's error comes from: relations at scans, inside one
+    // interval between scans (only the odometry there), and the rest; the three shares add up to
+    // its abs_trans_mean_m.
+    fs::path scans_path = ap.has("scans") ? fs::path(ap.option("scans")) : nodes_path;
     if (!ap.has("scans") && !fs::exists(scans_path)) scans_path = dir / "trajectory_keyframes.tum";
     if (fs::exists(scans_path) || ap.has("scans")) {
       std::vector<double> scan_times;
@@ -136,10 +155,9 @@ int evalCommand(const Argv& args) {
     }
     if (!reference.empty()) {
       const auto mr = slam::relationMetrics(reference, rel, offset, 5.0);  // reference poses are sparse
-      r["reference_abs_trans_mean_m"] = mr.abs_trans_m.mean;
-      r["reference_abs_rot_mean_deg"] = mr.abs_rot_deg.mean;
+      j["relations"]["reference_abs_trans_mean_m"] = mr.abs_trans_m.mean;
+      j["relations"]["reference_abs_rot_mean_deg"] = mr.abs_rot_deg.mean;
     }
-    if (m.used == 0) throw common::InputError(ap.option("relations") + ": no relation falls inside the run's time span (wrong dataset or offset?)");
   }
   if (ap.has("reference")) {
     const auto tm = slam::trajectoryMetrics(estimate, reference, positions_only, positions_only ? 2.0 : 1.0);

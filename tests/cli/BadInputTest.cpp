@@ -96,7 +96,7 @@ TEST(BadInput, EvalArguments) {
   const fs::path d = scratchDir("bad_eval");
   const std::string rel = " --relations " + repoPath("rawlogs/intel-corrected-excerpt.log.gz");
   expectBadInput("eval " + d.string(), "give --relations FILE and/or --reference FILE");
-  expectBadInput("eval " + d.string() + rel + " --max-gap 0", "--max-gap: must be a positive number of seconds");
+  expectBadInput("eval " + d.string() + rel + " --max-gap -1", "--max-gap: must be a number of seconds >= 0");
   expectBadInput("eval " + (d / "no-run").string() + rel, "trajectory_odometry.tum: missing (not a run folder?)");
   // A run folder and relations that evaluate, with a --scans file that is not there.
   const fs::path run = d / "run";

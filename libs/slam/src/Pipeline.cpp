@@ -12,7 +12,6 @@
 #include "urbanslam/esdf/PoseOps.h"
 #include "urbanslam/laser_loop/LoopDetector.h"
 #include "urbanslam/vision_loop/LoopDetector.h"
-#include "urbanslam/vision_loop/VocabularyFile.h"
 
 namespace urbanslam::slam {
 
@@ -25,6 +24,7 @@ Pipeline::Pipeline(PipelineOptions options)
     : options_(std::move(options)),
       motion_(options_.motion, options_.vehicle),
       images_(options_.loop_closure.image_max_offset_s),
+      submap_(options_.local),
       closer_(options_.loop_closure) {
   std::stringstream ss(options_.input.laser_labels);
   std::string label;
@@ -49,13 +49,6 @@ Pipeline::Pipeline(PipelineOptions options)
           return laser_detector_->score(laser_detector_->keyframe(current), earlier) - laser_detector_->factor();
         },
         "laser");
-  }
-  if (options_.loop_closure.image_detector == "tree_of_words") {
-    // Tree of Words over the keyframe images (thesis §4.2); the vocabulary decides SIFT or ORB.
-    const std::string path = options_.image_loop.vocabulary.empty() ? vision_loop::kDefaultVocabularyPath : options_.image_loop.vocabulary;
-    auto vocabulary = std::make_shared<const vision_loop::Vocabulary>(vision_loop::loadVocabulary(path));
-    const auto features = vision_loop::featureOptions(options_.image_loop, vocabulary->descriptorType());
-    image_detector_ = std::make_unique<vision_loop::LoopDetector>(vocabulary, features, vision_loop::detectorOptions(options_.image_loop));
   }
 }
 
@@ -215,11 +208,7 @@ void Pipeline::addKeyframe(io::LaserScan scan) {
   }
   // The keyframe is an anchor of the trajectory at odometry times (offset identity).
   addAnchor({kf.timestamp, k, common::Pose2{}, motion_.odometryPose()});
-  if (options_.local.scan_matching) {
-    alignment::AlignerOptions ao;
-    recent_sets_.push_back(alignment::pointSetFromScan(kf.scan, ao.scan, ao.in_vehicle_frame));
-    while (recent_sets_.size() > static_cast<size_t>(options_.local.submap_keyframes)) recent_sets_.pop_front();
-  }
+  if (options_.local.scan_matching) submap_.addKeyframe(kf.scan);
   if (laser_detector_) laser_detector_->addKeyframe(kf.scan);  // features once per keyframe
   have_scan_keyframe_ = have_scan_keyframe_ || kf.hasScan();
   keyframes_.push_back(std::move(kf));
@@ -238,15 +227,15 @@ void Pipeline::addKeyframe(io::LaserScan scan) {
 }
 
 void Pipeline::localScanMatching(const io::LaserScan& scan, common::Pose2& z, Eigen::Matrix3d& cov) {
-  common::Pose2 pose;
-  Eigen::Matrix3d a_cov;
-  if (!matchSubmap(scan, z, pose, a_cov)) {
+  const alignment::PriorMatchResult r = matchSubmap(scan, z, cov);
+  if (!r.valid) {
     ++stats_.scan_matches_rejected;
     return;
   }
   ++stats_.scan_matches_used;
-  z = pose;
-  cov = options_.local.covariance_scale * a_cov;
+  // The posterior of the increment given the odometry and the scan replaces the odometry's.
+  z = r.pose;
+  cov = options_.local.covariance_scale * r.cov;
   const double sxy = options_.local.min_sigma_xy_m, sphi = options_.local.min_sigma_phi_deg * kDeg;
   cov(0, 0) = std::max(cov(0, 0), sxy * sxy);
   cov(1, 1) = std::max(cov(1, 1), sxy * sxy);
@@ -256,11 +245,19 @@ void Pipeline::localScanMatching(const io::LaserScan& scan, common::Pose2& z, Ei
 void Pipeline::anchorScan(const io::LaserScan& scan) {
   // A scan between keyframes: its submap match places it relative to the last keyframe, for the
   // trajectory at odometry times only (the filter keeps one pose per keyframe).
-  common::Pose2 pose;
-  Eigen::Matrix3d cov;
-  if (!matchSubmap(scan, motion_.increment(), pose, cov)) return;
+  Eigen::Matrix3d cov = motion_.covariance();
+  cov.diagonal() += Eigen::Vector3d(1e-8, 1e-8, 1e-10);
+  const alignment::PriorMatchResult r = matchSubmap(scan, motion_.increment(), cov);
+  if (!r.valid) return;
   ++stats_.scans_anchored;
-  addAnchor({scan.timestamp, keyframes_.size() - 1, pose, motion_.odometryPose()});
+  addAnchor({scan.timestamp, keyframes_.size() - 1, r.pose, motion_.odometryPose()});
+}
+
+alignment::PriorMatchResult Pipeline::matchSubmap(const io::LaserScan& scan, const common::Pose2& z, const Eigen::Matrix3d& cov) const {
+  std::vector<common::Pose2> poses;
+  for (size_t i = keyframes_.size() - std::min(keyframes_.size(), submap_.size()); i < keyframes_.size(); ++i)
+    poses.push_back(keyframes_[i].pose);
+  return submap_.match(scan, z, cov, poses);
 }
 
 void Pipeline::addAnchor(const ScanAnchor& anchor) {
@@ -268,94 +265,6 @@ void Pipeline::addAnchor(const ScanAnchor& anchor) {
   // Odometry readings taken at the scan's time hang from it: the trajectory at that time is the
   // scan's pose, not the odometry prediction from the anchor before.
   for (auto it = odometry_.rbegin(); it != odometry_.rend() && it->timestamp == anchor.timestamp; ++it) it->anchor = anchors_.size() - 1;
-}
-
-const alignment::IndexedReference* Pipeline::localSubmap() const {
-  // The points of the last few keyframes in the frame of the last one (a local submap, as
-  // KISS-ICP and Cartographer match against), so one poor scan does not make the odometry jump
-  // and the drift between keyframes shrinks.
-  const size_t n = keyframes_.size(), first = n - std::min(n, recent_sets_.size());
-  std::vector<common::Pose2> offsets;
-  for (size_t i = first; i < n; ++i) offsets.push_back(common::between(keyframes_.back().pose, keyframes_[i].pose));
-  const auto same = [](const common::Pose2& a, const common::Pose2& b) { return a.x == b.x && a.y == b.y && a.phi == b.phi; };
-  if (submap_.keyframes == n && submap_.offsets.size() == offsets.size() &&
-      std::equal(offsets.begin(), offsets.end(), submap_.offsets.begin(), same))
-    return submap_.reference.get();
-  alignment::PointSet points;
-  for (size_t i = first; i < n; ++i) {
-    const auto t = alignment::transformed(recent_sets_[i - first], offsets[i - first]);
-    points.insert(points.end(), t.begin(), t.end());
-  }
-  submap_ = {n, std::move(offsets), points.empty() ? nullptr : std::make_unique<alignment::IndexedReference>(std::move(points))};
-  return submap_.reference.get();
-}
-
-bool Pipeline::matchSubmap(const io::LaserScan& scan, const common::Pose2& z, common::Pose2& pose, Eigen::Matrix3d& cov) const {
-  alignment::AlignerOptions ao;
-  ao.method = alignment::parseMethod(options_.local.method);
-  const alignment::IndexedReference* submap = localSubmap();
-  if (!submap) return false;  // the recent keyframes have no scans: keep the odometry
-  const alignment::IndexedReference& reference = *submap;
-  const alignment::PointSet current = alignment::pointSetFromScan(scan, ao.scan, ao.in_vehicle_frame);
-  const auto within = [&](const alignment::AlignmentResult& r, double max_m, double max_deg) {
-    const common::Pose2 c = common::between(z, r.transform);
-    return std::hypot(c.x, c.y) <= max_m && std::abs(c.phi) <= max_deg * kDeg;
-  };
-  const LocalOptions& lo = options_.local;
-  const auto trusted = [&](const alignment::AlignmentResult& r) {
-    return r.converged && r.matchedFraction() >= lo.trusted_matched_fraction && within(r, lo.max_trusted_correction_m, lo.max_trusted_correction_deg);
-  };
-  auto a = alignment::alignPointSets(reference, current, z, ao);
-  bool unanimous = false;
-  if (lo.retry_below_fraction > 0 && (!trusted(a) || a.matchedFraction() < lo.retry_below_fraction)) {
-    // The odometry guess may be far off (a missed turn, reversing, a false turn): PL-ICP from it
-    // can stop in a wrong minimum. Other starts; the match explaining most of the scan (then the
-    // smallest residual) wins.
-    const auto better = [&](const alignment::AlignmentResult& b) {
-      if (!b.converged) return false;
-      if (!a.converged) return true;
-      return b.matchedFraction() > a.matchedFraction() ||
-             (b.matchedFraction() == a.matchedFraction() && b.rms_residual_m < a.rms_residual_m);
-    };
-    // Outdoors the wheels slip on kerbs and grass and the odometry turns 10-20° that the
-    // vehicle did not (Freiburg campus), so the odometry's translation without its turn is a
-    // start too.
-    const common::Pose2 starts[] = {{0, 0, z.phi}, {-z.x, -z.y, z.phi}, {z.x, z.y, 0}};
-    std::vector<alignment::AlignmentResult> results{a};
-    for (const common::Pose2& g : starts) {
-      results.push_back(alignment::alignPointSets(reference, current, g, ao));
-      if (better(results.back())) a = results.back();
-    }
-    // Every start, the odometry and its opposite among them, ended at the same pose (settled or
-    // still creeping along the same valley): the scans have a single minimum within the
-    // odometry's reach, so the match is trusted even when it explains less of the scan than
-    // trusted_matched_fraction. Reversing in FR079 turns the view: 64 % matched, and the
-    // odometry, which reports reversing as driving forwards, was kept 1 m off.
-    unanimous = lo.trust_agreeing_starts && a.converged && std::all_of(results.begin(), results.end(), [&](const alignment::AlignmentResult& b) {
-      const common::Pose2 d = common::between(a.transform, b.transform);
-      return std::hypot(d.x, d.y) <= 0.05 && std::abs(d.phi) <= kDeg;
-    });
-  }
-  if (lo.fine_start_gate_m > 0 && !unanimous) {
-    // PL-ICP's wide first gate (4 m) reaches the right basin from a poor guess, but from a good
-    // one it lets clutter drag the match along a wall: on MIT CSAIL 0.7 m off the odometry with
-    // 68 % of the scan matched, where a 0.5 m first gate stays at the right pose with 71 %. So
-    // PL-ICP also runs from the odometry with a narrow first gate, and that match (the
-    // odometry's basin) is kept unless the wide-gate one explains clearly more of the scan.
-    // Skipped when every retry start agreed: then the odometry is the outlier (FR079 reversing).
-    alignment::AlignerOptions fine = ao;
-    fine.icp.gate_initial_m = lo.fine_start_gate_m;
-    auto b = alignment::alignPointSets(reference, current, z, fine);
-    const double gain = a.matchedFraction() - b.matchedFraction();
-    if (b.converged && (!a.converged || gain < lo.fine_start_min_gain ||
-                        (gain == lo.fine_start_min_gain && b.rms_residual_m < a.rms_residual_m)))
-      a = std::move(b);
-  }
-  const bool trust = trusted(a) || (unanimous && within(a, lo.max_trusted_correction_m, lo.max_trusted_correction_deg));
-  if (!a.converged || !(trust || within(a, lo.max_correction_m, lo.max_correction_deg))) return false;
-  pose = a.transform;
-  cov = a.cov;
-  return true;
 }
 
 void Pipeline::reportClosure(const LoopClosureRecord& r) {
@@ -504,16 +413,21 @@ std::vector<io::StampedPose> Pipeline::odometryTrajectory() const {
   // (readings stamped with a scan's time hang from its anchor and come before it).
   const auto last = std::unique(out.rbegin(), out.rend(), [](const auto& a, const auto& b) { return a.timestamp == b.timestamp; });
   out.erase(out.begin(), last.base());
-  // Except at a scan's own time: a reading read after the scan can carry the same stamp (the
-  // Intel log's stamps go back and forth: 2661.47, scan, 2661.07, 2661.14, 2661.47), and the pose
-  // there is the scan's, 0.18 m before that reading's.
+  // The scans placed by matching are poses of this trajectory too, so that at a scan's time it
+  // is that scan's pose (a reading with the same stamp gives way: the Intel log's stamps go back
+  // and forth, 2661.47, scan, 2661.07, 2661.14, 2661.47, and the pose there is the scan's, not
+  // that later reading's) and between scans it moves with the odometry from one to the next.
   const auto scans = scanTrajectory();
+  std::vector<io::StampedPose> merged;
+  merged.reserve(out.size() + scans.size());
   auto o = out.begin();
   for (const auto& a : scans) {
-    o = std::lower_bound(o, out.end(), a.timestamp, [](const io::StampedPose& p, double t) { return p.timestamp < t; });
-    if (o != out.end() && o->timestamp == a.timestamp) o->pose = a.pose;
+    for (; o != out.end() && o->timestamp <= a.timestamp; ++o)
+      if (o->timestamp < a.timestamp) merged.push_back(*o);
+    if (merged.empty() || merged.back().timestamp != a.timestamp) merged.push_back(a);
   }
-  return out;
+  merged.insert(merged.end(), o, out.end());
+  return merged;
 }
 
 std::vector<io::StampedPose> Pipeline::scanTrajectory() const {

@@ -7,11 +7,23 @@
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/slam/Pipeline.h"
 #include "urbanslam/vision_loop/LoopDetector.h"
+#include "urbanslam/vision_loop/VocabularyFile.h"
 
 namespace urbanslam::slam {
 
+void Pipeline::startImageDetector() {
+  if (image_detector_ || options_.loop_closure.image_detector != "tree_of_words") return;
+  // Tree of Words over the keyframe images (thesis §4.2); the vocabulary decides SIFT or ORB.
+  // Loaded at the first image, so a log without a camera never reads it.
+  const std::string path = options_.image_loop.vocabulary.empty() ? vision_loop::kDefaultVocabularyPath : options_.image_loop.vocabulary;
+  auto vocabulary = std::make_shared<const vision_loop::Vocabulary>(vision_loop::loadVocabulary(path));
+  const auto features = vision_loop::featureOptions(options_.image_loop, vocabulary->descriptorType());
+  image_detector_ = std::make_unique<vision_loop::LoopDetector>(vocabulary, features, vision_loop::detectorOptions(options_.image_loop));
+}
+
 void Pipeline::onCameraImage(const io::CameraImage& image, double progress) {
   if (!image.pixels || image.width <= 0 || image.height <= 0) return;
+  startImageDetector();
   if (stats_.scans > 0) {
     images_.addImage(image);  // goes to the nearest keyframe in time, decided one keyframe later
     return;

@@ -27,21 +27,18 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("speed_sigma_mps", o.motion.speed_sigma_mps, 1e-4, 10.0, "m/s", "steering model: speed noise (Q_v)");
   s.add("steering_sigma_deg", o.motion.steering_sigma_deg, 1e-3, 45.0, "deg", "steering model: steering angle noise (Q_v)");
 
-  s.section("local", "Local SLAM: odometry between keyframes refined by scan matching");
-  s.add("scan_matching", o.local.scan_matching, "align each keyframe's scan with the previous keyframe's");
-  s.add("method", o.local.method, {"icp", "plicp", "crf", "crf+icp"}, "alignment method");
-  s.add("submap_keyframes", o.local.submap_keyframes, 1, 100, "keyframes", "match against a local submap of the last this many keyframes");
-  s.add("max_correction_m", o.local.max_correction_m, 0.0, 10.0, "m", "reject a scan match that moves the odometry more than this");
-  s.add("max_correction_deg", o.local.max_correction_deg, 0.0, 180.0, "deg", "reject a scan match that turns the odometry more than this");
-  s.add("trusted_matched_fraction", o.local.trusted_matched_fraction, 0.0, 1.0, "", "a scan match with this share of points matched is trusted over the odometry up to max_trusted_correction");
-  s.add("max_trusted_correction_m", o.local.max_trusted_correction_m, 0.0, 10.0, "m", "a trusted scan match may move the odometry this much");
-  s.add("max_trusted_correction_deg", o.local.max_trusted_correction_deg, 0.0, 180.0, "deg", "a trusted scan match may turn the odometry this much");
-  s.add("fine_start_gate_m", o.local.fine_start_gate_m, 0.0, 10.0, "m", "also align from the odometry with this first association gate (the default 4 m reaches the right basin from a poor guess, but clutter can drag a good one along a wall); 0: off");
-  s.add("fine_start_min_gain", o.local.fine_start_min_gain, 0.0, 1.0, "", "the narrow-gate match is kept unless the wide-gate one matches this share more of the scan's points");
-  s.add("retry_below_fraction", o.local.retry_below_fraction, 0.0, 1.0, "", "a scan match with fewer points matched (or untrusted) is retried from standing still, from the reversed odometry and from the odometry without its turn; 0: never");
-  s.add("trust_agreeing_starts", o.local.trust_agreeing_starts, "a retried scan match that every start ends at is trusted (up to max_trusted_correction) even below trusted_matched_fraction");
+  s.section("local", "Local SLAM: the odometry between keyframes weighed against a scan match with the local submap");
+  s.add("scan_matching", o.local.scan_matching, "match each scan with the local submap of the last keyframes, weighed against the odometry");
   s.add("match_every_scan", o.local.match_every_scan, "also match the scans between keyframes with the submap; the trajectory at odometry times follows them (the map holds keyframes only)");
-  s.add("covariance_scale", o.local.covariance_scale, 0.1, 1000.0, "", "inflation of the alignment covariance");
+  s.add("resolution_m", o.local.resolution_m, 0.01, 1.0, "m", "likelihood grid cell of the correlative search");
+  s.add("hit_sigma_m", o.local.hit_sigma_m, 0.005, 1.0, "m", "spread of a return about the surface it hit (likelihood grid)");
+  s.add("miss_floor", o.local.miss_floor, 1e-6, 1.0, "", "density of a return the submap does not explain, relative to a hit's peak");
+  s.add("voxel_m", o.local.voxel_m, 0.01, 10.0, "m", "the correlative search scores one scan point per voxel of this size (the refinement uses every point)");
+  s.add("search_window_m", o.local.search_window_m, 0.0, 10.0, "m", "the correlative search reaches at least this far from the odometry (and at least its 3 sigma)");
+  s.add("search_window_deg", o.local.search_window_deg, 0.0, 180.0, "deg", "... and turns at least this far from it");
+  s.add("odometry_outlier_probability", o.local.odometry_outlier_probability, 0.0, 0.5, "", "probability that the odometry is wrong beyond its covariance (a missed turn, reversing, slip): what a scan match far from it pays");
+  s.add("point_sigma_m", o.local.point_sigma_m, 0.001, 1.0, "m", "a return's distance to the submap's surface in the least-squares refinement");
+  s.add("covariance_scale", o.local.covariance_scale, 0.1, 1000.0, "", "the filter gets the match's posterior covariance times this (consecutive matches share the submap's points: correlated errors)");
   s.add("min_sigma_xy_m", o.local.min_sigma_xy_m, 0.0, 1.0, "m", "floor on the scan-matching position sigma");
   s.add("min_sigma_phi_deg", o.local.min_sigma_phi_deg, 0.0, 10.0, "deg", "floor on the scan-matching heading sigma");
 

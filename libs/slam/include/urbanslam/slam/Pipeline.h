@@ -9,19 +9,16 @@
 #include <memory>
 #include <vector>
 
-#include "urbanslam/alignment/PointSet.h"
 #include "urbanslam/io/DataSource.h"
 #include "urbanslam/io/MapOutputs.h"
 #include "urbanslam/slam/KeyframeImages.h"
+#include "urbanslam/slam/LocalSubmap.h"
 #include "urbanslam/slam/LoopCloser.h"
 #include "urbanslam/slam/MotionIntegrator.h"
 #include "urbanslam/slam/Observer.h"
 #include "urbanslam/slam/PipelineOptions.h"
 #include "urbanslam/vision_loop/BagOfWords.h"
 
-namespace urbanslam::alignment {
-class IndexedReference;
-}
 namespace urbanslam::esdf {
 class Esdf;
 }
@@ -84,8 +81,9 @@ class Pipeline {
   void finish();
 
   const std::vector<Keyframe>& keyframes() const { return keyframes_; }
-  // Estimated pose at every odometry (or drive) reading's time, from the current keyframe
-  // estimates and the odometry since each keyframe.
+  // Estimated pose at every odometry (or drive) reading's time and at every scan placed by
+  // matching (scanTrajectory(): at a scan's time this is the scan's pose), from the current
+  // keyframe estimates and the odometry between the scans.
   std::vector<io::StampedPose> odometryTrajectory() const;
   // Estimated pose at every scan placed by scan matching: the keyframes and, with
   // [local] match_every_scan, the scans matched between them. Between these the trajectory at
@@ -120,18 +118,14 @@ class Pipeline {
   void onScan(io::LaserScan scan, double progress);
   void addKeyframe(io::LaserScan scan);
   void localScanMatching(const io::LaserScan& scan, common::Pose2& z, Eigen::Matrix3d& cov);
-  // The scan aligned with the local submap (the last keyframes, in the last one's frame) from
-  // the guess z, with the retries and the trust rules of [local]: the scan's pose in the last
-  // keyframe's frame and the alignment covariance, or false when the match is refused.
-  bool matchSubmap(const io::LaserScan& scan, const common::Pose2& z, common::Pose2& pose, Eigen::Matrix3d& cov) const;
-  // The local submap with its kd-tree and normals, rebuilt only when a keyframe is added or the
-  // submap's keyframes move relative to each other (a closure): the scans between two keyframes
-  // share it. Null when the recent keyframes have no points.
-  const alignment::IndexedReference* localSubmap() const;
+  // The scan matched with the local submap from the odometry since the last keyframe (prior z
+  // with covariance cov): its pose in the last keyframe's frame and the posterior covariance.
+  alignment::PriorMatchResult matchSubmap(const io::LaserScan& scan, const common::Pose2& z, const Eigen::Matrix3d& cov) const;
   void anchorScan(const io::LaserScan& scan);
   void addAnchor(const ScanAnchor& anchor);
   void searchLoopClosures(size_t current);
   // Camera images (PipelineImages.cpp): attachment to keyframes, Tree of Words proposals.
+  void startImageDetector();  // [loop_closure] image_detector, at the first image
   void onCameraImage(const io::CameraImage& image, double progress);
   void attachImage(const AssignedImage& assigned);
   void proposeImageClosure(size_t earlier, size_t current, double score);
@@ -163,13 +157,7 @@ class Pipeline {
   std::vector<size_t> image_keyframes_;  // image database id -> keyframe
   KeyframeImageAssigner images_;
   std::deque<LoopClosureRecord> pending_;  // passed alignment + gate, awaiting confirmation
-  std::deque<alignment::PointSet> recent_sets_;  // point sets of the last keyframes (local submap)
-  struct LocalSubmap {
-    size_t keyframes = 0;                    // keyframes_.size() when built
-    std::vector<common::Pose2> offsets;      // each recent keyframe in the last one's frame
-    std::unique_ptr<const alignment::IndexedReference> reference;
-  };
-  mutable LocalSubmap submap_;
+  LocalSubmap submap_;
   LoopCloser closer_;
   bool have_first_ts_ = false;
   bool have_scan_keyframe_ = false;  // camera-only logs make a keyframe of every image until a scan comes

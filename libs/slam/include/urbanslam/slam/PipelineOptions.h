@@ -28,42 +28,36 @@ struct VehicleOptions {
 struct MotionOptions {
   std::string model = "auto";  // auto | odometry | steering: auto = steering for speed+steering logs
   // Odometry noise per increment (sigma grows with distance and turning).
-  double odometry_sigma_xy_per_m = 0.05;
+  double odometry_sigma_xy_per_m = 0.1;
   double odometry_sigma_xy_min_m = 0.002;
-  double odometry_sigma_phi_per_rad = 0.05;
-  double odometry_sigma_phi_per_m_rad = 0.01;
+  double odometry_sigma_phi_per_rad = 0.3;
+  double odometry_sigma_phi_per_m_rad = 0.1;
   double odometry_sigma_phi_min_rad = 0.0005;
   // Speed + steering noise (Q_v of the steering model, thesis eq. 2.19).
-  double speed_sigma_mps = 0.1;
-  double steering_sigma_deg = 2.0;
+  double speed_sigma_mps = 0.2;
+  double steering_sigma_deg = 3.0;
 };
 
 // Local SLAM: the odometry increment between keyframes refined by aligning their scans.
 struct LocalOptions {
   bool scan_matching = true;
-  std::string method = "plicp";        // icp | plicp | crf | crf+icp
   int submap_keyframes = 5;            // the scan is matched against the last this many keyframes
-  double max_correction_m = 0.5;       // larger disagreements with odometry: keep the odometry
-  double max_correction_deg = 10.0;
-  // A match that explains most of the scan is trusted further than the odometry: wheel odometry
-  // misses part of fast turns and, on FR079, reports reversing as driving forwards.
-  double trusted_matched_fraction = 0.7;  // share of scan points matched for a trusted match
-  double max_trusted_correction_m = 1.5;  // trusted matches may correct the odometry this much
-  double max_trusted_correction_deg = 45.0;
-  // PL-ICP's first association gate is wide (4 m) so that it reaches the right basin from a
-  // poor guess; from a good one clutter can drag it along a wall. A second alignment from the
-  // odometry with this narrow first gate is kept unless the wide-gate one matches
-  // fine_start_min_gain more of the scan.
-  double fine_start_gate_m = 1.0;         // 0: off
-  double fine_start_min_gain = 0.05;
-  // A match from the odometry guess matching fewer points than this (or untrusted) is retried
-  // from standing still and from the reversed translation; the one matching most points wins.
-  double retry_below_fraction = 0.0;      // 0: never retry
-  bool trust_agreeing_starts = true;      // a retried match that every start reaches is trusted
   // The scans between keyframes are matched with the submap too, and the trajectory at odometry
   // times follows them (the filter and the map still hold keyframes only).
   bool match_every_scan = true;
-  double covariance_scale = 4.0;       // alignment covariance inflation (matched scans are correlated)
+  // The matcher (alignment/PriorScanMatcher.h): odometry prior and scan evidence weighed by
+  // their uncertainties.
+  double resolution_m = 0.05;          // likelihood grid cell
+  double hit_sigma_m = 0.05;           // spread of a return about the surface it hit
+  double miss_floor = 0.05;            // density of an unexplained return relative to a hit's peak
+  double voxel_m = 0.2;                // the correlative search scores one scan point per voxel
+  double search_window_m = 1.0;        // the search reaches at least this far from the odometry
+  double search_window_deg = 30.0;
+  double odometry_outlier_probability = 1e-4;  // the odometry being wrong beyond its covariance
+  double point_sigma_m = 0.01;         // a return's distance to the reference surface (refinement)
+  // The filter gets the match's covariance times this: consecutive matches share the submap's
+  // points, so their errors are correlated, which the filter's independent edges cannot say.
+  double covariance_scale = 4.0;
   double min_sigma_xy_m = 0.01;        // floors on the scan-matching uncertainty
   double min_sigma_phi_deg = 0.25;
 };
@@ -76,7 +70,7 @@ struct LoopClosureOptions {
   double laser_threshold = 0.0;        // strong-classifier margin offset (higher: fewer false alarms)
   // Image proposals (Tree of Words, [image_loop]) go through the same alignment, gating and
   // confirmation as the laser candidates; without scans they are only recorded.
-  std::string image_detector = "none";  // none | tree_of_words
+  std::string image_detector = "tree_of_words";  // none | tree_of_words
   double image_max_offset_s = 0.5;      // an image is attached to the nearest keyframe only this close in time
   int min_keyframe_gap = 30;           // closures only with keyframes at least this much older
   double search_radius_m = 4.0;        // initial set: earlier keyframes this close (+ 3 sigma)

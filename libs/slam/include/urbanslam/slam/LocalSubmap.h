@@ -1,0 +1,49 @@
+#pragma once
+// Local SLAM's reference: the scans of the last few keyframes, placed by their current estimates
+// in the frame of the newest (a local submap, as KISS-ICP and Cartographer match against), and
+// the one matcher that places a scan in it: the odometry prior and the scan evidence weighed
+// by their uncertainties (alignment/PriorScanMatcher.h). The prepared reference (kd-tree,
+// normals, likelihood grid) is kept until a keyframe is added or the submap's keyframes move
+// relative to each other (a closure), so the scans between two keyframes share it.
+#include <deque>
+#include <memory>
+#include <vector>
+
+#include "urbanslam/alignment/PointSet.h"
+#include "urbanslam/alignment/PriorScanMatcher.h"
+#include "urbanslam/io/LaserScan.h"
+#include "urbanslam/slam/PipelineOptions.h"
+
+namespace urbanslam::slam {
+
+alignment::PriorMatcherOptions priorMatcherOptions(const LocalOptions& options);
+
+class LocalSubmap {
+ public:
+  explicit LocalSubmap(const LocalOptions& options);
+
+  // The keyframe's scan joins the submap; the oldest beyond submap_keyframes leaves.
+  void addKeyframe(const io::LaserScan& scan);
+  size_t size() const { return sets_.size(); }
+  // The scan's pose in the newest keyframe's frame, from the prior (the odometry since that
+  // keyframe, with its covariance). poses: the current estimates of the submap's keyframes,
+  // oldest first (size() of them). Not valid when the submap or the scan has too few points.
+  alignment::PriorMatchResult match(const io::LaserScan& scan, const common::Pose2& prior, const Eigen::Matrix3d& prior_cov,
+                                    const std::vector<common::Pose2>& poses) const;
+
+ private:
+  const alignment::MatchReference* reference(const std::vector<common::Pose2>& poses) const;
+
+  alignment::PriorMatcherOptions matcher_;
+  size_t capacity_;
+  std::deque<alignment::PointSet> sets_;   // each keyframe's points in its own frame
+  size_t generation_ = 0;                  // keyframes added so far
+  struct Cache {
+    size_t generation = static_cast<size_t>(-1);
+    std::vector<common::Pose2> offsets;    // each keyframe in the newest one's frame
+    std::unique_ptr<const alignment::MatchReference> reference;
+  };
+  mutable Cache cache_;
+};
+
+}  // namespace urbanslam::slam

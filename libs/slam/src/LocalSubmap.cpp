@@ -1,0 +1,68 @@
+#include "urbanslam/slam/LocalSubmap.h"
+
+#include <algorithm>
+
+#include "urbanslam/alignment/Aligner.h"
+
+namespace urbanslam::slam {
+
+alignment::PriorMatcherOptions priorMatcherOptions(const LocalOptions& o) {
+  alignment::PriorMatcherOptions m;
+  m.grid.resolution_m = o.resolution_m;
+  m.grid.hit_sigma_m = o.hit_sigma_m;
+  m.grid.miss_floor = o.miss_floor;
+  m.voxel_m = o.voxel_m;
+  m.search_window_m = o.search_window_m;
+  m.search_window_deg = o.search_window_deg;
+  m.odometry_outlier_probability = o.odometry_outlier_probability;
+  m.point_sigma_m = o.point_sigma_m;
+  return m;
+}
+
+LocalSubmap::LocalSubmap(const LocalOptions& options)
+    : matcher_(priorMatcherOptions(options)), capacity_(static_cast<size_t>(std::max(1, options.submap_keyframes))) {}
+
+void LocalSubmap::addKeyframe(const io::LaserScan& scan) {
+  const alignment::AlignerOptions ao;
+  sets_.push_back(alignment::pointSetFromScan(scan, ao.scan, ao.in_vehicle_frame));
+  while (sets_.size() > capacity_) sets_.pop_front();
+  ++generation_;
+}
+
+const alignment::MatchReference* LocalSubmap::reference(const std::vector<common::Pose2>& poses) const {
+  std::vector<common::Pose2> offsets;
+  for (const auto& p : poses) offsets.push_back(common::between(poses.back(), p));
+  const auto same = [](const common::Pose2& a, const common::Pose2& b) { return a.x == b.x && a.y == b.y && a.phi == b.phi; };
+  if (cache_.generation == generation_ && cache_.offsets.size() == offsets.size() &&
+      std::equal(offsets.begin(), offsets.end(), cache_.offsets.begin(), same))
+    return cache_.reference.get();
+  alignment::PointSet points;
+  for (size_t i = 0; i < sets_.size(); ++i) {
+    const auto t = alignment::transformed(sets_[i], offsets[i]);
+    points.insert(points.end(), t.begin(), t.end());
+  }
+  cache_.generation = generation_;
+  cache_.offsets = std::move(offsets);
+  cache_.reference = points.empty() ? nullptr : std::make_unique<const alignment::MatchReference>(std::move(points), Eigen::Vector2d::Zero(), matcher_);
+  return cache_.reference.get();
+}
+
+alignment::PriorMatchResult LocalSubmap::match(const io::LaserScan& scan, const common::Pose2& prior, const Eigen::Matrix3d& prior_cov,
+                                               const std::vector<common::Pose2>& poses) const {
+  alignment::PriorMatchResult none;
+  none.pose = prior;
+  none.cov = prior_cov;
+  if (poses.size() != sets_.size() || sets_.empty()) {
+    none.failure_reason = "no submap";
+    return none;
+  }
+  const alignment::MatchReference* ref = reference(poses);
+  if (!ref) {
+    none.failure_reason = "empty submap";
+    return none;
+  }
+  const alignment::AlignerOptions ao;
+  return alignment::matchWithPrior(*ref, alignment::pointSetFromScan(scan, ao.scan, ao.in_vehicle_frame), prior, prior_cov, matcher_);
+}
+
+}  // namespace urbanslam::slam
