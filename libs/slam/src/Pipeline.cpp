@@ -278,6 +278,9 @@ void Pipeline::reportClosure(const LoopClosureRecord& r) {
 // second: between(x_j, x_i) ⊕ z_ik ⊕ between(x_k, x_m) ≈ z_jm. A wrong match in a symmetric
 // building rarely repeats consistently at the next keyframe; a true one does.
 bool Pipeline::consistent(const LoopClosureRecord& a, const LoopClosureRecord& b) const {
+  // Two alignments onto the same earlier scan would repeat one aliasing (a corridor, a symmetric
+  // room) rather than confirm it: the confirmation aligns with another scan of the earlier visit.
+  if (a.from == b.from) return false;
   const auto& kf = keyframes_;
   const common::Pose2 predicted =
       common::compose(common::compose(common::between(kf[b.from].pose, kf[a.from].pose), a.measurement),
