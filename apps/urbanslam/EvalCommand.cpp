@@ -59,6 +59,8 @@ int evalCommand(const Argv& args) {
                "    on the run's nodes (trajectory_scans.tum: every scan it placed) interpolated at each relation\n"
                "    time, every relation inside the run (the others counted as skipped); relations_odometry: the\n"
                "    same on trajectory_odometry.tum (a folder without trajectory_scans.tum: that one only);\n"
+               "    relations.loops: the accepted closures checked against the relations (a relation within 3 s\n"
+               "    of both closure times, carried to them by the run's nodes): checked, contradicted (> 0.5 m / 5 deg);\n"
                "    the time offset between the run and the relations is found from the reference trajectory\n"
                "    (--reference, or reference.tum in RUN_DIR) when their time bases differ;\n"
                "  --reference: ATE/RPE against a TUM trajectory or a log with a reference (corrected CARMEN log,\n"
@@ -152,6 +154,26 @@ int evalCommand(const Argv& args) {
       b["at_scans"] = cls(by.at_scans);
       b["one_interval"] = cls(by.one_interval);
       b["other"] = cls(by.other);
+    }
+    // The run's accepted closures against the relations (independent of any corrected log).
+    if (fs::exists(dir / "loop_closures.csv")) {
+      const auto lc = slam::checkLoopsWithRelations(slam::readLoopClosuresCsv((dir / "loop_closures.csv").string()), nodes, rel, offset);
+      common::Json& l = j["relations"]["loops"];
+      l["accepted"] = lc.accepted;
+      l["checked"] = lc.checked;
+      l["contradicted"] = lc.contradicted;
+      common::Json list = common::Json::array();
+      for (const auto& f : lc.contradictions) {
+        common::Json e = common::Json::object();
+        e["from_keyframe"] = f.from_keyframe;
+        e["to_keyframe"] = f.to_keyframe;
+        e["from_time"] = f.from_time;
+        e["to_time"] = f.to_time;
+        e["error_m"] = f.error_m;
+        e["error_deg"] = f.error_deg;
+        list.push(std::move(e));
+      }
+      l["contradicted_list"] = std::move(list);
     }
     if (!reference.empty()) {
       const auto mr = slam::relationMetrics(reference, rel, offset, 5.0);  // reference poses are sparse

@@ -201,3 +201,31 @@ TEST(Evaluation, TimeOffsetWithoutSharedTimestampsFollowsTheFit) {
   EXPECT_NEAR(off, base, 0.005);
   EXPECT_LT(slam::relationMetrics(ref, rel, off).abs_trans_m.mean, 1e-3);
 }
+
+// A closure between two visits of a circle, checked against a relation a second away from it:
+// the relation carried over those seconds by the run's nodes predicts the closure's measurement.
+TEST(Evaluation, LoopsCheckedAgainstRelations) {
+  // The run's nodes: a circle of radius 5 m at 0.1 rad/s, one node every 0.5 s.
+  std::vector<io::StampedPose> nodes;
+  const auto truth = [](double t) {
+    const double a = 0.1 * t;
+    return common::Pose2{5 * std::sin(a), 5 - 5 * std::cos(a), a};
+  };
+  for (double t = 0; t <= 130; t += 0.5) nodes.push_back({t, truth(t)});
+  // The relation between t = 10 and t = 73.8 (one lap and a little later): exact.
+  const std::vector<slam::Relation> rel{{10.0, 73.8, common::between(truth(10.0), truth(73.8))}};
+  slam::LoopRow good, bad, far;
+  good.accepted = bad.accepted = far.accepted = true;
+  good.from_time = bad.from_time = 11.0;
+  good.to_time = bad.to_time = 75.0;
+  good.measurement = common::between(truth(11.0), truth(75.0));
+  bad.measurement = common::compose(good.measurement, {0.8, 0.0, 0.0});  // 0.8 m along the path
+  far.from_time = 40.0;  // no relation near these times
+  far.to_time = 100.0;
+  const auto c = slam::checkLoopsWithRelations({good, bad, far}, nodes, rel, 0.0);
+  EXPECT_EQ(c.accepted, 3u);
+  EXPECT_EQ(c.checked, 2u);
+  ASSERT_EQ(c.contradicted, 1u);
+  EXPECT_NEAR(c.contradictions[0].error_m, 0.8, 1e-2);
+  EXPECT_DOUBLE_EQ(c.contradictions[0].from_time, 11.0);
+}

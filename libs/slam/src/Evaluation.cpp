@@ -334,4 +334,44 @@ LoopMetrics classifyLoopClosures(const std::vector<LoopRow>& loops, const std::v
   return m;
 }
 
+RelationLoopCheck checkLoopsWithRelations(const std::vector<LoopRow>& loops, const std::vector<io::StampedPose>& nodes,
+                                          const std::vector<Relation>& rel, double time_offset_s, double bridge_s, double tol_m,
+                                          double tol_deg) {
+  RelationLoopCheck c;
+  const auto t = shifted(nodes, time_offset_s);
+  // Relations by their first time, each in both directions.
+  std::vector<Relation> both;
+  both.reserve(2 * rel.size());
+  for (const auto& r : rel) {
+    both.push_back(r);
+    both.push_back({r.t2, r.t1, common::inverse(r.expected)});
+  }
+  std::sort(both.begin(), both.end(), [](const Relation& a, const Relation& b) { return a.t1 < b.t1; });
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const auto& l : loops) {
+    if (!l.accepted) continue;
+    ++c.accepted;
+    const Relation* best = nullptr;
+    double best_d = inf;
+    auto it = std::lower_bound(both.begin(), both.end(), l.from_time - bridge_s, [](const Relation& r, double x) { return r.t1 < x; });
+    for (; it != both.end() && it->t1 <= l.from_time + bridge_s; ++it) {
+      const double d = std::abs(it->t1 - l.from_time) + std::abs(it->t2 - l.to_time);
+      if (std::abs(it->t2 - l.to_time) <= bridge_s && d < best_d) best = &*it, best_d = d;
+    }
+    Pose2 a, r1, r2, b;
+    if (!best || !interpolatePose(t, l.from_time, inf, a) || !interpolatePose(t, best->t1, inf, r1) ||
+        !interpolatePose(t, best->t2, inf, r2) || !interpolatePose(t, l.to_time, inf, b))
+      continue;
+    ++c.checked;
+    const Pose2 expected = common::compose(common::compose(common::between(a, r1), best->expected), common::between(r2, b));
+    const Pose2 err = common::between(expected, l.measurement);
+    const double err_m = std::hypot(err.x, err.y), err_deg = std::abs(err.phi) * kRad2Deg;
+    if (err_m > tol_m || err_deg > tol_deg) {
+      ++c.contradicted;
+      c.contradictions.push_back({l.from_keyframe, l.to_keyframe, l.from_time, l.to_time, err_m, err_deg, l.measurement, expected});
+    }
+  }
+  return c;
+}
+
 }  // namespace urbanslam::slam

@@ -107,4 +107,18 @@ struct LoopMetrics {
 LoopMetrics classifyLoopClosures(const std::vector<LoopRow>& loops, const std::vector<io::StampedPose>& reference,
                                  bool positions_only, double tol_m = 0.5, double tol_deg = 5.0);
 
+// Accepted closures checked against the relations, which are independent of any corrected log:
+// a closure (times a, b) is checkable when a relation (t1, t2), in either direction, has
+// |t1 - a| and |t2 - b| both within bridge_s; the relation is carried to the closure's times by
+// the run's own nodes over those short legs, (node(a)^-1 node(t1)) relation (node(t2)^-1 node(b)),
+// and the closure is contradicted when its measurement differs from that by more than the
+// tolerances. The nearest relation (smallest |t1 - a| + |t2 - b|) decides.
+struct RelationLoopCheck {
+  size_t accepted = 0, checked = 0, contradicted = 0;
+  std::vector<FalseClosure> contradictions;  // reference: the relation carried to the closure's times
+};
+RelationLoopCheck checkLoopsWithRelations(const std::vector<LoopRow>& loops, const std::vector<io::StampedPose>& nodes,
+                                          const std::vector<Relation>& rel, double time_offset_s, double bridge_s = 3.0,
+                                          double tol_m = 0.5, double tol_deg = 5.0);
+
 }  // namespace urbanslam::slam
