@@ -155,9 +155,11 @@ int evalCommand(const Argv& args) {
       b["one_interval"] = cls(by.one_interval);
       b["other"] = cls(by.other);
     }
-    // The run's accepted closures against the relations (independent of any corrected log).
+    // The run's accepted closures against the relations (independent of any corrected log),
+    // carried over the short legs by the odometry-time trajectory (it follows the turns between
+    // sparse scans; at the scans it is their poses).
     if (fs::exists(dir / "loop_closures.csv")) {
-      const auto lc = slam::checkLoopsWithRelations(slam::readLoopClosuresCsv((dir / "loop_closures.csv").string()), nodes, rel, offset);
+      const auto lc = slam::checkLoopsWithRelations(slam::readLoopClosuresCsv((dir / "loop_closures.csv").string()), estimate, rel, offset);
       common::Json& l = j["relations"]["loops"];
       l["accepted"] = lc.accepted;
       l["checked"] = lc.checked;
