@@ -7,11 +7,13 @@
 
 using namespace urbanslam;
 
-// The accumulated covariance must equal a Monte-Carlo estimate of the composed noisy increments.
+// The accumulated covariance must equal a Monte-Carlo estimate of the composed noisy increments,
+// the readings' errors being systematic over the increment (one draw, every reading).
 TEST(MotionIntegrator, CovarianceMatchesMonteCarlo) {
   slam::MotionOptions mo;
   mo.odometry_sigma_xy_per_m = 0.05;
   mo.odometry_sigma_phi_per_rad = 0.05;
+  mo.odometry_sigma_phi_per_m_rad = 0.01;  // small enough for the first-order propagation to hold
   slam::VehicleOptions vo;
   slam::MotionIntegrator mi(mo, vo);
   std::vector<common::Pose2> odo;
@@ -22,7 +24,7 @@ TEST(MotionIntegrator, CovarianceMatchesMonteCarlo) {
   }
   for (size_t i = 0; i < odo.size(); ++i) mi.addOdometry({static_cast<double>(i), odo[i]});
   const Eigen::Matrix3d analytic = mi.covariance();
-  // Monte Carlo with the same per-step noise.
+  // Monte Carlo: one error draw per increment, scaled to each reading's sigmas.
   std::mt19937 rng(3);
   std::normal_distribution<double> n01;
   const double sxy = mo.odometry_sigma_xy_min_m + 0.05 * 0.2;
@@ -32,7 +34,8 @@ TEST(MotionIntegrator, CovarianceMatchesMonteCarlo) {
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (int s = 0; s < kSamples; ++s) {
     common::Pose2 q;
-    for (int i = 1; i < 20; ++i) q = common::compose(q, {0.2 + sxy * n01(rng), sxy * n01(rng), 0.05 + sphi * n01(rng)});
+    const double ex = n01(rng), ey = n01(rng), ephi = n01(rng);
+    for (int i = 1; i < 20; ++i) q = common::compose(q, {0.2 + sxy * ex, sxy * ey, 0.05 + sphi * ephi});
     ends.emplace_back(q.x, q.y, q.phi);
     mean += ends.back();
   }

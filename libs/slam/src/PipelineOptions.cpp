@@ -29,6 +29,7 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
 
   s.section("local", "Local SLAM: the odometry between keyframes weighed against a scan match with the local submap");
   s.add("scan_matching", o.local.scan_matching, "match each scan with the local submap of the last keyframes, weighed against the odometry");
+  s.add("submap_keyframes", o.local.submap_keyframes, 1, 100, "keyframes", "match against a local submap of the last this many keyframes");
   s.add("match_every_scan", o.local.match_every_scan, "also match the scans between keyframes with the submap; the trajectory at odometry times follows them (the map holds keyframes only)");
   s.add("resolution_m", o.local.resolution_m, 0.01, 1.0, "m", "likelihood grid cell of the correlative search");
   s.add("hit_sigma_m", o.local.hit_sigma_m, 0.005, 1.0, "m", "spread of a return about the surface it hit (likelihood grid)");

@@ -35,6 +35,7 @@ class MotionIntegrator {
   VehicleOptions vehicle_;
   common::Pose2 increment_, odom_;
   Eigen::Matrix3d cov_ = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d odometry_sqrt_ = Eigen::Matrix3d::Zero();  // cov_ = this * this' for wheel odometry
   bool have_input_ = false, have_odom_ = false, have_drive_ = false;
   io::OdometryReading last_odom_;
   io::DriveReading last_drive_;
