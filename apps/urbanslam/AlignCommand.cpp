@@ -65,9 +65,10 @@ int alignCommand(const Argv& args) {
   ap.addPositional("LOG", "any supported log (MRPT rawlog, CARMEN log, GMapping gfs log, Victoria Park folder/zip)");
   ap.addPositional("A", "index of the reference scan");
   ap.addPositional("B", "index of the scan to align onto A");
-  ap.addOption("method", "M", "icp | plicp | crf | crf+icp (CRF-match coarse, ICP refine)", "crf+icp");
+  ap.addOption("method", "M", "prior (the guess as a prior: correlative search + point-to-line with the prior, local SLAM's matcher) | icp | plicp | crf | crf+icp (CRF-match coarse, ICP refine)", "prior");
+  ap.addOption("prior-sigma", "M,DEG", "method prior: how far off the guess may be (1 sigma: metres on x and y, degrees)", "0.5,15");
   ap.addOption("guess", "x,y,phi", "initial guess of B in A (metres, metres, radians)", "0,0,0");
-  ap.addOption("covariance", "C", "line (line variance, thesis) | hessian | sampling", "line");
+  ap.addOption("covariance", "C", "line (line variance, thesis) | hessian | sampling (methods other than prior, which gives its posterior)", "line");
   ap.addFlag("json", "print one JSON object: x, y, phi, cov, iterations, time_ms, converged, ...");
   ap.addEpilog("Exit code 0 also when the alignment fails (converged: false, with a reason); 2 for bad input.");
   if (!ap.parse(args)) return 0;
@@ -83,6 +84,22 @@ int alignCommand(const Argv& args) {
     throw common::InputError(e.what());
   }
   const common::Pose2 guess = parseGuess(ap.option("guess"));
+  {
+    std::stringstream ss(ap.option("prior-sigma"));
+    std::string a, b;
+    double m = 0, d = 0;
+    size_t pa = 0, pb = 0;
+    bool ok = std::getline(ss, a, ',') && std::getline(ss, b, ',') && ss.peek() == EOF;
+    try {
+      if (ok) m = std::stod(a, &pa), d = std::stod(b, &pb);
+    } catch (const std::exception&) {
+      ok = false;
+    }
+    if (!ok || pa != a.size() || pb != b.size() || !(m > 0) || !(d > 0) || !std::isfinite(m) || !std::isfinite(d))
+      throw common::InputError("--prior-sigma: '" + ap.option("prior-sigma") + "' is not M,DEG (two positive numbers)");
+    options.prior_sigma_m = m;
+    options.prior_sigma_deg = d;
+  }
 
   auto source = io::openDataSource(log);
   io::Measurement m;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <random>
 
 #include "SyntheticScan.h"
@@ -79,9 +80,11 @@ TEST(CorrelativeSearch, BranchAndBoundFindsTheExhaustiveOptimum) {
   window.half_angle_rad = 0.25;
   const CorrelativeResult r = correlativeSearch(grid, pts, prior, window);
   // The same score over every pose of the same lattice.
-  double max_range = grid.resolution();
-  for (const auto& p : pts) max_range = std::max(max_range, p.norm());
-  const double step = std::acos(1.0 - grid.resolution() * grid.resolution() / (2 * max_range * max_range));
+  std::vector<double> ranges;
+  for (const auto& p : pts) ranges.push_back(p.norm());
+  std::sort(ranges.begin(), ranges.end());
+  const double far = std::max(grid.resolution(), ranges[static_cast<size_t>(0.9 * static_cast<double>(ranges.size() - 1))]);
+  const double step = std::acos(1.0 - grid.resolution() * grid.resolution() / (2 * far * far));
   const int k = static_cast<int>(std::ceil(window.half_angle_rad / step)), w = static_cast<int>(std::ceil(window.half_width_m / grid.resolution()));
   double best = -1e300;
   common::Pose2 best_pose;

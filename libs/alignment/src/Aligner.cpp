@@ -50,9 +50,26 @@ AlignmentResult alignPointSets(const IndexedReference& indexed, const PointSet& 
     return out;
   }
 
+  if (options.method == Method::Prior) {
+    // The guess as a prior: the scan decides wherever it is clear (PriorScanMatcher.h).
+    const double sxy = options.prior_sigma_m, sphi = options.prior_sigma_deg * M_PI / 180.0;
+    const MatchReference reference(a, Eigen::Vector2d(guess.x, guess.y), options.prior);
+    const PriorMatchResult m =
+        matchWithPrior(reference, b, guess, Eigen::Vector3d(sxy * sxy, sxy * sxy, sphi * sphi).asDiagonal(), options.prior);
+    out.transform = m.pose;
+    out.converged = m.valid;
+    out.failure_reason = m.failure_reason;
+    if (m.valid) out.cov = m.cov;
+    out.iterations = m.iterations;
+    out.matches = m.matched;
+    out.rms_residual_m = m.rms_residual_m;
+    out.time_ms = sw.milliseconds();
+    return out;
+  }
   RegistrationResult reg;
   bool point_to_line = false;
   switch (options.method) {
+    case Method::Prior: break;  // above
     case Method::Icp: reg = icpWithIndex(a, indexed.index(), {}, b, guess, options.icp); break;
     case Method::PlIcp:
       point_to_line = true;
@@ -141,15 +158,17 @@ AlignmentResult alignPointSets(const IndexedReference& indexed, const PointSet& 
 }
 
 Method parseMethod(const std::string& name) {
+  if (name == "prior") return Method::Prior;
   if (name == "icp") return Method::Icp;
   if (name == "plicp" || name == "pl-icp") return Method::PlIcp;
   if (name == "crf") return Method::Crf;
   if (name == "crf+icp" || name == "crficp") return Method::CrfIcp;
-  throw std::invalid_argument("unknown alignment method '" + name + "' (icp, plicp, crf, crf+icp)");
+  throw std::invalid_argument("unknown alignment method '" + name + "' (prior, icp, plicp, crf, crf+icp)");
 }
 
 std::string methodName(Method method) {
   switch (method) {
+    case Method::Prior: return "prior";
     case Method::Icp: return "icp";
     case Method::PlIcp: return "plicp";
     case Method::Crf: return "crf";

@@ -18,10 +18,18 @@ class Search {
  public:
   Search(const LikelihoodGrid& grid, const std::vector<Eigen::Vector2d>& points, const MotionPrior& prior, const CorrelativeWindow& w)
       : grid_(grid), prior_(prior), r_(grid.resolution()) {
-    double max_range = r_;
-    for (const auto& p : points) max_range = std::max(max_range, p.norm());
-    // A heading step that moves the farthest point by one cell (Hess et al. 2016, eq. 7).
-    step_ = std::acos(std::max(-1.0, 1.0 - r_ * r_ / (2.0 * max_range * max_range)));
+    // A heading step that moves a far point by one cell (Hess et al. 2016, eq. 7), "far" being
+    // the 90th percentile of the ranges: the few farthest returns would make the step, and the
+    // search, many times finer for nothing (the refinement settles the heading).
+    std::vector<double> ranges;
+    for (const auto& p : points) ranges.push_back(p.norm());
+    double far = r_;
+    if (!ranges.empty()) {
+      const auto q = ranges.begin() + static_cast<long>(0.9 * static_cast<double>(ranges.size() - 1));
+      std::nth_element(ranges.begin(), q, ranges.end());
+      far = std::max(far, *q);
+    }
+    step_ = std::acos(std::max(-1.0, 1.0 - r_ * r_ / (2.0 * far * far)));
     const int k = static_cast<int>(std::ceil(w.half_angle_rad / step_));
     half_cells_ = std::max(0, static_cast<int>(std::ceil(w.half_width_m / r_)));
     const Eigen::Vector2d t(prior.mean().x, prior.mean().y);

@@ -73,10 +73,12 @@ PriorMatchResult matchWithPrior(const MatchReference& reference, const PointSet&
   const double gate2 = o.gate_m * o.gate_m;
   common::Pose2 x = coarse.pose;
   Eigen::Matrix3d H;
+  double sum_d2 = 0;
   const auto linearise = [&](const common::Pose2& at, Eigen::Vector3d& g, int& matched) {
     H.setZero();
     g.setZero();
     matched = 0;
+    sum_d2 = 0;
     const Eigen::Matrix2d R = Eigen::Rotation2Dd(at.phi).toRotationMatrix();
     const Eigen::Vector2d t(at.x, at.y);
     for (size_t i = 0; i < scan.size(); ++i) {
@@ -85,6 +87,7 @@ PriorMatchResult matchWithPrior(const MatchReference& reference, const PointSet&
       double d2 = 0;
       if (!reference.indexed().index().nearestWithin(q, gate2, &j, &d2)) continue;
       ++matched;
+      sum_d2 += d2;
       const Eigen::Vector2d dq(-rp.y(), rp.x());  // d q / d phi
       const Eigen::Vector2d e2 = q - ref[static_cast<size_t>(j)].p;
       const LineNormal& n = normals[static_cast<size_t>(j)];
@@ -127,6 +130,7 @@ PriorMatchResult matchWithPrior(const MatchReference& reference, const PointSet&
   out.pose = x;
   out.cov = 0.5 * (cov + cov.transpose());
   out.matched = matched;
+  out.rms_residual_m = matched > 0 ? std::sqrt(sum_d2 / matched) : 0.0;
   return finish();
 }
 

@@ -3,7 +3,9 @@
 // use: scan B aligned onto scan A, i.e. the pose of B seen from A (common::between(pose_A,
 // pose_B)), with its covariance, starting from a guess in the same convention.
 //
-// Methods: "icp" (point-to-point, thesis §3.3.1), "plicp" (point-to-line), "crf" (CRF-match,
+// Methods: "prior" (the guess as a prior with prior_sigma: correlative search over its window,
+// then point-to-line least squares with the prior term: PriorScanMatcher.h, local SLAM's
+// matcher), "icp" (point-to-point, thesis §3.3.1), "plicp" (point-to-line), "crf" (CRF-match,
 // §3.3.2) and "crf+icp" (CRF-match for the coarse alignment, ICP to refine, as in the thesis;
 // the refinement also runs from CRF-match's other hypotheses and from the guess, and the one
 // that matches most points wins).
@@ -18,12 +20,13 @@
 #include "urbanslam/alignment/CrfMatch.h"
 #include "urbanslam/alignment/Icp.h"
 #include "urbanslam/alignment/IndexedReference.h"
+#include "urbanslam/alignment/PriorScanMatcher.h"
 #include "urbanslam/alignment/ScanModel.h"
 #include "urbanslam/io/LaserScan.h"
 
 namespace urbanslam::alignment {
 
-enum class Method { Icp, PlIcp, Crf, CrfIcp };
+enum class Method { Prior, Icp, PlIcp, Crf, CrfIcp };
 
 struct AlignerOptions {
   Method method = Method::CrfIcp;
@@ -34,6 +37,9 @@ struct AlignerOptions {
   CovarianceOptions covariance;
   double min_constraint_ratio = 0.01; // below: the geometry leaves a direction free (degenerate)
   bool in_vehicle_frame = true;       // LaserScan input: apply sensor_pose (vehicle relative pose)
+  PriorMatcherOptions prior;          // method prior
+  double prior_sigma_m = 0.5;         // method prior: how far off the guess may be (1 sigma, x and y)
+  double prior_sigma_deg = 15.0;      // ... and its heading
 };
 
 struct AlignmentResult {
@@ -61,7 +67,7 @@ AlignmentResult alignPointSets(const PointSet& a, const PointSet& b, const commo
 AlignmentResult alignPointSets(const IndexedReference& a, const PointSet& b, const common::Pose2& guess,
                                const AlignerOptions& options);
 
-Method parseMethod(const std::string& name);  // icp | plicp | crf | crf+icp; throws invalid_argument
+Method parseMethod(const std::string& name);  // prior | icp | plicp | crf | crf+icp; throws invalid_argument
 std::string methodName(Method method);
 
 }  // namespace urbanslam::alignment

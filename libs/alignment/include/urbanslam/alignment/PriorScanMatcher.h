@@ -51,6 +51,7 @@ struct PriorMatchResult {
   double scan_log_likelihood = 0;     // at search_pose
   double prior_weight = 1;            // the prior's Gaussian share at the result (0: odometry outvoted)
   int voxels = 0, points = 0, matched = 0;  // thinned points, refinement points, associated at the end
+  double rms_residual_m = 0;          // distance of the associated points to their neighbours
   int iterations = 0, search_nodes = 0;
   double time_ms = 0;
   double matchedFraction() const { return points > 0 ? static_cast<double>(matched) / points : 0.0; }
