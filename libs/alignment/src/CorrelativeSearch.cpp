@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace urbanslam::alignment {
@@ -67,13 +68,20 @@ class Search {
  private:
   double score(int level, int a, int ox, int oy) {
     ++nodes_;
+    const float* values = grid_.levelData(level);
+    const int w = grid_.width(), h = grid_.height(), pad = grid_.pad();
+    const float floor = grid_.floorValue();
     double sum = 0;
-    for (const auto& c : cells_[static_cast<size_t>(a)]) sum += grid_.value(level, c.x() + ox, c.y() + oy);
+    for (const auto& c : cells_[static_cast<size_t>(a)]) {
+      const int i = c.x() + ox + pad, j = c.y() + oy + pad;
+      sum += (i < 0 || j < 0 || i >= w || j >= h) ? floor : values[static_cast<size_t>(j) * static_cast<size_t>(w) + static_cast<size_t>(i)];
+    }
     const int last = std::min(half_cells_, ox + (1 << level) - 1), last_y = std::min(half_cells_, oy + (1 << level) - 1);
     const double m2 = prior_.minMahalanobis2(ox * r_, last * r_, oy * r_, last_y * r_, dphi_[static_cast<size_t>(a)]);
     return sum + prior_.logDensity(m2);
   }
 
+  // Blocks best first; a block is split only while its bound beats the best pose so far.
   void branch(std::vector<Node> nodes, int level) {
     std::sort(nodes.begin(), nodes.end(), [](const Node& a, const Node& b) { return a.score > b.score; });
     for (const Node& n : nodes) {
@@ -82,13 +90,24 @@ class Search {
         best_ = n;
         continue;
       }
-      const int s = 1 << (level - 1);
-      std::vector<Node> children;
-      for (int dx : {0, s})
-        for (int dy : {0, s})
-          if (n.ox + dx <= half_cells_ && n.oy + dy <= half_cells_)
-            children.push_back({n.angle, n.ox + dx, n.oy + dy, score(level - 1, n.angle, n.ox + dx, n.oy + dy)});
-      branch(std::move(children), level - 1);
+      branchChildren(n, level);
+    }
+  }
+
+  void branchChildren(const Node& n, int level) {
+    const int s = 1 << (level - 1);
+    std::array<Node, 4> children;
+    int count = 0;
+    for (int dx : {0, s})
+      for (int dy : {0, s})
+        if (n.ox + dx <= half_cells_ && n.oy + dy <= half_cells_)
+          children[static_cast<size_t>(count++)] = {n.angle, n.ox + dx, n.oy + dy, score(level - 1, n.angle, n.ox + dx, n.oy + dy)};
+    std::sort(children.begin(), children.begin() + count, [](const Node& a, const Node& b) { return a.score > b.score; });
+    for (int k = 0; k < count; ++k) {
+      const Node& c = children[static_cast<size_t>(k)];
+      if (c.score <= best_.score) return;
+      if (level - 1 == 0) best_ = c;
+      else branchChildren(c, level - 1);
     }
   }
 

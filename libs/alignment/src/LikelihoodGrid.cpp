@@ -28,6 +28,14 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
   std::vector<float> base(static_cast<size_t>(width_) * static_cast<size_t>(height_), floor_);
   const int r = static_cast<int>(std::ceil(reach / resolution_));
   const double inv2s2 = 1.0 / (2.0 * o.hit_sigma_m * o.hit_sigma_m);
+  // The cell value as a function of the squared distance, tabulated (a stamp of (2r+1)² cells
+  // per point would otherwise cost an exp and a log each).
+  constexpr int kTable = 1024;
+  const double max_d2 = 2.0 * (r + 1) * (r + 1) * resolution_ * resolution_;
+  std::vector<float> table(kTable + 1);
+  for (int k = 0; k <= kTable; ++k)
+    table[static_cast<size_t>(k)] = static_cast<float>(std::log(std::exp(-(max_d2 * k / kTable) * inv2s2) + o.miss_floor));
+  const double to_index = kTable / max_d2;
   for (const auto& sp : reference) {
     if (std::abs(sp.p.x() - centre.x()) > o.max_radius_m || std::abs(sp.p.y() - centre.y()) > o.max_radius_m) continue;
     const Eigen::Vector2i c = cellOf(sp.p);
@@ -36,7 +44,7 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
         const int a = i + pad_, b = j + pad_;
         if (a < 0 || b < 0 || a >= width_ || b >= height_) continue;
         const Eigen::Vector2d cell_centre = origin_ + resolution_ * Eigen::Vector2d(i + 0.5, j + 0.5);
-        const float v = static_cast<float>(std::log(std::exp(-(cell_centre - sp.p).squaredNorm() * inv2s2) + o.miss_floor));
+        const float v = table[static_cast<size_t>(std::min<double>(kTable, (cell_centre - sp.p).squaredNorm() * to_index + 0.5))];
         float& dst = base[static_cast<size_t>(b) * static_cast<size_t>(width_) + static_cast<size_t>(a)];
         dst = std::max(dst, v);
       }

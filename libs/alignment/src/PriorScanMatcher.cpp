@@ -117,7 +117,7 @@ PriorMatchResult matchWithPrior(const MatchReference& reference, const PointSet&
     const Eigen::Vector3d step = -H.ldlt().solve(g);
     if (!step.allFinite()) break;
     x = {x.x + step(0), x.y + step(1), common::wrapToPi(x.phi + step(2))};
-    if (std::hypot(step(0), step(1)) < 1e-7 && std::abs(step(2)) < 1e-8) break;
+    if (std::hypot(step(0), step(1)) < 1e-5 && std::abs(step(2)) < 1e-6) break;
   }
   // 3. The posterior covariance at the estimate.
   linearise(x, g, matched);

@@ -21,8 +21,8 @@ struct LikelihoodGridOptions {
   double resolution_m = 0.05;      // cell size
   double hit_sigma_m = 0.05;       // spread of a return about the surface it hit (noise + cell size)
   double miss_floor = 0.05;        // κ: the density of an unexplained return relative to a hit's peak
-  double max_radius_m = 40.0;      // cells farther than this from the centre (along x or y) are left out
-  int levels = 6;                  // pyramid levels above the base (blocks of 2^levels cells)
+  double max_radius_m = 16.0;      // cells farther than this from the centre (along x or y) are left out
+  int levels = 5;                  // pyramid levels above the base (blocks of 2^levels cells; wider windows get more root blocks)
 };
 
 class LikelihoodGrid {
@@ -45,6 +45,12 @@ class LikelihoodGrid {
     if (a < 0 || b < 0 || a >= width_ || b >= height_) return floor_;
     return level_[static_cast<size_t>(level)][static_cast<size_t>(b) * static_cast<size_t>(width_) + static_cast<size_t>(a)];
   }
+  // Raw access for tight loops: level h's values, row-major, width() x height(), cell (i, j) at
+  // (j + pad()) * width() + i + pad().
+  const float* levelData(int level) const { return level_[static_cast<size_t>(level)].data(); }
+  int width() const { return width_; }
+  int height() const { return height_; }
+  int pad() const { return pad_; }
   // The log-likelihood of one point at p (level 0).
   float score(const Eigen::Vector2d& p) const {
     const Eigen::Vector2i c = cellOf(p);

@@ -51,8 +51,8 @@ struct LocalOptions {
   double hit_sigma_m = 0.05;           // spread of a return about the surface it hit
   double miss_floor = 0.05;            // density of an unexplained return relative to a hit's peak
   double voxel_m = 0.2;                // the correlative search scores one scan point per voxel
-  double search_window_m = 1.0;        // the search reaches at least this far from the odometry
-  double search_window_deg = 30.0;
+  double search_window_m = 0.3;        // the search reaches at least this far from the odometry
+  double search_window_deg = 5.0;
   double odometry_outlier_probability = 1e-4;  // the odometry being wrong beyond its covariance
   double point_sigma_m = 0.01;         // a return's distance to the reference surface (refinement)
   // The filter gets the match's covariance times this: consecutive matches share the submap's
