@@ -1,15 +1,15 @@
 #!/usr/bin/env bash
-# How much the relation metric depends on how many of the log's scans there are, on FR079 (the one
-# log with relations whose corrected log keeps every scan: 4791). Intel's corrected log, the only
-# Intel log here, keeps 910 of the raw log's 13631 scans (1 in 15), and Cartographer's Table II
-# figure comes from the raw log. Two measurements, each for keeping 1 scan in k:
+# How much the relation metric depends on how many of the log's scans there are, on FR079's raw
+# log (4934 scans). The Freiburg corrected logs keep fewer scans than the raw ones (Intel's: 910
+# of 13631, 1 in 15), and Cartographer's Table II figures come from the raw logs. Two
+# measurements, each for keeping 1 scan in k:
 #   same poses  urbanslam's own scan poses of the full run, every k-th kept, the gaps bridged
 #               with the odometry exactly as `run` bridges them (forward from the earlier scan,
 #               backward from the later one, blended by time) at every odometry time, scored
 #               by `urbanslam eval`: the effect of density alone;
 #   rerun       `urbanslam run` on the log with the other scans relabelled RLASER, which the ini
-#               does not use (the reader still sees them, so the corrected log's odometry
-#               re-anchoring at each scan is read as before): what the system makes of it.
+#               does not use (the odometry is untouched): what the system makes of it; ATE against
+#               run_datasets.sh's reference (the corrected log's poses at the raw log's times).
 #
 #   bench/slam/scan_density.sh [BUILD_DIR] [OUT_DIR]
 # OUT_DIR must hold run_datasets.sh's and relation_breakdown.sh's output (the full FR079 run and
@@ -17,14 +17,15 @@
 set -euo pipefail
 source "$(dirname "$0")/paths.sh" "$@"
 [[ -x $U ]] || { echo "missing $U (build first)" >&2; exit 2; }
-LOG=$D/corrected_logs/freiburg-079-corrected.log.gz
+LOG=$D/raw_logs/fr079.clf.gz
 REL=$D/relations/fr079.relations
 run=$OUT/fr079/urbanslam
 dr=$OUT/fr079/dead-reckoning/run
-for f in "$run/trajectory_scans.tum" "$dr/trajectory_odometry.tum" "$OUT/fr079/urbanslam.eval.json"; do
+REF=$OUT/fr079/reference.tum
+for f in "$run/trajectory_scans.tum" "$dr/trajectory_odometry.tum" "$OUT/fr079/urbanslam.eval.json" "$REF"; do
   [[ -f $f ]] || { echo "missing $f (run run_datasets.sh, then relation_breakdown.sh)" >&2; exit 2; }
 done
-off=$(python3 -c "import json; print(json.load(open('$OUT/fr079/urbanslam.eval.json'))['relations']['time_offset_s'])")
+off=0  # the raw log is in the relations' time base
 KS=(1 2 3 5 10 15)
 
 # A run folder holding the run's scan poses thinned to every k-th, bridged by the odometry at
@@ -87,7 +88,7 @@ PY
 }
 
 mkdir -p "$OUT/fr079/density"
-echo "FR079, keeping 1 scan in k (Intel's corrected log: 1 in 15 of the raw log's)"
+echo "FR079 raw log, keeping 1 scan in k (Intel's corrected log: 1 in 15 of the raw log's)"
 echo " k  scans  relations  same_poses_m  rerun_m  rerun_ate_m  rerun_loops"
 for k in "${KS[@]}"; do
   sp=$OUT/fr079/density/same$k
@@ -101,7 +102,7 @@ for k in "${KS[@]}"; do
     thin_log "$LOG" "$d/log.gz" "$k"
     $U run --quiet --ini ini/fr079.ini --out "$d/run" "$d/log.gz"
     j=$d/eval.json
-    $U eval "$d/run" --relations "$REL" --time-offset "$off" --reference "$LOG" --json > "$j"
+    $U eval "$d/run" --relations "$REL" --time-offset "$off" --reference "$REF" --json > "$j"
   fi
   python3 - "$k" "$n" "$sp/eval.json" "$j" <<'PY'
 import json, sys
