@@ -69,12 +69,18 @@ class Search {
   double score(int level, int a, int ox, int oy) {
     ++nodes_;
     const float* values = grid_.levelData(level);
-    const int w = grid_.width(), h = grid_.height(), pad = grid_.pad();
+    const int w = grid_.levelWidth(level), h = grid_.levelHeight(level), pad = grid_.pad();
     const float floor = grid_.floorValue();
+    const int shift = LikelihoodGrid::shiftOf(level);
     double sum = 0;
     for (const auto& c : cells_[static_cast<size_t>(a)]) {
       const int i = c.x() + ox + pad, j = c.y() + oy + pad;
-      sum += (i < 0 || j < 0 || i >= w || j >= h) ? floor : values[static_cast<size_t>(j) * static_cast<size_t>(w) + static_cast<size_t>(i)];
+      if (i < 0 || j < 0) {
+        sum += floor;
+        continue;
+      }
+      const int ia = i >> shift, ja = j >> shift;
+      sum += (ia >= w || ja >= h) ? floor : values[static_cast<size_t>(ja) * static_cast<size_t>(w) + static_cast<size_t>(ia)];
     }
     const int last = std::min(half_cells_, ox + (1 << level) - 1), last_y = std::min(half_cells_, oy + (1 << level) - 1);
     const double m2 = prior_.minMahalanobis2(ox * r_, last * r_, oy * r_, last_y * r_, dphi_[static_cast<size_t>(a)]);

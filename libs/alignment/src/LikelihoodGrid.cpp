@@ -52,18 +52,63 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
   level_.push_back(std::move(base));
   // Level h from level h-1 by doubling: the block of 2^h starting at (i, j) is four blocks of
   // 2^(h-1) starting at (i, j), (i+s, j), (i, j+s), (i+s, j+s).
-  for (int k = 1; k <= levels; ++k) {
-    const int s = 1 << (k - 1);
+  dims_.push_back({width_, height_});
+  // Levels 1 .. kFullLevels at full resolution: the exact largest value of the block of 2^h
+  // cells starting at each cell (rows first, then columns, in loops the compiler vectorises;
+  // a block reaching past the edge sees the floor there). Most of a search's blocks are scored
+  // at these levels, where an exact bound prunes most.
+  const size_t w_ = static_cast<size_t>(width_), h_ = static_cast<size_t>(height_);
+  for (int k = 1; k <= std::min(levels, kFullLevels); ++k) {
+    const size_t step = static_cast<size_t>(1) << (k - 1);
     const std::vector<float>& prev = level_.back();
-    std::vector<float> next(prev.size(), floor_);
-    const auto at = [&](int a, int b) {
-      return a < width_ && b < height_ ? prev[static_cast<size_t>(b) * static_cast<size_t>(width_) + static_cast<size_t>(a)] : floor_;
-    };
-    for (int b = 0; b < height_; ++b)
-      for (int a = 0; a < width_; ++a)
-        next[static_cast<size_t>(b) * static_cast<size_t>(width_) + static_cast<size_t>(a)] =
-            std::max(std::max(at(a, b), at(a + s, b)), std::max(at(a, b + s), at(a + s, b + s)));
+    std::vector<float> rows(prev.size(), floor_), next(prev.size(), floor_);
+    for (size_t b = 0; b < h_; ++b) {
+      const float* src = prev.data() + b * w_;
+      float* dst = rows.data() + b * w_;
+      const size_t n = w_ > step ? w_ - step : 0;
+      for (size_t a = 0; a < n; ++a) dst[a] = std::max(src[a], src[a + step]);
+      for (size_t a = n; a < w_; ++a) dst[a] = std::max(src[a], floor_);
+    }
+    for (size_t b = 0; b < h_; ++b) {
+      const float* r0 = rows.data() + b * w_;
+      float* dst = next.data() + b * w_;
+      if (b + step < h_) {
+        const float* r1 = rows.data() + (b + step) * w_;
+        for (size_t a = 0; a < w_; ++a) dst[a] = std::max(r0[a], r1[a]);
+      } else {
+        for (size_t a = 0; a < w_; ++a) dst[a] = std::max(r0[a], floor_);
+      }
+    }
     level_.push_back(std::move(next));
+    dims_.push_back({width_, height_});
+  }
+  // Higher levels at 1/2^h of the resolution (Olson's multi-resolution tables): block_max holds
+  // the largest value of each aligned block of 2^h cells (from the four blocks of the level
+  // below), and the stored value is the largest over two blocks on each axis, which covers every
+  // block of 2^h cells starting inside block I: a looser bound for a quarter of the memory.
+  std::vector<float> block_max = level_.front();
+  int bw = width_, bh = height_;
+  for (int k = 1; k <= levels; ++k) {
+    const int nw = (bw + 1) / 2, nh = (bh + 1) / 2;
+    std::vector<float> next(static_cast<size_t>(nw) * static_cast<size_t>(nh), floor_);
+    const auto at = [&](int a, int b) {
+      return a < bw && b < bh ? block_max[static_cast<size_t>(b) * static_cast<size_t>(bw) + static_cast<size_t>(a)] : floor_;
+    };
+    for (int b = 0; b < nh; ++b)
+      for (int a = 0; a < nw; ++a)
+        next[static_cast<size_t>(b) * static_cast<size_t>(nw) + static_cast<size_t>(a)] =
+            std::max(std::max(at(2 * a, 2 * b), at(2 * a + 1, 2 * b)), std::max(at(2 * a, 2 * b + 1), at(2 * a + 1, 2 * b + 1)));
+    block_max = std::move(next);
+    bw = nw;
+    bh = nh;
+    if (k <= kFullLevels) continue;
+    std::vector<float> dilated(block_max.size(), floor_);
+    for (int b = 0; b < bh; ++b)
+      for (int a = 0; a < bw; ++a)
+        dilated[static_cast<size_t>(b) * static_cast<size_t>(bw) + static_cast<size_t>(a)] =
+            std::max(std::max(at(a, b), at(a + 1, b)), std::max(at(a, b + 1), at(a + 1, b + 1)));
+    level_.push_back(std::move(dilated));
+    dims_.push_back({bw, bh});
   }
 }
 

@@ -11,6 +11,7 @@ alignment::PriorMatcherOptions priorMatcherOptions(const LocalOptions& o) {
   m.grid.resolution_m = o.resolution_m;
   m.grid.hit_sigma_m = o.hit_sigma_m;
   m.grid.miss_floor = o.miss_floor;
+  m.grid.max_radius_m = o.grid_radius_m;
   m.voxel_m = o.voxel_m;
   m.search_window_m = o.search_window_m;
   m.search_window_deg = o.search_window_deg;

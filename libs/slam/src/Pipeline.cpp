@@ -162,7 +162,8 @@ void Pipeline::onScan(io::LaserScan scan, double progress) {
     common::Stopwatch kw;
     addKeyframe(std::move(scan));
     stats_.keyframe_ms.push_back(kw.milliseconds());
-  } else if (options_.local.scan_matching && options_.local.match_every_scan && !scan.ranges.empty() && keyframes_.back().hasScan()) {
+  } else if (options_.local.scan_matching && options_.local.match_every_scan && !scan.ranges.empty() && keyframes_.back().hasScan() &&
+             (anchors_.empty() || std::abs(scan.timestamp - anchors_.back().timestamp) >= options_.local.match_min_interval_s)) {
     anchorScan(scan);
   }
   const double ms = sw.milliseconds();

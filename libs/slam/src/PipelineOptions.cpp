@@ -34,6 +34,8 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("resolution_m", o.local.resolution_m, 0.01, 1.0, "m", "likelihood grid cell of the correlative search");
   s.add("hit_sigma_m", o.local.hit_sigma_m, 0.005, 1.0, "m", "spread of a return about the surface it hit (likelihood grid)");
   s.add("miss_floor", o.local.miss_floor, 1e-6, 1.0, "", "density of a return the submap does not explain, relative to a hit's peak");
+  s.add("match_min_interval_s", o.local.match_min_interval_s, 0.0, 10.0, "s", "a scan between keyframes is matched only this long after the last matched scan (a fast scanner's trajectory needs no node per scan)");
+  s.add("grid_radius_m", o.local.grid_radius_m, 2.0, 200.0, "m", "the correlative search's likelihood grid covers the submap this far (along x and y) around its newest keyframe; returns beyond score nothing there (the refinement uses every return)");
   s.add("voxel_m", o.local.voxel_m, 0.01, 10.0, "m", "the correlative search scores one scan point per voxel of this size (the refinement uses every point)");
   s.add("search_window_m", o.local.search_window_m, 0.0, 10.0, "m", "the correlative search reaches at least this far from the odometry (and at least its 3 sigma)");
   s.add("search_window_deg", o.local.search_window_deg, 0.0, 180.0, "deg", "... and turns at least this far from it");

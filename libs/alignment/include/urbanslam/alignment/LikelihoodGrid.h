@@ -6,9 +6,11 @@
 // place seen for the first time). The score of a candidate pose is the sum over the scan's
 // points of the cells they fall in, so a pose costs one lookup per point.
 //
-// Coarser levels for branch and bound: level h holds, for the block of 2^h x 2^h cells whose
+// Coarser levels for branch and bound: level h bounds, for the block of 2^h x 2^h cells whose
 // lowest corner is a cell, the largest value in the block; a sum over level h bounds the score
-// of every pose whose translation lies in that block (Cartographer's precomputation grids).
+// of every pose whose translation lies in that block (Cartographer's precomputation grids, kept
+// at 1/2^h of the resolution, each value the largest over two aligned blocks per axis, as in
+// Olson's multi-resolution tables: a quarter of the memory per level instead of a full copy).
 #include <vector>
 
 #include <Eigen/Core>
@@ -21,7 +23,7 @@ struct LikelihoodGridOptions {
   double resolution_m = 0.05;      // cell size
   double hit_sigma_m = 0.05;       // spread of a return about the surface it hit (noise + cell size)
   double miss_floor = 0.05;        // κ: the density of an unexplained return relative to a hit's peak
-  double max_radius_m = 16.0;      // cells farther than this from the centre (along x or y) are left out
+  double max_radius_m = 40.0;      // cells farther than this from the centre (along x or y) are left out
   int levels = 5;                  // pyramid levels above the base (blocks of 2^levels cells; wider windows get more root blocks)
 };
 
@@ -38,18 +40,25 @@ class LikelihoodGrid {
     return {static_cast<int>(std::floor((p.x() - origin_.x()) / resolution_)),
             static_cast<int>(std::floor((p.y() - origin_.y()) / resolution_))};
   }
-  // Level 0: the cell's value; level h: the largest value in the block of 2^h cells whose lowest
-  // corner is (i, j). The floor outside the grid.
+  // Levels up to kFullLevels are stored at full resolution (exact block maxima); higher ones at
+  // 1/2^h of it (a looser bound).
+  static constexpr int kFullLevels = 2;
+  static int shiftOf(int level) { return level <= kFullLevels ? 0 : level; }
+  // Level 0: the cell's value; level h: a bound on the largest value in the block of 2^h x 2^h
+  // cells whose lowest corner is (i, j). The floor outside the grid.
   float value(int level, int i, int j) const {
-    const int a = i + pad_, b = j + pad_;
-    if (a < 0 || b < 0 || a >= width_ || b >= height_) return floor_;
-    return level_[static_cast<size_t>(level)][static_cast<size_t>(b) * static_cast<size_t>(width_) + static_cast<size_t>(a)];
+    const int sh = shiftOf(level);
+    const Dims& d = dims_[static_cast<size_t>(level)];
+    if (i + pad_ < 0 || j + pad_ < 0) return floor_;
+    const int a = (i + pad_) >> sh, b = (j + pad_) >> sh;
+    if (a >= d.width || b >= d.height) return floor_;
+    return level_[static_cast<size_t>(level)][static_cast<size_t>(b) * static_cast<size_t>(d.width) + static_cast<size_t>(a)];
   }
-  // Raw access for tight loops: level h's values, row-major, width() x height(), cell (i, j) at
-  // (j + pad()) * width() + i + pad().
+  // Raw access for tight loops: level h's values, row-major, levelWidth(h) x levelHeight(h);
+  // the cell (i, j) of value() at ((j + pad()) >> shiftOf(h)) * levelWidth(h) + ((i + pad()) >> shiftOf(h)).
   const float* levelData(int level) const { return level_[static_cast<size_t>(level)].data(); }
-  int width() const { return width_; }
-  int height() const { return height_; }
+  int levelWidth(int level) const { return dims_[static_cast<size_t>(level)].width; }
+  int levelHeight(int level) const { return dims_[static_cast<size_t>(level)].height; }
   int pad() const { return pad_; }
   // The log-likelihood of one point at p (level 0).
   float score(const Eigen::Vector2d& p) const {
@@ -63,6 +72,10 @@ class LikelihoodGrid {
   int pad_ = 0;              // cells before cell 0 on each axis (blocks that start outside)
   int width_ = 0, height_ = 0;
   float floor_ = 0;
+  struct Dims {
+    int width, height;
+  };
+  std::vector<Dims> dims_;
   std::vector<std::vector<float>> level_;
 };
 

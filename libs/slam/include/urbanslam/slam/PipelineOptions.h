@@ -45,12 +45,14 @@ struct LocalOptions {
   // The scans between keyframes are matched with the submap too, and the trajectory at odometry
   // times follows them (the filter and the map still hold keyframes only).
   bool match_every_scan = true;
+  double match_min_interval_s = 0.0;   // ... but no scan sooner than this after the last matched one
   // The matcher (alignment/PriorScanMatcher.h): odometry prior and scan evidence weighed by
   // their uncertainties.
   double resolution_m = 0.05;          // likelihood grid cell
   double hit_sigma_m = 0.05;           // spread of a return about the surface it hit
   double miss_floor = 0.05;            // density of an unexplained return relative to a hit's peak
   double voxel_m = 0.2;                // the correlative search scores one scan point per voxel
+  double grid_radius_m = 40.0;         // the likelihood grid covers the submap this far around its last keyframe
   double search_window_m = 0.3;        // the search reaches at least this far from the odometry
   double search_window_deg = 5.0;
   double odometry_outlier_probability = 1e-4;  // the odometry being wrong beyond its covariance
