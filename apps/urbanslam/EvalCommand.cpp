@@ -41,6 +41,18 @@ std::vector<io::StampedPose> loadReference(const std::string& path, bool& positi
   throw common::InputError(path + ": carries no reference trajectory (no reference poses, no GPS)");
 }
 
+// One closure that disagrees with a reference (the corrected log's poses or the relations).
+common::Json closureJson(const slam::FalseClosure& f) {
+  common::Json e = common::Json::object();
+  e["from_keyframe"] = f.from_keyframe;
+  e["to_keyframe"] = f.to_keyframe;
+  e["from_time"] = f.from_time;
+  e["to_time"] = f.to_time;
+  e["error_m"] = f.error_m;
+  e["error_deg"] = f.error_deg;
+  return e;
+}
+
 common::Json poseJson(const common::Pose2& p) {
   common::Json j = common::Json::object();
   j["x"] = p.x;
@@ -165,16 +177,7 @@ int evalCommand(const Argv& args) {
       l["checked"] = lc.checked;
       l["contradicted"] = lc.contradicted;
       common::Json list = common::Json::array();
-      for (const auto& f : lc.contradictions) {
-        common::Json e = common::Json::object();
-        e["from_keyframe"] = f.from_keyframe;
-        e["to_keyframe"] = f.to_keyframe;
-        e["from_time"] = f.from_time;
-        e["to_time"] = f.to_time;
-        e["error_m"] = f.error_m;
-        e["error_deg"] = f.error_deg;
-        list.push(std::move(e));
-      }
+      for (const auto& f : lc.contradictions) list.push(closureJson(f));
       l["contradicted_list"] = std::move(list);
     }
     if (!reference.empty()) {
@@ -209,13 +212,7 @@ int evalCommand(const Argv& args) {
       size_t favour_run = 0, favour_reference = 0;
       common::Json list = common::Json::array();
       for (const auto& f : lm.false_closures) {
-        common::Json e = common::Json::object();
-        e["from_keyframe"] = f.from_keyframe;
-        e["to_keyframe"] = f.to_keyframe;
-        e["from_time"] = f.from_time;
-        e["to_time"] = f.to_time;
-        e["error_m"] = f.error_m;
-        e["error_deg"] = f.error_deg;
+        common::Json e = closureJson(f);
         const auto in_map = [&](long k) { return k >= 0 && static_cast<size_t>(k) < keyframes.size(); };
         if (weigh && in_map(f.from_keyframe) && in_map(f.to_keyframe)) {
           const auto ev = slam::weighClosure(keyframes[static_cast<size_t>(f.from_keyframe)].scan,
