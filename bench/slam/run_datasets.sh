@@ -136,13 +136,8 @@ peer_log() {  # in.log.gz out.log.gz
 import gzip, math, sys
 src, dst = sys.argv[1:3]
 corrected = any(l.startswith('NEFF') for l in gzip.open(src, 'rt'))
-wrap = lambda a: math.atan2(math.sin(a), math.cos(a))
-def compose(a, b):
-    c, s = math.cos(a[2]), math.sin(a[2])
-    return (a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], wrap(a[2] + b[2]))
-def between(a, b):
-    c, s = math.cos(a[2]), math.sin(a[2]); dx, dy = b[0] - a[0], b[1] - a[1]
-    return (c * dx + s * dy, -s * dx + c * dy, wrap(b[2] - a[2]))
+sys.path.insert(0, 'bench/slam')
+from pose2 import wrap, compose, between
 same = lambda a, b: abs(a[0] - b[0]) < 1e-9 and abs(a[1] - b[1]) < 1e-9 and abs(wrap(a[2] - b[2])) < 1e-9
 raw = last = scan_pose = None
 prev = None
@@ -204,13 +199,8 @@ rbpf_tum() {  # peer_dir console_output
 import math, os, re, sys
 p, out = sys.argv[1:3]
 log = os.path.join(p, 'log')
-wrap = lambda a: math.atan2(math.sin(a), math.cos(a))
-def compose(a, b):
-    c, s = math.cos(a[2]), math.sin(a[2])
-    return (a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], wrap(a[2] + b[2]))
-def between(a, b):
-    c, s = math.cos(a[2]), math.sin(a[2]); dx, dy = b[0] - a[0], b[1] - a[1]
-    return (c * dx + s * dy, -s * dx + c * dy, wrap(b[2] - a[2]))
+sys.path.insert(0, 'bench/slam')
+from pose2 import wrap, compose, between
 def rows(name):
     for l in open(os.path.join(log, name)):
         v = l.split()
@@ -305,6 +295,21 @@ peer() {
 
 (IFS=$'\t'; echo "${COLS[*]}") > "$TSV"
 printf "%-14s %-15s %6s %8s %7s %9s %8s %8s %8s %6s %6s %8s %7s  %s\n" dataset system rel_n rel_m ±sd sq_m2 ±sd rot_deg ate_m loops false wall_s rtf status
+# A peer on the dataset's peer rawlog with its ini (FOLDER/NAME.ini), its trajectory made into
+# FOLDER/trajectory_odometry.tum by TUM_FN FOLDER TUM_ARG, scored, and its row printed. Uses the
+# loop's $o, $name, $dur and $can_eval.
+run_peer() {  # name folder tum_fn tum_arg
+  local sys=$1 p=$2 tum_fn=$3 tum_arg=$4 st ev=-
+  peer "$sys" "$p/$sys.ini" "$o/peer.rawlog" </dev/null > "$o/$sys.out" 2>&1
+  st=$(status_of $RC "$o/$sys.out")
+  if [[ $RC == 0 ]]; then
+    "$tum_fn" "$p" "$tum_arg"
+    if evaluate "$p" "$o/$sys.eval.json"; then ev=$o/$sys.eval.json
+    elif [[ $can_eval == 1 ]]; then st=no-eval; fi
+  fi
+  row "$name" "$sys" "$st" "$WALL" "$dur" "$ev" relations -
+}
+
 for d in "${datasets[@]}"; do
   read -r name log ini rel refspec <<<"$d"
   [[ -z ${DATASETS:-} ]] || want "$name" "$DATASETS" || continue
@@ -365,14 +370,7 @@ print(max(t) - min(t))")
     sed -e 's/^SHOW_PROGRESS_3D_REAL_TIME=1/SHOW_PROGRESS_3D_REAL_TIME=0/' -e 's/^SAVE_3D_SCENE=1/SAVE_3D_SCENE=0/' \
         -e 's/^LOG_FREQUENCY=50/LOG_FREQUENCY=1000000/' -e "s#^logOutput_dir=.*#logOutput_dir=$p/log#" \
         /usr/share/mrpt/config_files/icp-slam/icp-slam_demo_classic.ini > "$p/icp-slam.ini"
-    peer icp-slam "$p/icp-slam.ini" "$o/peer.rawlog" </dev/null > "$o/icp-slam.out" 2>&1
-    st=$(status_of $RC "$o/icp-slam.out"); ev=-
-    if [[ $RC == 0 ]]; then
-      icp_tum "$p" "$o/peer.timestamps.txt"
-      if evaluate "$p" "$o/icp-slam.eval.json"; then ev=$o/icp-slam.eval.json
-      elif [[ $can_eval == 1 ]]; then st=no-eval; fi
-    fi
-    row "$name" icp-slam "$st" "$WALL" "$dur" "$ev" relations -
+    run_peer icp-slam "$p" icp_tum "$o/peer.timestamps.txt"
   fi
   # rbpf-slam: the first frame has no odometry action (the first reading has no increment), and
   # rbpf-slam needs one with every frame: rawlog_offset=3 skips that pair (MRPT counts objects).
@@ -383,13 +381,6 @@ print(max(t) - min(t))")
         -e "s#^logOutput_dir=.*#logOutput_dir=$p/log#" -e 's/^rawlog_offset=.*/rawlog_offset=3\nRANDOM_SEED=1/' \
         -e 's/^verbosity_level *= *DEBUG/verbosity_level = INFO/' -e "s/^sampleSize=[0-9]*/sampleSize=$RBPF_PARTICLES/" \
         "/usr/share/mrpt/config_files/rbpf-slam/$RBPF_INI" > "$p/rbpf-slam.ini"
-    peer rbpf-slam "$p/rbpf-slam.ini" "$o/peer.rawlog" </dev/null > "$o/rbpf-slam.out" 2>&1
-    st=$(status_of $RC "$o/rbpf-slam.out"); ev=-
-    if [[ $RC == 0 ]]; then
-      rbpf_tum "$p" "$o/rbpf-slam.out"
-      if evaluate "$p" "$o/rbpf-slam.eval.json"; then ev=$o/rbpf-slam.eval.json
-      elif [[ $can_eval == 1 ]]; then st=no-eval; fi
-    fi
-    row "$name" rbpf-slam "$st" "$WALL" "$dur" "$ev" relations -
+    run_peer rbpf-slam "$p" rbpf_tum "$o/rbpf-slam.out"
   fi
 done
