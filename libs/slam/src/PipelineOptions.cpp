@@ -37,7 +37,7 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("match_min_interval_s", o.local.match_min_interval_s, 0.0, 10.0, "s", "a scan between keyframes is matched only this long after the last matched scan (a fast scanner's trajectory needs no node per scan)");
   s.add("grid_radius_m", o.local.grid_radius_m, 2.0, 200.0, "m", "the correlative search's likelihood grid covers the submap this far (along x and y) around its newest keyframe; returns beyond score nothing there (the refinement uses every return)");
   s.add("voxel_m", o.local.voxel_m, 0.01, 10.0, "m", "the correlative search scores one scan point per voxel of this size (the refinement uses every point)");
-  s.add("search_window_m", o.local.search_window_m, 0.0, 10.0, "m", "the correlative search reaches at least this far from the odometry (and at least its 3 sigma)");
+  s.add("search_window_m", o.local.search_window_m, 0.0, 10.0, "m", "the correlative search reaches at least this far from the odometry (and at least its 3 sigma and twice its travel: odometry can be wrong in direction)");
   s.add("search_window_deg", o.local.search_window_deg, 0.0, 180.0, "deg", "... and turns at least this far from it");
   s.add("odometry_outlier_probability", o.local.odometry_outlier_probability, 0.0, 0.5, "", "probability that the odometry is wrong beyond its covariance (a missed turn, reversing, slip): what a scan match far from it pays");
   s.add("point_sigma_m", o.local.point_sigma_m, 0.001, 1.0, "m", "a return's distance to the submap's surface in the least-squares refinement");
