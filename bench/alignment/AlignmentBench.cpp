@@ -1,4 +1,4 @@
-// Scan-alignment evaluation on real scans (issue 4).
+// Scan-alignment evaluation on real scans.
 //
 // Pairs with a known relative pose:
 //  * Freiburg corrected logs: the FLASER poses (GMapping output) are the reference trajectory.

@@ -1,5 +1,5 @@
 #!/bin/sh
-# Scan-alignment evaluation (issue 4): success rate / CPU time of ICP, PL-ICP, CRF-match, CRF+ICP
+# Scan-alignment evaluation: success rate / CPU time of ICP, PL-ICP, CRF-match, CRF+ICP
 # and MRPT's CICP on real scan pairs, and the NEES of the covariance methods.
 # Usage: bench/alignment/run_alignment_bench.sh [BUILD_DIR] [extra alignment_bench args]
 set -e

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Reproduces the laser loop-closure evaluation of issue 5 (closing note): models trained on one
+# Reproduces the laser loop-closure evaluation: models trained on one
 # set of logs and tested on different ones (indoor → outdoor and back, default model → held-out
 # logs, Victoria Park via GPS labels), detection at 0 / 0.1 / 1 % false alarm next to the
 # published 66 % (0 % FA) and 85 % (1 % FA), the rotation split, the nearest-neighbour baseline,

@@ -1,4 +1,4 @@
-// Speed of the Tree of Words pieces (issue 6): descriptor → word (≤ k·L comparisons) on a full
+// Speed of the Tree of Words pieces: descriptor → word (≤ k·L comparisons) on a full
 // k = 10, L = 6 tree (10^6 words), query time against 10^3 … 10^6 images (synthetic bags: 300
 // words per image drawn uniformly from 10^6 words), loading a 10^6-word vocabulary, and the
 // whole per-frame time on 640×480 images (extraction, quantisation, query, verification).

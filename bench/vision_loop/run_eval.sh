@@ -1,5 +1,5 @@
 #!/bin/sh
-# Reproduces the Tree of Words figures (issue 6): vocabulary reproducibility, precision-recall on
+# Reproduces the Tree of Words figures: vocabulary reproducibility, precision-recall on
 # the RTAB-Map loop sequence with the shipped vocabularies (trained on other images), and the
 # speed benches. Usage: bench/vision_loop/run_eval.sh [BUILD_DIR] (default: build).
 # Outputs: out/vision_loop/ (JSON per run, PR curves as CSV and PNG, bench.json).

@@ -1,5 +1,5 @@
 #pragma once
-// The laser loop-closure detector the SLAM pipeline uses (issue item 7). Features are computed
+// The laser loop-closure detector the SLAM pipeline uses. Features are computed
 // once per keyframe and stored; a query compares the current scan's features with a candidate
 // set of stored keyframes (or with all of them) using the trained strong classifier.
 //

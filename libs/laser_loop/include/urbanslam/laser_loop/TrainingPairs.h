@@ -1,5 +1,5 @@
 #pragma once
-// Labelled scan pairs from real logs (issue item 3). Every scan of a log gets its features and a
+// Labelled scan pairs from real logs. Every scan of a log gets its features and a
 // reference position; two scans of the same log form a positive pair when they were taken within
 // d_pos of each other (any heading) and a negative pair when farther apart than d_neg; pairs in
 // between are ambiguous and never used.
