@@ -21,10 +21,37 @@ AlignmentResult align(const io::LaserScan& a, const io::LaserScan& b, const Pose
   return r;
 }
 
+namespace {
+
+// Method prior: the guess as a prior with options.prior_sigma_*; the scan decides wherever it is
+// clear (PriorScanMatcher.h).
+AlignmentResult alignWithPrior(const MatchReference& reference, const PointSet& b, const Pose2& guess, const AlignerOptions& options) {
+  AlignmentResult out;
+  const double sxy = options.prior_sigma_m, sphi = options.prior_sigma_deg * M_PI / 180.0;
+  const PriorMatchResult m =
+      matchWithPrior(reference, b, guess, Eigen::Vector3d(sxy * sxy, sxy * sxy, sphi * sphi).asDiagonal(), options.prior);
+  out.transform = m.pose;
+  out.converged = m.valid;
+  out.failure_reason = m.failure_reason;
+  const double max_m = options.covariance.max_std_m, max_rad = options.covariance.max_std_rad;
+  out.cov = m.valid ? m.cov : Eigen::Matrix3d(Eigen::Vector3d(max_m * max_m, max_m * max_m, max_rad * max_rad).asDiagonal());
+  out.iterations = m.iterations;
+  out.matches = m.matched;
+  out.rms_residual_m = m.rms_residual_m;
+  out.points_a = static_cast<int>(reference.indexed().points().size());
+  out.points_b = static_cast<int>(b.size());
+  return out;
+}
+
+}  // namespace
+
 AlignmentResult alignPointSets(const PointSet& a, const PointSet& b, const Pose2& guess,
                                const AlignerOptions& options) {
   common::Stopwatch sw;
-  AlignmentResult r = alignPointSets(IndexedReference(a), b, guess, options);
+  // (The prior method builds its kd-tree with its grid: no IndexedReference first.)
+  AlignmentResult r = options.method == Method::Prior && std::isfinite(guess.x) && std::isfinite(guess.y) && std::isfinite(guess.phi)
+                          ? alignWithPrior(MatchReference(a, Eigen::Vector2d(guess.x, guess.y), options.prior), b, guess, options)
+                          : alignPointSets(IndexedReference(a), b, guess, options);
   r.time_ms = sw.milliseconds();
   return r;
 }
@@ -51,18 +78,10 @@ AlignmentResult alignPointSets(const IndexedReference& indexed, const PointSet& 
   }
 
   if (options.method == Method::Prior) {
-    // The guess as a prior: the scan decides wherever it is clear (PriorScanMatcher.h).
-    const double sxy = options.prior_sigma_m, sphi = options.prior_sigma_deg * M_PI / 180.0;
+    // The prior method keeps its own kd-tree next to its likelihood grid (MatchReference): callers
+    // with a prepared reference match many scans against one MatchReference instead.
     const MatchReference reference(a, Eigen::Vector2d(guess.x, guess.y), options.prior);
-    const PriorMatchResult m =
-        matchWithPrior(reference, b, guess, Eigen::Vector3d(sxy * sxy, sxy * sxy, sphi * sphi).asDiagonal(), options.prior);
-    out.transform = m.pose;
-    out.converged = m.valid;
-    out.failure_reason = m.failure_reason;
-    if (m.valid) out.cov = m.cov;
-    out.iterations = m.iterations;
-    out.matches = m.matched;
-    out.rms_residual_m = m.rms_residual_m;
+    out = alignWithPrior(reference, b, guess, options);
     out.time_ms = sw.milliseconds();
     return out;
   }

@@ -60,7 +60,7 @@ class Search {
     CorrelativeResult out;
     out.pose = {prior_.mean().x + best_.ox * r_, prior_.mean().y + best_.oy * r_, common::wrapToPi(prior_.mean().phi + dphi_[static_cast<size_t>(best_.angle)])};
     out.score = best_.score;
-    out.scan_score = best_.score - prior_.logDensity(prior_.difference(out.pose).dot(prior_.information() * prior_.difference(out.pose)));
+    out.scan_score = best_.score - prior_.logDensity(out.pose);
     out.nodes = nodes_;
     return out;
   }
@@ -108,7 +108,9 @@ class Search {
       for (int dy : {0, s})
         if (n.ox + dx <= half_cells_ && n.oy + dy <= half_cells_)
           children[static_cast<size_t>(count++)] = {n.angle, n.ox + dx, n.oy + dy, score(level - 1, n.angle, n.ox + dx, n.oy + dy)};
-    std::sort(children.begin(), children.begin() + count, [](const Node& a, const Node& b) { return a.score > b.score; });
+    for (int k = 1; k < count; ++k)  // best first (insertion sort of at most four)
+      for (int m = k; m > 0 && children[static_cast<size_t>(m)].score > children[static_cast<size_t>(m - 1)].score; --m)
+        std::swap(children[static_cast<size_t>(m)], children[static_cast<size_t>(m - 1)]);
     for (int k = 0; k < count; ++k) {
       const Node& c = children[static_cast<size_t>(k)];
       if (c.score <= best_.score) return;

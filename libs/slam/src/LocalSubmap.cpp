@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "urbanslam/alignment/Aligner.h"
+#include "urbanslam/alignment/ScanModel.h"
 
 namespace urbanslam::slam {
 
@@ -23,9 +23,13 @@ alignment::PriorMatcherOptions priorMatcherOptions(const LocalOptions& o) {
 LocalSubmap::LocalSubmap(const LocalOptions& options)
     : matcher_(priorMatcherOptions(options)), capacity_(static_cast<size_t>(std::max(1, options.submap_keyframes))) {}
 
+alignment::PointSet LocalSubmap::points(const io::LaserScan& scan) const {
+  // The alignment module's scan model, in the vehicle frame (the scan's sensor pose applied).
+  return alignment::pointSetFromScan(scan, scan_model_, true);
+}
+
 void LocalSubmap::addKeyframe(const io::LaserScan& scan) {
-  const alignment::AlignerOptions ao;
-  sets_.push_back(alignment::pointSetFromScan(scan, ao.scan, ao.in_vehicle_frame));
+  sets_.push_back(points(scan));
   while (sets_.size() > capacity_) sets_.pop_front();
   ++generation_;
 }
@@ -62,8 +66,7 @@ alignment::PriorMatchResult LocalSubmap::match(const io::LaserScan& scan, const 
     none.failure_reason = "empty submap";
     return none;
   }
-  const alignment::AlignerOptions ao;
-  return alignment::matchWithPrior(*ref, alignment::pointSetFromScan(scan, ao.scan, ao.in_vehicle_frame), prior, prior_cov, matcher_);
+  return alignment::matchWithPrior(*ref, points(scan), prior, prior_cov, matcher_);
 }
 
 }  // namespace urbanslam::slam

@@ -11,6 +11,7 @@
 
 #include "urbanslam/alignment/PointSet.h"
 #include "urbanslam/alignment/PriorScanMatcher.h"
+#include "urbanslam/alignment/ScanModel.h"
 #include "urbanslam/io/LaserScan.h"
 #include "urbanslam/slam/PipelineOptions.h"
 
@@ -33,8 +34,10 @@ class LocalSubmap {
 
  private:
   const alignment::MatchReference* reference(const std::vector<common::Pose2>& poses) const;
+  alignment::PointSet points(const io::LaserScan& scan) const;
 
   alignment::PriorMatcherOptions matcher_;
+  alignment::ScanModelOptions scan_model_;
   size_t capacity_;
   std::deque<alignment::PointSet> sets_;   // each keyframe's points in its own frame
   size_t generation_ = 0;                  // keyframes added so far
