@@ -52,12 +52,6 @@ TEST(MotionPrior, MixtureDensityAndWeight) {
   EXPECT_NEAR(prior.logDensity(1e6), std::log(0.01 / 2.0), 1e-9);
 }
 
-std::vector<Eigen::Vector2d> positions(const PointSet& set) {
-  std::vector<Eigen::Vector2d> out;
-  for (const auto& p : set) out.push_back(p.p);
-  return out;
-}
-
 PointSet scanPoints(const test::World& world, const common::Pose2& pose, unsigned seed = 7) {
   test::ScanSpec spec;
   spec.seed = seed;
@@ -83,7 +77,7 @@ TEST(CorrelativeSearch, BranchAndBoundFindsTheExhaustiveOptimum) {
   std::vector<double> ranges;
   for (const auto& p : pts) ranges.push_back(p.norm());
   std::sort(ranges.begin(), ranges.end());
-  const double far = std::max(grid.resolution(), ranges[static_cast<size_t>(0.9 * static_cast<double>(ranges.size() - 1))]);
+  const double far = std::max(grid.resolution(), ranges[static_cast<size_t>(0.5 * static_cast<double>(ranges.size() - 1))]);
   const double step = std::acos(1.0 - grid.resolution() * grid.resolution() / (2 * far * far));
   const int k = static_cast<int>(std::ceil(window.half_angle_rad / step)), w = static_cast<int>(std::ceil(window.half_width_m / grid.resolution()));
   double best = -1e300;

@@ -25,7 +25,7 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
   const int h = any ? static_cast<int>(std::ceil((hi.y() - lo.y()) / resolution_)) + 1 : 1;
   width_ = w + pad_;
   height_ = h + pad_;
-  std::vector<float> base(static_cast<size_t>(width_) * static_cast<size_t>(height_), floor_);
+  Cells base(static_cast<size_t>(width_) * static_cast<size_t>(height_), floor_);
   const int r = static_cast<int>(std::ceil(reach / resolution_));
   const double inv2s2 = 1.0 / (2.0 * o.hit_sigma_m * o.hit_sigma_m);
   // The cell value as a function of the squared distance, tabulated (a stamp of (2r+1)² cells
@@ -60,8 +60,8 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
   const size_t w_ = static_cast<size_t>(width_), h_ = static_cast<size_t>(height_);
   for (int k = 1; k <= std::min(levels, kFullLevels); ++k) {
     const size_t step = static_cast<size_t>(1) << (k - 1);
-    const std::vector<float>& prev = level_.back();
-    std::vector<float> rows(prev.size(), floor_), next(prev.size(), floor_);
+    const Cells& prev = level_.back();
+    Cells rows(prev.size()), next(prev.size());  // every cell written below
     for (size_t b = 0; b < h_; ++b) {
       const float* src = prev.data() + b * w_;
       float* dst = rows.data() + b * w_;
@@ -86,23 +86,25 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
   // the largest value of each aligned block of 2^h cells (from the four blocks of the level
   // below), and the stored value is the largest over two blocks on each axis, which covers every
   // block of 2^h cells starting inside block I: a looser bound for a quarter of the memory.
-  std::vector<float> block_max = level_.front();
+  Cells block_max;
+  const Cells* src = &level_.front();  // the block maxima of the level below (the base at first)
   int bw = width_, bh = height_;
   for (int k = 1; k <= levels; ++k) {
     const int nw = (bw + 1) / 2, nh = (bh + 1) / 2;
-    std::vector<float> next(static_cast<size_t>(nw) * static_cast<size_t>(nh), floor_);
+    Cells next(static_cast<size_t>(nw) * static_cast<size_t>(nh));  // every cell written below
     const auto at = [&](int a, int b) {
-      return a < bw && b < bh ? block_max[static_cast<size_t>(b) * static_cast<size_t>(bw) + static_cast<size_t>(a)] : floor_;
+      return a < bw && b < bh ? (*src)[static_cast<size_t>(b) * static_cast<size_t>(bw) + static_cast<size_t>(a)] : floor_;
     };
     for (int b = 0; b < nh; ++b)
       for (int a = 0; a < nw; ++a)
         next[static_cast<size_t>(b) * static_cast<size_t>(nw) + static_cast<size_t>(a)] =
             std::max(std::max(at(2 * a, 2 * b), at(2 * a + 1, 2 * b)), std::max(at(2 * a, 2 * b + 1), at(2 * a + 1, 2 * b + 1)));
     block_max = std::move(next);
+    src = &block_max;
     bw = nw;
     bh = nh;
     if (k <= kFullLevels) continue;
-    std::vector<float> dilated(block_max.size(), floor_);
+    Cells dilated(block_max.size());  // every cell written below
     for (int b = 0; b < bh; ++b)
       for (int a = 0; a < bw; ++a)
         dilated[static_cast<size_t>(b) * static_cast<size_t>(bw) + static_cast<size_t>(a)] =

@@ -11,6 +11,8 @@
 // of every pose whose translation lies in that block (Cartographer's precomputation grids, kept
 // at 1/2^h of the resolution, each value the largest over two aligned blocks per axis, as in
 // Olson's multi-resolution tables: a quarter of the memory per level instead of a full copy).
+#include <memory>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -76,7 +78,24 @@ class LikelihoodGrid {
     int width, height;
   };
   std::vector<Dims> dims_;
-  std::vector<std::vector<float>> level_;
+  // Storage whose size constructor leaves the cells unset: every level is written in full by a
+  // pass over the one below, and zeroing megabytes first would double the memory traffic.
+  template <typename T>
+  struct NoFill : std::allocator<T> {
+    template <typename U>
+    struct rebind {
+      using other = NoFill<U>;
+    };
+    NoFill() = default;
+    template <typename U>
+    NoFill(const NoFill<U>&) {}
+    template <typename U>
+    void construct(U* p) { ::new (static_cast<void*>(p)) U; }
+    template <typename U, typename... A>
+    void construct(U* p, A&&... a) { ::new (static_cast<void*>(p)) U(std::forward<A>(a)...); }
+  };
+  using Cells = std::vector<float, NoFill<float>>;
+  std::vector<Cells> level_;
 };
 
 }  // namespace urbanslam::alignment
