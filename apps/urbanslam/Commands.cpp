@@ -9,6 +9,7 @@ const std::vector<Command>& commands() {
       {"eval", "accuracy of a run: relations, ATE/RPE, true/false loop closures", evalCommand},
       {"graph", "feed a g2o/TORO pose graph to the ESDF incrementally; chi2 and timings", graphCommand},
       {"align", "align two laser scans of a log (ICP, PL-ICP, CRF-match, CRF+ICP) with covariance", alignCommand},
+      {"simulate", "drive a car through a generated city: laser, odometry, GPS and ground truth", simulateCommand},
       {"check-ini", "validate an ini file and print the resolved configuration", checkIniCommand},
       {"train-laser-loop", "train the laser loop-closure classifier (AdaBoost) from logs with a reference", trainLaserLoopCommand},
       {"eval-laser-loop", "ROC of a laser loop-closure model on held-out logs", evalLaserLoopCommand},

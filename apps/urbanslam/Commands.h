@@ -25,6 +25,7 @@ int trainLaserLoopCommand(const Argv& args);
 int evalLaserLoopCommand(const Argv& args);
 int buildVocabularyCommand(const Argv& args);
 int evalImageLoopCommand(const Argv& args);
+int simulateCommand(const Argv& args);
 
 // Every registered subcommand, in the order `urbanslam --help` lists them.
 const std::vector<Command>& commands();

@@ -5,7 +5,10 @@
 #include "ArgParser.h"
 #include "Commands.h"
 #include "DefaultPaths.h"
+#include "urbanslam/common/Error.h"
 #include "urbanslam/common/Progress.h"
+#include "urbanslam/sim/SimOptions.h"
+#include "urbanslam/sim/SimulatedSource.h"
 #include "urbanslam/slam/Pipeline.h"
 #include "urbanslam/slam/RunOutputs.h"
 
@@ -28,11 +31,13 @@ class ProgressObserver : public slam::PipelineObserver {
 }  // namespace
 
 int runCommand(const Argv& args) {
-  ArgParser ap("urbanslam run [--ini FILE] [--out DIR] [--quiet] [--json] [LOG]",
+  ArgParser ap("urbanslam run [--ini FILE] [--out DIR] [--quiet] [--json] [LOG | --simulate CITY_INI]",
                "Builds a map and trajectory from a log: MRPT rawlog (either layout, gzipped or not),\n"
                "CARMEN log (raw or Freiburg-corrected), GMapping gfs log, Victoria Park (folder or zip) or a\n"
                "folder of camera images (one keyframe per image; image loop proposals need [loop_closure] image_detector).");
   ap.addPositional("LOG", "input log; default: the shipped rawlogs/intel.rawlog", false);
+  ap.addOption("simulate", "CITY_INI", "map a simulated city drive streamed straight from the simulator (no file; see\n"
+                                       "`urbanslam simulate`) instead of a LOG");
   ap.addOption("ini", "FILE", "configuration (see ini/default.ini for every key)", "ini/default.ini");
   ap.addOption("out", "DIR", "output folder (created if needed)", "out");
   ap.addFlag("quiet", "no progress bar and no summary on stderr");
@@ -45,7 +50,11 @@ int runCommand(const Argv& args) {
       "(written last: its presence marks a complete run).");
   if (!ap.parse(args)) return 0;
 
-  const std::string log = ap.positional("LOG").empty() ? defaultRawlog() : ap.positional("LOG");
+  if (ap.has("simulate") && !ap.positional("LOG").empty())
+    throw common::InputError("run: give either a LOG or --simulate CITY_INI, not both");
+  const std::string log = ap.has("simulate")        ? ap.option("simulate")
+                          : ap.positional("LOG").empty() ? defaultRawlog()
+                                                         : ap.positional("LOG");
   const std::string ini = ap.has("ini") ? ap.option("ini") : defaultIni();
   const bool quiet = ap.flag("quiet");
   std::string resolved;
@@ -55,7 +64,9 @@ int runCommand(const Argv& args) {
   if (options.image_loop.vocabulary.empty())
     options.image_loop.vocabulary = projectHome() + "/" + vision_loop::kDefaultVocabularyPath;
 
-  auto source = io::openDataSource(log);
+  // The simulator is a data source like a file reader: a drive of any length streams through.
+  std::unique_ptr<io::DataSource> source =
+      ap.has("simulate") ? std::make_unique<sim::SimulatedSource>(sim::loadSimOptions(log)) : io::openDataSource(log);
   slam::Pipeline pipeline(options);
   common::ProgressBar bar("run", 1000, !quiet);
   ProgressObserver progress(bar);

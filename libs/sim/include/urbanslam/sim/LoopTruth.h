@@ -1,0 +1,44 @@
+#pragma once
+// Ground-truth loop pairs: two scans far apart in time whose views overlap. Overlap is the
+// fraction of the newer scan's beam end points (world frame, true poses) that have an end point
+// of the older scan within match_radius_m. Candidates come from a spatial hash of the sensor
+// positions, so a drive costs O(n * revisits), not O(n^2).
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "urbanslam/io/LaserScan.h"
+#include "urbanslam/sim/Geometry.h"
+#include "urbanslam/sim/SimOptions.h"
+
+namespace urbanslam::sim {
+
+struct LoopPair {
+  double t_old = 0, t_new = 0;
+  double overlap = 0;     // fraction in [0, 1]
+  double distance_m = 0;  // between the sensor positions
+};
+
+class LoopTruthFinder {
+ public:
+  explicit LoopTruthFinder(const LoopTruthOptions& options);
+  // Adds a scan taken at the true vehicle pose and returns the pairs it forms with earlier scans.
+  std::vector<LoopPair> add(const io::LaserScan& scan, const common::Pose2& vehicle);
+
+  // The beam end points the overlap is computed from: every point_stride-th beam, if valid.
+  static std::vector<Vec2> endPoints(const io::LaserScan& scan, const common::Pose2& vehicle, int stride);
+
+ private:
+  struct Entry {
+    double t;
+    Vec2 sensor;
+    std::vector<float> xy;  // end points, interleaved (floats: half the memory of a long drive)
+  };
+  int64_t cellKey(Vec2 p) const;
+
+  LoopTruthOptions options_;
+  std::vector<Entry> scans_;
+  std::unordered_map<int64_t, std::vector<uint32_t>> cells_;
+};
+
+}  // namespace urbanslam::sim

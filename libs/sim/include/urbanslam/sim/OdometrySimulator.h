@@ -1,0 +1,40 @@
+#pragma once
+// Wheel odometry of a car: distance from the wheel encoders (scale error, noise, slip) and heading
+// change from the true motion plus a steering-encoder offset and noise, accumulated into a pose in
+// the odometry frame as the log readers deliver it.
+#include "urbanslam/io/Measurements.h"
+#include "urbanslam/sim/Driver.h"
+#include "urbanslam/sim/Random.h"
+#include "urbanslam/sim/SimOptions.h"
+
+namespace urbanslam::sim {
+
+class OdometrySimulator {
+ public:
+  OdometrySimulator(const OdometryOptions& options, double wheelbase_m, uint64_t seed);
+  // A reading at the vehicle's current state (the first call only sets the reference).
+  io::OdometryReading read(const VehicleState& state, double timestamp);
+
+ private:
+  OdometryOptions options_;
+  double wheelbase_m_;
+  Rng rng_;
+  bool started_ = false;
+  VehicleState last_;
+  common::Pose2 pose_;
+  double slip_until_s_ = -1, slip_factor_ = 0;
+};
+
+class GpsSimulator {
+ public:
+  GpsSimulator(const GpsOptions& options, uint64_t seed);
+  // A fix at the vehicle's current state, or false during an outage.
+  bool read(const VehicleState& state, double timestamp, io::GpsFix& out);
+
+ private:
+  GpsOptions options_;
+  Rng rng_;
+  double last_s_ = 0, outage_until_s_ = -1;
+};
+
+}  // namespace urbanslam::sim

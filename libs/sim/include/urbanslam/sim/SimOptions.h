@@ -1,0 +1,103 @@
+#pragma once
+// Options of the simulator, one struct per ini section. Member names are the ini keys; units are
+// in the names. declareSimOptions() documents them (check-ini style) and loadSimOptions() rejects
+// unknown keys and out-of-range values with the file, section and key.
+#include <string>
+
+#include "urbanslam/common/OptionsSchema.h"
+#include "urbanslam/common/Pose2.h"
+#include "urbanslam/sim/CityOptions.h"
+
+namespace urbanslam::sim {
+
+struct VehicleOptions {
+  double wheelbase_m = 2.7;
+  double max_steering_deg = 35.0;
+  double max_steering_rate_deg_s = 60.0;  // how fast the driver can turn the wheel
+  double max_accel_mps2 = 1.5;
+  double max_decel_mps2 = 2.5;
+};
+
+struct RouteOptions {
+  double route_length_km = 3.0;
+  double speed_mps = 10.0;         // cruising speed on straight streets
+  double turn_speed_mps = 4.0;     // speed through a turn
+  double lookahead_min_m = 4.0;    // pure pursuit look-ahead: at least this ...
+  double lookahead_s = 0.6;        // ... or this many seconds of travel
+  double revisit_probability = 0.6;  // after exploring, head back to an earlier intersection
+  int explore_min_edges = 2;       // street pieces driven freely before deciding to return
+  int explore_max_edges = 12;
+  double straight_probability = 0.5;  // at an intersection while exploring
+  double start_time_s = 1700000000.0;  // timestamp of the first measurement
+  double step_s = 0.01;            // integration step of the vehicle
+};
+
+struct LaserOptions {
+  bool enabled = true;
+  std::string label = "LASER";
+  double rate_hz = 10.0;
+  double fov_deg = 180.0;          // 180 (front) or 360
+  double angular_resolution_deg = 0.5;
+  double max_range_m = 80.0;
+  double range_sigma_m = 0.01;
+  double range_sigma_per_m = 0.0005;
+  double dropout_probability = 0.01;  // a beam returns nothing (glass, black paint)
+  double x_m = 1.5, y_m = 0.0, yaw_deg = 0.0;  // mounting pose on the vehicle (rear axle frame)
+};
+
+struct OdometryOptions {
+  bool enabled = true;
+  double rate_hz = 50.0;
+  double sigma_per_m = 0.02;        // relative distance noise (1 sigma per metre travelled)
+  double sigma_per_rad = 0.02;      // heading noise per radian turned
+  double sigma_phi_per_m_rad = 0.001;  // heading noise per metre travelled
+  double scale_bias = 0.01;         // wheel radius error: distance reads (1 + this) too long
+  double steering_bias_deg = 0.1;   // steering encoder offset: a straight drive curves
+  double slip_probability = 0.01;   // per second: a wheel slip event
+  double slip_duration_s = 0.5;
+  double slip_scale = 0.3;          // during a slip the distance reads up to this much too long
+};
+
+struct GpsOptions {
+  bool enabled = false;
+  double rate_hz = 1.0;
+  double sigma_m = 2.0;
+  double outage_probability = 0.01;  // per second: the fix is lost (urban canyon)
+  double outage_min_s = 5.0;
+  double outage_max_s = 60.0;
+};
+
+struct TrafficOptions {
+  double car_spacing_m = 120.0;        // mean gap between moving cars per lane; 0: none
+  double car_speed_mps = 8.0;
+  double pedestrian_spacing_m = 40.0;  // mean gap between pedestrians per sidewalk; 0: none
+  double pedestrian_speed_mps = 1.3;
+  double clearance_m = 8.0;            // moving objects this close to the vehicle are left out
+};
+
+struct LoopTruthOptions {
+  double min_gap_s = 30.0;        // a loop pair is at least this far apart in time
+  double max_distance_m = 15.0;   // ... and its sensor positions at most this far apart
+  double match_radius_m = 0.3;    // a beam end point overlaps when the other scan has one this close
+  double min_overlap = 0.5;       // reported when at least this fraction overlaps
+  int point_stride = 4;           // every n-th beam end point is compared
+};
+
+struct SimOptions {
+  CityOptions city;
+  VehicleOptions vehicle;
+  RouteOptions route;
+  LaserOptions laser;
+  OdometryOptions odometry;
+  GpsOptions gps;
+  TrafficOptions traffic;
+  LoopTruthOptions loops;
+};
+
+void declareSimOptions(common::OptionsSchema& s, SimOptions& o);
+// Defaults overlaid by the ini (path "" = defaults only). resolved_ini: the effective configuration.
+SimOptions loadSimOptions(const std::string& path, std::string* resolved_ini = nullptr);
+
+inline common::Pose2 laserMount(const LaserOptions& l) { return {l.x_m, l.y_m, l.yaw_deg * M_PI / 180.0}; }
+
+}  // namespace urbanslam::sim
