@@ -13,6 +13,7 @@
 #include "urbanslam/laser_loop/LinePlot.h"
 #include "urbanslam/slam/ClosureEvidence.h"
 #include "urbanslam/slam/Evaluation.h"
+#include "urbanslam/slam/MapAccuracy.h"
 
 namespace urbanslam::cli {
 
@@ -61,10 +62,38 @@ common::Json poseJson(const common::Pose2& p) {
   return j;
 }
 
+// The map against the simulated city's walls, and the share of true revisits closed.
+void evaluateAgainstSimulation(const fs::path& run, const fs::path& sim, const common::Pose2& to_truth, common::Json& j) {
+  const fs::path simplemap = run / "map.simplemap";
+  if (!fs::exists(simplemap))
+    throw common::InputError(simplemap.string() + ": missing (the map is scored on the keyframe scans; [output] write_simplemap = true)");
+  const auto keyframes = io::readSimpleMap(simplemap.string());
+  std::vector<io::PosedScan> posed;
+  for (const auto& k : keyframes) posed.push_back({k.pose, &k.scan});
+  const auto acc = slam::mapAccuracy(io::mapPoints(posed), to_truth, slam::readWallsCsv((sim / "walls.csv").string()));
+  common::Json m = common::Json::object();
+  m["points"] = acc.points;
+  m["mean_m"] = acc.mean_m;
+  m["median_m"] = acc.median_m;
+  m["p95_m"] = acc.p95_m;
+  m["within_0_1_m"] = acc.within_0_1_m;
+  m["beyond_1_m"] = acc.beyond_1_m;
+  j["map"] = std::move(m);
+  if (fs::exists(run / "loop_closures.csv")) {
+    const auto r = slam::loopRecall(slam::readLoopClosuresCsv((run / "loop_closures.csv").string()),
+                                    slam::readTrueLoopsCsv((sim / "loops.csv").string()));
+    common::Json l = common::Json::object();
+    l["revisited_scans"] = r.revisited_scans;
+    l["closed_scans"] = r.closed_scans;
+    l["recall"] = r.recall;
+    j["loops_recall"] = std::move(l);
+  }
+}
+
 }  // namespace
 
 int evalCommand(const Argv& args) {
-  ArgParser ap("urbanslam eval RUN_DIR (--relations FILE | --reference FILE) [--json]",
+  ArgParser ap("urbanslam eval RUN_DIR (--relations FILE | --reference FILE | --truth SIM_DIR) [--json]",
                "Evaluates the output folder of `urbanslam run`:\n"
                "  --relations: the relation metric of Kümmerle et al. 2009 as Cartographer computes it\n"
                "    (error = (p1^-1 p2) expected^-1; abs/squared translational and rotational error, mean +/- std)\n"
@@ -82,10 +111,15 @@ int evalCommand(const Argv& args) {
                "  relations_odometry.by_scans: the relation error by where both times fall among the run's scans (--scans):\n"
                "    at_scans, one_interval (inside one interval between two scans: odometry only), other; each\n"
                "    with n, abs_trans_mean_m and share_m (its error sum over all relations; the shares add up).\n"
+               "  --truth: a simulated drive's folder (`urbanslam simulate`): its truth.tum is the reference, and\n"
+               "    also map (distance of every keyframe scan point, placed by the run and carried by the ATE's\n"
+               "    alignment, to the nearest true wall of walls.csv: mean, median, p95, within_0_1_m, beyond_1_m)\n"
+               "    and loops_recall (revisited scans of loops.csv joined by an accepted closure within 2 s of both times).\n"
                "Plots: RUN_DIR/eval_trajectory.png, RUN_DIR/eval_error.png.");
   ap.addPositional("RUN_DIR", "output folder of urbanslam run");
   ap.addOption("relations", "FILE", "Freiburg relations file (t1 t2 x y z roll pitch yaw)");
   ap.addOption("reference", "FILE", "reference trajectory: TUM file or a log that carries one");
+  ap.addOption("truth", "SIM_DIR", "folder written by urbanslam simulate (truth.tum, walls.csv, loops.csv)");
   ap.addOption("scans", "FILE", "TUM file whose times are the scans the run placed, for the relations' breakdown (default: RUN_DIR/trajectory_scans.tum, else trajectory_keyframes.tum); give another run's to compare two runs on the same classes");
   ap.addOption("time-offset", "S", "seconds added to the run's timestamps for --relations (default: found)");
   ap.addOption("max-gap", "S", "a relation is used only when the trajectory poses around each of its times are at most this far apart [s]; 0: any gap", "0");
@@ -93,7 +127,11 @@ int evalCommand(const Argv& args) {
   ap.addOption("loop-tolerance-deg", "DEG", "... and this", "5");
   ap.addFlag("json", "print the figures as one JSON object");
   if (!ap.parse(args)) return 0;
-  if (!ap.has("relations") && !ap.has("reference")) throw common::InputError("give --relations FILE and/or --reference FILE");
+  if (!ap.has("relations") && !ap.has("reference") && !ap.has("truth"))
+    throw common::InputError("give --relations FILE, --reference FILE or --truth SIM_DIR");
+  if (ap.has("reference") && ap.has("truth")) throw common::InputError("give --reference FILE or --truth SIM_DIR, not both");
+  const fs::path truth_dir = ap.has("truth") ? fs::path(ap.option("truth")) : fs::path();
+  const std::string reference_path = ap.has("truth") ? (truth_dir / "truth.tum").string() : ap.option("reference");
   const double max_gap_arg = ap.optionDouble("max-gap");
   if (!(max_gap_arg >= 0)) throw common::InputError("--max-gap: must be a number of seconds >= 0");
   const double max_gap = max_gap_arg > 0 ? max_gap_arg : std::numeric_limits<double>::infinity();
@@ -111,7 +149,7 @@ int evalCommand(const Argv& args) {
   j["run"] = dir.string();
   bool positions_only = false;
   std::vector<io::StampedPose> reference;
-  if (ap.has("reference")) reference = loadReference(ap.option("reference"), positions_only);
+  if (!reference_path.empty()) reference = loadReference(reference_path, positions_only);
   else if (fs::exists(dir / "reference.tum")) reference = io::readTum((dir / "reference.tum").string());
 
   if (ap.has("relations")) {
@@ -186,9 +224,10 @@ int evalCommand(const Argv& args) {
       j["relations"]["reference_abs_rot_mean_deg"] = mr.abs_rot_deg.mean;
     }
   }
-  if (ap.has("reference")) {
+  if (!reference_path.empty()) {
     const auto tm = slam::trajectoryMetrics(estimate, reference, positions_only, positions_only ? 2.0 : 1.0);
-    j["reference"] = ap.option("reference");
+    j["reference"] = reference_path;
+    if (ap.has("truth")) evaluateAgainstSimulation(dir, truth_dir, tm.alignment, j);
     j["positions_only"] = positions_only;
     j["matched"] = tm.matched;
     j["ate_rmse_m"] = tm.ate_rmse_m;

@@ -189,4 +189,13 @@ TEST(Cli, SimulatedDriveRunsFromFileAndStream) {
   // simulator's default scale and steering bias, ends 27 m off.
   EXPECT_LT(worst, 0.005 * driven);
   EXPECT_EQ(runCli("run --quiet --out " + (d / "both").string() + " --simulate " + ini.string() + " x.rawlog").code, 2);
+  // Against the simulation: the map's points lie on the true walls (most within 10 cm).
+  const CliResult e = runCli("eval --json " + (d / "file").string() + " --truth " + (d / "sim").string());
+  ASSERT_EQ(e.code, 0) << e.err;
+  const auto field = [&](const std::string& key) {
+    const auto at = e.out.find("\"" + key + "\":");
+    return at == std::string::npos ? -1.0 : std::stod(e.out.substr(at + key.size() + 3));
+  };
+  EXPECT_GT(field("within_0_1_m"), 0.5) << e.out;
+  EXPECT_GE(field("recall"), 0.0) << e.out;
 }

@@ -247,6 +247,7 @@ TrajectoryMetrics trajectoryMetrics(const std::vector<io::StampedPose>& estimate
   const double th = std::atan2(sxy, sxx), c = std::cos(th), s = std::sin(th);
   const Eigen::Vector2d t = cr - Eigen::Vector2d(c * ce.x() - s * ce.y(), s * ce.x() + c * ce.y());
   const Pose2 align{t.x(), t.y(), th};
+  m.alignment = align;
   double sum2 = 0;
   for (size_t i = 0; i < e.size(); ++i) {
     const Pose2 a = common::compose(align, e[i]);

@@ -74,6 +74,7 @@ struct TrajectoryMetrics {
   bool positions_only = false;     // reference without headings (GPS)
   std::vector<double> times, errors_m;  // per matched pose, after alignment (for plots)
   std::vector<io::StampedPose> aligned;  // the estimate, rigidly aligned onto the reference
+  common::Pose2 alignment;               // the rigid transform from the estimate's frame to the reference's
 };
 
 // Matches every reference pose to the estimate at the same time (interpolated), aligns the
