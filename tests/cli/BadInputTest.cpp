@@ -95,7 +95,8 @@ TEST(BadInput, IniAndOutputFolder) {
 TEST(BadInput, EvalArguments) {
   const fs::path d = scratchDir("bad_eval");
   const std::string rel = " --relations " + repoPath("rawlogs/intel-corrected-excerpt.log.gz");
-  expectBadInput("eval " + d.string(), "give --relations FILE and/or --reference FILE");
+  expectBadInput("eval " + d.string(), "give --relations FILE, --reference FILE or --truth SIM_DIR");
+  expectBadInput("eval " + d.string() + " --reference x.tum --truth " + d.string(), "not both");
   expectBadInput("eval " + d.string() + rel + " --max-gap -1", "--max-gap: must be a number of seconds >= 0");
   expectBadInput("eval " + (d / "no-run").string() + rel, "trajectory_odometry.tum: missing (not a run folder?)");
   // A run folder and relations that evaluate, with a --scans file that is not there.
@@ -104,4 +105,6 @@ TEST(BadInput, EvalArguments) {
   writeFile(run / "trajectory_odometry.tum", "0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n2 2 0 0 0 0 0 1\n");
   const std::string ok_rel = " --relations " + writeFile(d / "r.relations", "0.5 1.5 1 0 0 0 0 0\n") + " --time-offset 0";
   expectBadInput("eval " + run.string() + ok_rel + " --scans " + (d / "nowhere.tum").string(), "nowhere.tum");
+  // --truth: a folder that is not a simulation's names the missing file.
+  expectBadInput("eval " + run.string() + " --truth " + d.string(), "truth.tum");
 }

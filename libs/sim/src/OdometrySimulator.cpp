@@ -25,12 +25,17 @@ io::OdometryReading OdometrySimulator::read(const VehicleState& s, double timest
     slip_factor_ = rng_.uniform(0, options_.slip_scale);
   }
   const double slip = s.time_s < slip_until_s_ ? slip_factor_ : 0.0;
-  const double ds = ds_true * (1 + options_.scale_bias + slip) + rng_.normal(options_.sigma_per_m * ds_true);
+  // Gauss-Markov step over the distance driven: stationary standard deviation sigma, correlation
+  // exp(-distance / correlation_length_m).
+  const double a = std::exp(-std::fabs(ds_true) / options_.correlation_length_m), q = std::sqrt(1 - a * a);
+  scale_error_ = a * scale_error_ + q * rng_.normal(options_.sigma_per_m);
+  turn_error_ = a * turn_error_ + q * rng_.normal(options_.sigma_per_rad);
+  drift_rad_per_m_ = a * drift_rad_per_m_ + q * rng_.normal(options_.sigma_phi_per_m_rad);
+  const double ds = ds_true * (1 + options_.scale_bias + slip + scale_error_);
   // The heading the car computes from its steering encoder: an offset bends every straight.
   const double bias = options_.steering_bias_deg * M_PI / 180.0;
   const double steer_error = ds_true * (std::tan(s.steering_rad + bias) - std::tan(s.steering_rad)) / wheelbase_m_;
-  const double dphi = dphi_true + steer_error +
-                      rng_.normal(options_.sigma_per_rad * std::fabs(dphi_true) + options_.sigma_phi_per_m_rad * ds_true);
+  const double dphi = dphi_true * (1 + turn_error_) + steer_error + drift_rad_per_m_ * std::fabs(ds_true);
   pose_ = common::compose(pose_, {ds * std::cos(dphi / 2), ds * std::sin(dphi / 2), dphi});
   last_ = s;
   return {timestamp, pose_};

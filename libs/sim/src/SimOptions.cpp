@@ -69,9 +69,10 @@ void declareSimOptions(common::OptionsSchema& s, SimOptions& o) {
   s.section("odometry", "Wheel odometry (wheel speed + steering encoder)");
   s.add("enabled", d.enabled, "simulate odometry");
   s.add("rate_hz", d.rate_hz, 0.1, 1000.0, "Hz", "readings per second");
-  s.add("sigma_per_m", d.sigma_per_m, 0.0, 1.0, "m/m", "distance noise per metre travelled");
-  s.add("sigma_per_rad", d.sigma_per_rad, 0.0, 1.0, "rad/rad", "heading noise per radian turned");
-  s.add("sigma_phi_per_m_rad", d.sigma_phi_per_m_rad, 0.0, 1.0, "rad/m", "heading noise per metre travelled");
+  s.add("sigma_per_m", d.sigma_per_m, 0.0, 1.0, "m/m", "distance scale error (1 sigma, drifting over correlation_length_m)");
+  s.add("sigma_per_rad", d.sigma_per_rad, 0.0, 1.0, "rad/rad", "heading error per radian turned (1 sigma, drifting)");
+  s.add("sigma_phi_per_m_rad", d.sigma_phi_per_m_rad, 0.0, 1.0, "rad/m", "heading drift per metre travelled (1 sigma, drifting)");
+  s.add("correlation_length_m", d.correlation_length_m, 0.01, 10000.0, "m", "distance over which the odometry errors decorrelate");
   s.add("scale_bias", d.scale_bias, -0.5, 0.5, "", "distance reads (1 + this) times the truth");
   s.add("steering_bias_deg", d.steering_bias_deg, -10.0, 10.0, "deg", "steering encoder offset");
   s.add("slip_probability", d.slip_probability, 0.0, 1.0, "1/s", "wheel slip events per second");

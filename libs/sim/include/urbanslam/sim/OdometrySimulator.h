@@ -1,7 +1,8 @@
 #pragma once
-// Wheel odometry of a car: distance from the wheel encoders (scale error, noise, slip) and heading
-// change from the true motion plus a steering-encoder offset and noise, accumulated into a pose in
-// the odometry frame as the log readers deliver it.
+// Wheel odometry of a car: distance from the wheel encoders (scale error, slip) and heading
+// change from the true motion plus a steering-encoder offset, accumulated into a pose in the
+// odometry frame as the log readers deliver it. The random errors are first-order Gauss-Markov
+// processes in the distance driven, so their statistics per metre do not depend on the rate.
 #include "urbanslam/io/Measurements.h"
 #include "urbanslam/sim/Driver.h"
 #include "urbanslam/sim/Random.h"
@@ -23,6 +24,8 @@ class OdometrySimulator {
   VehicleState last_;
   common::Pose2 pose_;
   double slip_until_s_ = -1, slip_factor_ = 0;
+  // The drifting errors' current values: distance scale, heading per radian turned, heading per metre.
+  double scale_error_ = 0, turn_error_ = 0, drift_rad_per_m_ = 0;
 };
 
 class GpsSimulator {

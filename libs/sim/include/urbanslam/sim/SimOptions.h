@@ -48,9 +48,13 @@ struct LaserOptions {
 struct OdometryOptions {
   bool enabled = true;
   double rate_hz = 50.0;
-  double sigma_per_m = 0.02;        // relative distance noise (1 sigma per metre travelled)
-  double sigma_per_rad = 0.02;      // heading noise per radian turned
-  double sigma_phi_per_m_rad = 0.001;  // heading noise per metre travelled
+  // Errors that drift with the distance driven (Gauss-Markov, correlated over
+  // correlation_length_m), as real wheel odometry's do (tyre load, floor, slip): white noise per
+  // reading would average out at high rates and depend on rate_hz.
+  double sigma_per_m = 0.04;           // distance scale error (1 sigma)
+  double sigma_per_rad = 0.27;         // heading error per radian turned (1 sigma)
+  double sigma_phi_per_m_rad = 0.032;  // heading drift per metre travelled (1 sigma)
+  double correlation_length_m = 2.0;   // distance over which those errors decorrelate
   double scale_bias = 0.01;         // wheel radius error: distance reads (1 + this) too long
   double steering_bias_deg = 0.1;   // steering encoder offset: a straight drive curves
   double slip_probability = 0.01;   // per second: a wheel slip event
