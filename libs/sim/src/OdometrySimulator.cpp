@@ -48,9 +48,16 @@ bool GpsSimulator::read(const VehicleState& s, double timestamp, io::GpsFix& out
   last_s_ = s.time_s;
   if (s.time_s >= outage_until_s_ && rng_.chance(options_.outage_probability * dt))
     outage_until_s_ = s.time_s + rng_.uniform(options_.outage_min_s, options_.outage_max_s);
+  if (s.time_s >= multipath_until_s_ && rng_.chance(options_.multipath_probability * dt)) {
+    multipath_until_s_ = s.time_s + options_.multipath_duration_s;
+    const double dir = rng_.uniform(-M_PI, M_PI);
+    jump_x_ = options_.multipath_jump_m * std::cos(dir);
+    jump_y_ = options_.multipath_jump_m * std::sin(dir);
+  }
   const double nx = rng_.normal(options_.sigma_m), ny = rng_.normal(options_.sigma_m);
   if (s.time_s < outage_until_s_) return false;
-  out = {timestamp, s.pose.x + nx, s.pose.y + ny};
+  const bool jumped = s.time_s < multipath_until_s_;
+  out = {timestamp, s.pose.x + nx + (jumped ? jump_x_ : 0), s.pose.y + ny + (jumped ? jump_y_ : 0)};
   return true;
 }
 

@@ -87,6 +87,9 @@ void declareSimOptions(common::OptionsSchema& s, SimOptions& o) {
   s.add("outage_probability", g.outage_probability, 0.0, 1.0, "1/s", "outages per second");
   s.add("outage_min_s", g.outage_min_s, 0.0, 3600.0, "s", "shortest outage");
   s.add("outage_max_s", g.outage_max_s, 0.0, 3600.0, "s", "longest outage");
+  s.add("multipath_probability", g.multipath_probability, 0.0, 1.0, "1/s", "multipath events per second (a reflection between facades)");
+  s.add("multipath_jump_m", g.multipath_jump_m, 0.0, 1000.0, "m", "how far a multipath event shifts the fix");
+  s.add("multipath_duration_s", g.multipath_duration_s, 0.0, 3600.0, "s", "how long a multipath event lasts");
 
   auto& t = o.traffic;
   s.section("traffic", "Moving objects the laser sees but the map must not keep");

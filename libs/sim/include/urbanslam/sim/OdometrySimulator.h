@@ -31,13 +31,15 @@ class OdometrySimulator {
 class GpsSimulator {
  public:
   GpsSimulator(const GpsOptions& options, uint64_t seed);
-  // A fix at the vehicle's current state, or false during an outage.
+  // A fix at the vehicle's current state (noise, and a jump while a multipath event lasts), or
+  // false during an outage.
   bool read(const VehicleState& state, double timestamp, io::GpsFix& out);
 
  private:
   GpsOptions options_;
   Rng rng_;
-  double last_s_ = 0, outage_until_s_ = -1;
+  double last_s_ = 0, outage_until_s_ = -1, multipath_until_s_ = -1;
+  double jump_x_ = 0, jump_y_ = 0;
 };
 
 }  // namespace urbanslam::sim

@@ -69,6 +69,9 @@ struct GpsOptions {
   double outage_probability = 0.01;  // per second: the fix is lost (urban canyon)
   double outage_min_s = 5.0;
   double outage_max_s = 60.0;
+  double multipath_probability = 0.01;  // per second: a reflected signal shifts the fix
+  double multipath_jump_m = 15.0;       // size of the shift (direction random)
+  double multipath_duration_s = 10.0;   // how long it lasts
 };
 
 struct TrafficOptions {
