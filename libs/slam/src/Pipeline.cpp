@@ -54,6 +54,14 @@ Pipeline::Pipeline(PipelineOptions options)
 
 Pipeline::~Pipeline() = default;
 
+void PipelineStats::recordStep(double ms, size_t keyframes) {
+  step_ms.push_back(ms);
+  size_t decade = 0;
+  for (size_t n = keyframes; n >= 10; n /= 10) ++decade;
+  if (step_ms_by_decade.size() <= decade) step_ms_by_decade.resize(decade + 1);
+  step_ms_by_decade[decade].push_back(ms);
+}
+
 void Pipeline::addObserver(PipelineObserver* observer) { observers_.push_back(observer); }
 
 void Pipeline::setCandidateScorer(CandidateScorer scorer, std::string name) { closer_.setScorer(std::move(scorer), std::move(name)); }
@@ -167,7 +175,7 @@ void Pipeline::onScan(io::LaserScan scan, double progress) {
     anchorScan(scan);
   }
   const double ms = sw.milliseconds();
-  stats_.step_ms.push_back(ms);
+  stats_.recordStep(ms, keyframes_.size());
   StepEvent ev{stats_.scans_used, keyframes_.size(), stats_.last_timestamp, ms, progress};
   for (auto* o : observers_) o->onStep(ev);
 }

@@ -38,7 +38,7 @@ void Pipeline::onCameraImage(const io::CameraImage& image, double progress) {
   attachImage(images_.imageKeyframe(keyframes_.size() - 1, image));
   const double ms = sw.milliseconds();
   stats_.keyframe_ms.push_back(ms);
-  stats_.step_ms.push_back(ms);
+  stats_.recordStep(ms, keyframes_.size());
   StepEvent ev{stats_.scans_used, keyframes_.size(), stats_.last_timestamp, ms, progress};
   for (auto* o : observers_) o->onStep(ev);
 }

@@ -135,6 +135,10 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   t["step_ms_p50"] = common::percentile(s.step_ms, 50);
   t["step_ms_p99"] = common::percentile(s.step_ms, 99);
   t["step_ms_max"] = common::percentile(s.step_ms, 100);
+  Json by = Json::object();
+  for (size_t k = 0; k < s.step_ms_by_decade.size(); ++k)
+    if (!s.step_ms_by_decade[k].empty()) by["1e" + std::to_string(k)] = common::percentile(s.step_ms_by_decade[k], 99);
+  t["step_ms_p99_by_keyframes"] = std::move(by);
   t["keyframe_ms_p50"] = common::percentile(s.keyframe_ms, 50);
   t["keyframe_ms_p99"] = common::percentile(s.keyframe_ms, 99);
   t["loop_search_ms_p50"] = common::percentile(s.closure_ms, 50);

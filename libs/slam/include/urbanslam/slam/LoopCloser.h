@@ -22,7 +22,7 @@ struct Keyframe;
 struct LoopClosureRecord {
   size_t from = 0, to = 0;           // earlier keyframe, current keyframe
   double from_time = 0, to_time = 0;
-  std::string detector;              // "laser", "image" or "geometric" (alignment + gating only)
+  std::string detector;              // which source proposed it: "pose" (near the estimate; alignment + gating verify), "laser" or "image"
   double score = 0;                  // classifier margin, image normalised score, or alignment matched fraction
   bool accepted = false;
   // When not accepted: classifier | alignment | ambiguous | free_space | gating | unconfirmed, or for image proposals that
@@ -85,7 +85,7 @@ class LoopCloser {
   LoopClosureOptions options_;
   KeyframeGrid grid_;
   CandidateScorer scorer_;
-  std::string detector_ = "geometric";
+  std::string detector_ = "pose";
   double chi2_2dof_;
   size_t cached_for_ = static_cast<size_t>(-1);
   std::unordered_map<size_t, Eigen::Matrix3d> cached_;  // relative covariances for cached_for_

@@ -61,6 +61,10 @@ struct PipelineStats {
   double first_timestamp = 0, last_timestamp = 0;
   double wall_s = 0;             // processing time, reading included
   std::vector<double> step_ms;   // per processed scan
+  // The same, by the map's size when the step ran: decade k holds the steps taken with 10^k to
+  // 10^(k+1) - 1 keyframes (constant time per step means the same figures in every decade).
+  std::vector<std::vector<double>> step_ms_by_decade;
+  void recordStep(double ms, size_t keyframes);
   std::vector<double> keyframe_ms, closure_ms;
 };
 
