@@ -2,6 +2,8 @@
 // consistent with the simulator's ground truth.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -108,6 +110,52 @@ TEST(SimulationOutputs, RawlogReadsBackWithTheProjectReader) {
   // truth.tum: one pose per scan, at the scan times.
   const auto truth = io::readTum((dir / "truth.tum").string());
   EXPECT_EQ(truth.size(), sum.scans);
+}
+
+TEST(SimulationOutputs, CameraImagesAreStoredBesideTheRawlogAndReadBackPixelForPixel) {
+  const auto dir = test::scratchDir("sim_camera");
+  SimOptions o = smallDrive();
+  o.route.route_length_km = 0.15;
+  o.laser.enabled = false;
+  o.camera.enabled = true;
+  o.camera.rate_hz = 1.0;
+  const auto sum = writeSimulation(o, dir.string(), "");
+  ASSERT_GT(sum.images, 10u);
+  EXPECT_EQ(sum.scans, 0u);
+  EXPECT_NEAR(static_cast<double>(sum.images), sum.duration_s * o.camera.rate_hz, 1.5);
+  // External images: one PNG each, a rawlog that holds only their names.
+  size_t files = 0;
+  for (const auto& f : std::filesystem::directory_iterator(dir / "city_Images")) files += f.path().extension() == ".png";
+  EXPECT_EQ(files, sum.images);
+  EXPECT_LT(std::filesystem::file_size(dir / "city.rawlog"), 640u * 480u);  // less than one image embedded
+
+  // Reference: the images straight from the simulator.
+  SimulatedSource sim(o);
+  auto file = io::openDataSource((dir / "city.rawlog").string());
+  io::Measurement a, b;
+  size_t images = 0, refs = 0;
+  while (sim.next(a)) {
+    ASSERT_TRUE(file->next(b));
+    ASSERT_EQ(a.index(), b.index());
+    refs += std::holds_alternative<io::ReferencePose>(a);
+    if (const auto* ia = std::get_if<io::CameraImage>(&a)) {
+      const auto& ib = std::get<io::CameraImage>(b);
+      EXPECT_EQ(ib.label, "CAMERA");
+      ASSERT_EQ(ib.width, ia->width);
+      ASSERT_EQ(ib.height, ia->height);
+      EXPECT_TRUE(*ia->pixels == *ib.pixels) << "image " << images;
+      char name[32];
+      std::snprintf(name, sizeof name, "CAMERA_%06zu.png", images);
+      EXPECT_EQ(std::filesystem::path(ib.source).filename().string(), name);
+      ++images;
+    }
+  }
+  EXPECT_FALSE(file->next(b));
+  EXPECT_EQ(images, sum.images);
+  EXPECT_EQ(refs, sum.images);  // without a laser, the truth is given at the image times
+  EXPECT_EQ(io::readTum((dir / "truth.tum").string()).size(), sum.images);
+  EXPECT_TRUE(std::filesystem::exists(dir / "image_loops.csv"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "image_loops.txt"));
 }
 
 TEST(SimulationOutputs, OdometryDriftsFromTheTruthOnlyAsMuchAsItsNoise) {

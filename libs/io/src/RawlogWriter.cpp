@@ -8,6 +8,8 @@
 #include <mrpt/serialization/CArchive.h>
 
 #include <cstdio>
+#include <filesystem>
+#include <mrpt/obs/CObservationImage.h>
 
 #include "MrptConversions.h"
 #include "urbanslam/common/AtomicFile.h"
@@ -28,6 +30,24 @@ struct RawlogWriter::Impl {
   common::Pose2 last_odom;
   size_t written = 0;
   bool closed = false;
+  ImageStorage images = ImageStorage::Embedded;
+  std::string images_dir, last_image;
+  size_t image_count = 0;
+
+  // The observation for m; an image is first saved beside the rawlog when stored externally.
+  mrpt::obs::CObservation::Ptr observation(const Measurement& m) {
+    auto o = detail::toMrpt(m);
+    const auto* img = std::get_if<CameraImage>(&m);
+    if (!img || images != ImageStorage::External) return o;
+    auto obs = std::dynamic_pointer_cast<mrpt::obs::CObservationImage>(o);
+    char name[64];
+    std::snprintf(name, sizeof name, "_%06zu.png", image_count++);
+    last_image = img->label + name;
+    const std::string file = images_dir + "/" + last_image;
+    if (!obs->image.saveToFile(file)) throw InputError(file + ": cannot write image");
+    obs->image.setExternalStorage(last_image);  // drops the pixels; the rawlog keeps the name
+    return obs;
+  }
 
   void flushFrame() {
     if (!frame || frame->size() == 0) return;
@@ -42,9 +62,17 @@ struct RawlogWriter::Impl {
   }
 };
 
-RawlogWriter::RawlogWriter(const std::string& path, RawlogLayout layout, int gz_level)
+RawlogWriter::RawlogWriter(const std::string& path, RawlogLayout layout, int gz_level, ImageStorage images)
     : impl_(std::make_unique<Impl>()) {
   impl_->path = path;
+  impl_->images = images;
+  if (images == ImageStorage::External) {
+    const std::filesystem::path p(path);
+    impl_->images_dir = (p.parent_path() / (p.stem().string() + "_Images")).string();
+    std::error_code ec;
+    std::filesystem::create_directories(impl_->images_dir, ec);
+    if (ec) throw InputError(impl_->images_dir + ": cannot create the images folder (" + ec.message() + ")");
+  }
   impl_->temp = common::temporaryPathFor(path);
   impl_->layout = layout;
   if (!impl_->out.open(impl_->temp, gz_level)) throw InputError(path + ": cannot write");
@@ -61,7 +89,7 @@ RawlogWriter::~RawlogWriter() {
 void RawlogWriter::write(const Measurement& m) {
   auto arch = mrpt::serialization::archiveFrom(impl_->out);
   if (impl_->layout == RawlogLayout::Observations) {
-    arch << *detail::toMrpt(m);
+    arch << *impl_->observation(m);
   } else if (const auto* od = std::get_if<OdometryReading>(&m)) {
     // Classic layout: the frame gathered so far, then the odometry increment as an action.
     impl_->flushFrame();
@@ -85,7 +113,7 @@ void RawlogWriter::write(const Measurement& m) {
     // without odometry would otherwise end up as a single frame.
     const bool scan = std::holds_alternative<LaserScan>(m);
     if (scan && impl_->frame_has_scan) impl_->flushFrame();
-    impl_->frame->insert(detail::toMrpt(m));
+    impl_->frame->insert(impl_->observation(m));
     impl_->frame_has_scan = impl_->frame_has_scan || scan;
   }
   ++impl_->written;
@@ -101,5 +129,7 @@ void RawlogWriter::close() {
 }
 
 size_t RawlogWriter::written() const { return impl_->written; }
+const std::string& RawlogWriter::lastImageFile() const { return impl_->last_image; }
+const std::string& RawlogWriter::imagesFolder() const { return impl_->images_dir; }
 
 }  // namespace urbanslam::io

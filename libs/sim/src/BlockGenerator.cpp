@@ -4,12 +4,35 @@
 #include <cmath>
 
 #include "urbanslam/sim/Random.h"
+#include "urbanslam/sim/SurfaceTexture.h"
 
 namespace urbanslam::sim {
 
 namespace {
 
 constexpr uint64_t kTagSide = 10, kTagDesign = 11, kTagPark = 12, kTagFurniture = 13;
+// Looks are drawn from hashes of their own, never from the geometry's generators: the camera's
+// attributes leave the walls the laser sees exactly as they were.
+constexpr uint64_t kTagLook = 14, kTagDesignLook = 15, kTagFurnitureLook = 16, kTagParkLook = 17, kTagDeadEndLook = 18;
+
+uint32_t lookId(uint64_t h) { return static_cast<uint32_t>(h >> 32) | 1u; }  // 0 stays "no look"
+
+SurfaceLook makeLook(uint64_t h, SurfaceKind kind) {
+  const uint32_t id = lookId(h);
+  return {id, kind, static_cast<float>(facadeHeight(id, kind))};
+}
+
+// A vertex of a block outline with the look and texture coordinate of the segment it starts.
+struct OutlineVertex {
+  Vec2 p;
+  SurfaceLook look;
+  double u = 0;
+};
+
+void addOutline(std::vector<Segment>& out, const std::vector<OutlineVertex>& v) {
+  for (size_t i = 0; i < v.size(); ++i)
+    out.push_back({v[i].p, v[(i + 1) % v.size()].p, v[i].look, static_cast<float>(v[i].u)});
+}
 
 // A facade along a block side in side coordinates: u along the side, v into the block (v < 0 is
 // the sidewalk). The outline runs from (0, setback) to (width, setback).
@@ -68,27 +91,36 @@ struct SideFrame {
 
 // The facades along one side, appended to the block outline (from its start corner, excluding
 // its end corner). Corner buildings are flush with the street so the sides join cleanly.
-void buildSide(const StreetGrid& g, const SideFrame& s, double length, Rng& rng, std::vector<Vec2>& outline,
-               std::vector<Segment>& out) {
+// Each facade carries its look: a repeated design's copies share one (the camera sees the same
+// building again), every other facade has its own. Texture coordinates run along the facade's
+// outline from its start, so copies of a design are textured identically wherever they stand.
+void buildSide(const StreetGrid& g, const SideFrame& s, double length, Rng& rng, int i, int j, int k,
+               std::vector<OutlineVertex>& outline, std::vector<Segment>& out) {
   const auto& o = g.options();
-  outline.push_back(s.origin);
+  const size_t side_start = outline.size();
+  outline.push_back({s.origin, {}, 0.0});
   double u = 0;
-  while (u < length - 1e-6) {
+  for (int n = 0; u < length - 1e-6; ++n) {
     double w = rng.uniform(o.facade_min_m, o.facade_max_m);
     Facade f;
+    SurfaceLook look = makeLook(hash64(g.seed(), kTagLook, i, j, k * 65536 + n), SurfaceKind::Facade);
     const double kind = rng.uniform();
     if (kind < o.featureless_wall_probability) {
       w *= 2;  // long blank walls: a corridor for scan matching
       f = plainFacade(std::min(w, length - u), 0.0);
       w = std::min(w, length - u);
+      look = makeLook(hash64(g.seed(), kTagLook, i, j, k * 65536 + n), SurfaceKind::Featureless);
     } else if (kind < o.featureless_wall_probability + o.repeated_design_probability) {
       double dw = 0;
-      f = designFacade(g, static_cast<int>(rng.next() % static_cast<uint64_t>(o.design_count)), dw);
+      const int design = static_cast<int>(rng.next() % static_cast<uint64_t>(o.design_count));
+      f = designFacade(g, design, dw);
       if (u + dw > length) {
         w = length - u;
         f = plainFacade(w, 0.0);
+        look.kind = SurfaceKind::Featureless;
       } else {
         w = dw;
+        look = makeLook(hash64(g.seed(), kTagDesignLook, design), SurfaceKind::Facade);
       }
     } else {
       if (length - u - w < o.facade_min_m) w = length - u;  // no sliver at the corner
@@ -96,29 +128,45 @@ void buildSide(const StreetGrid& g, const SideFrame& s, double length, Rng& rng,
       const double setback = corner ? 0.0 : (rng.chance(0.5) ? rng.uniform(0.3, 2.0) : 0.0);
       f = detailedFacade(rng, w, setback);
     }
-    for (const Vec2& p : f.outline) outline.push_back(s.at({u + p.x, p.y}));
+    double fu = 0;  // arc length along this facade's outline
+    for (size_t q = 0; q < f.outline.size(); ++q) {
+      if (q > 0) fu += norm(f.outline[q] - f.outline[q - 1]);
+      outline.push_back({s.at({u + f.outline[q].x, f.outline[q].y}), look, fu});
+    }
+    if (n == 0) {  // the side's corner vertex starts the first facade's texture
+      outline[side_start].look = look;
+      outline[side_start].u = -norm(outline[side_start + 1].p - s.origin);
+    }
     for (const auto& e : f.extras) {
       std::vector<Vec2> poly;
       for (const Vec2& p : e) poly.push_back(s.at({u + p.x, p.y}));
-      addPolygon(out, poly);
+      // The arcade's pillars carry its ground floor; the wall behind them shows above.
+      const double pillar_h = SurfaceTexture({look.id, SurfaceKind::Facade, 0.f}).groundFloorHeight();
+      addPolygon(out, poly, {look.id, SurfaceKind::Pillar, static_cast<float>(pillar_h)});
     }
     u += w;
   }
 }
 
 // Trees, lamp posts and parked cars on the sidewalk and parking lane beside one block side.
-void buildFurniture(const StreetGrid& g, const SideFrame& s, double length, Rng& rng, std::vector<Segment>& out) {
+void buildFurniture(const StreetGrid& g, const SideFrame& s, double length, Rng& rng, int i, int j, int k,
+                    std::vector<Segment>& out) {
   const auto& o = g.options();
   const double sw = g.sidewalkWidth(), pk = g.parkingWidth();
+  int n = 0;
+  auto look = [&](SurfaceKind kind) {
+    return makeLook(hash64(g.seed(), kTagFurnitureLook, i, j, k * 65536 + n++), kind);
+  };
   if (o.tree_spacing_m > 0 && rng.chance(o.tree_probability)) {
     for (double u = 4.0 + rng.uniform(0, o.tree_spacing_m); u < length - 4.0;
          u += o.tree_spacing_m * rng.uniform(0.7, 1.3))
-      addCircle(out, s.at({u, -0.6 * sw}), rng.uniform(0.15, 0.35));
+      addCircle(out, s.at({u, -0.6 * sw}), rng.uniform(0.15, 0.35), 6, look(SurfaceKind::Tree));
   }
   if (o.lamp_post_spacing_m > 0) {
     for (double u = 3.0 + rng.uniform(0, o.lamp_post_spacing_m); u < length - 3.0; u += o.lamp_post_spacing_m) {
       const Vec2 c = s.at({u, -0.85 * sw});
-      addPolygon(out, {{c.x - 0.1, c.y - 0.1}, {c.x + 0.1, c.y - 0.1}, {c.x + 0.1, c.y + 0.1}, {c.x - 0.1, c.y + 0.1}});
+      addPolygon(out, {{c.x - 0.1, c.y - 0.1}, {c.x + 0.1, c.y - 0.1}, {c.x + 0.1, c.y + 0.1}, {c.x - 0.1, c.y + 0.1}},
+                 look(SurfaceKind::LampPost));
     }
   }
   if (o.parked_car_probability > 0) {
@@ -127,22 +175,28 @@ void buildFurniture(const StreetGrid& g, const SideFrame& s, double length, Rng&
       if (!rng.chance(o.parked_car_probability)) continue;
       const double len = rng.uniform(3.8, 4.9), wid = rng.uniform(1.6, 1.9);
       addRectangle(out, s.at({u + 2.5 + rng.uniform(-0.4, 0.4), -sw - pk / 2 + rng.uniform(-0.1, 0.1)}), heading,
-                   len, wid);
+                   len, wid, look(SurfaceKind::ParkedCar));
     }
   }
 }
 
 // Open space: a park of trees, or a paved square with a fountain and lamp posts.
-void buildPark(const Box& b, Rng& rng, std::vector<Segment>& out) {
+void buildPark(const Box& b, Rng& rng, uint64_t look_seed, std::vector<Segment>& out) {
+  int n = 0;
+  auto look = [&](SurfaceKind kind) { return makeLook(hash64(look_seed, kTagParkLook, n++), kind); };
   if (rng.chance(0.5)) {
     for (double x = b.x0 + 6; x < b.x1 - 4; x += rng.uniform(7, 12))
       for (double y = b.y0 + 6; y < b.y1 - 4; y += rng.uniform(7, 12))
-        if (rng.chance(0.6)) addCircle(out, {x + rng.uniform(-2, 2), y + rng.uniform(-2, 2)}, rng.uniform(0.15, 0.4));
+        if (rng.chance(0.6)) {
+          const Vec2 c{x + rng.uniform(-2, 2), y + rng.uniform(-2, 2)};
+          addCircle(out, c, rng.uniform(0.15, 0.4), 6, look(SurfaceKind::Tree));
+        }
   } else {
-    addCircle(out, {(b.x0 + b.x1) / 2, (b.y0 + b.y1) / 2}, rng.uniform(2.0, 5.0), 12);
+    addCircle(out, {(b.x0 + b.x1) / 2, (b.y0 + b.y1) / 2}, rng.uniform(2.0, 5.0), 12, look(SurfaceKind::Fountain));
     for (double x = b.x0 + 5; x < b.x1 - 4; x += 15)
       for (double y : {b.y0 + 5, b.y1 - 5})
-        addPolygon(out, {{x - 0.1, y - 0.1}, {x + 0.1, y - 0.1}, {x + 0.1, y + 0.1}, {x - 0.1, y + 0.1}});
+        addPolygon(out, {{x - 0.1, y - 0.1}, {x + 0.1, y - 0.1}, {x + 0.1, y + 0.1}, {x - 0.1, y + 0.1}},
+                   look(SurfaceKind::LampPost));
   }
 }
 
@@ -159,18 +213,18 @@ void generateBlock(const StreetGrid& g, int i, int j, std::vector<Segment>& out)
   const double lengths[4] = {b.x1 - b.x0, b.y1 - b.y0, b.x1 - b.x0, b.y1 - b.y0};
   if (g.isPark(i, j)) {
     Rng rng(hash64(g.seed(), kTagPark, i, j));
-    buildPark(b, rng, out);
+    buildPark(b, rng, hash64(g.seed(), kTagParkLook, i, j), out);
   } else {
-    std::vector<Vec2> outline;
+    std::vector<OutlineVertex> outline;
     for (int k = 0; k < 4; ++k) {
       Rng rng(hash64(g.seed(), kTagSide, i, j, k));
-      buildSide(g, sides[k], lengths[k], rng, outline, out);
+      buildSide(g, sides[k], lengths[k], rng, i, j, k, outline, out);
     }
-    addPolygon(out, outline);
+    addOutline(out, outline);
   }
   for (int k = 0; k < 4; ++k) {
     Rng rng(hash64(g.seed(), kTagFurniture, i, j, k));
-    buildFurniture(g, sides[k], lengths[k], rng, out);
+    buildFurniture(g, sides[k], lengths[k], rng, i, j, k, out);
   }
 }
 
@@ -181,8 +235,9 @@ void generateDeadEnd(const StreetGrid& g, int axis, int i, int j, std::vector<Se
   const double s0 = (axis == 0 ? a.x : a.y) + h, s1 = (axis == 0 ? b.x : b.y) - h, mid = (s0 + s1) / 2;
   const double lo = g.deadEndClosedAtEnd(axis, i, j) ? mid : s0, hi = g.deadEndClosedAtEnd(axis, i, j) ? s1 : mid;
   const double c = axis == 0 ? a.y : a.x;
-  if (axis == 0) addPolygon(out, {{lo, c - h}, {hi, c - h}, {hi, c + h}, {lo, c + h}});
-  else addPolygon(out, {{c - h, lo}, {c + h, lo}, {c + h, hi}, {c - h, hi}});
+  const SurfaceLook look = makeLook(hash64(g.seed(), kTagDeadEndLook, axis, i, j), SurfaceKind::Barrier);
+  if (axis == 0) addPolygon(out, {{lo, c - h}, {hi, c - h}, {hi, c + h}, {lo, c + h}}, look);
+  else addPolygon(out, {{c - h, lo}, {c + h, lo}, {c + h, hi}, {c - h, hi}}, look);
 }
 
 }  // namespace urbanslam::sim

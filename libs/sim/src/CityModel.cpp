@@ -47,6 +47,11 @@ std::vector<Segment> CityModel::segmentsNear(const Box& box) const {
 }
 
 double CityModel::raycast(Vec2 o, Vec2 d, double max_range) const {
+  RayHit hit;
+  return raycast(o, d, max_range, hit) ? hit.range : kNoHit;
+}
+
+bool CityModel::raycast(Vec2 o, Vec2 d, double max_range, RayHit& hit) const {
   // Amanatides-Woo walk over the global cell grid (tiles are whole numbers of cells). A hit found
   // in a cell counts only if it lies within that cell: a long segment may be hit further on.
   const double cell = tile_m_ / cells_;
@@ -69,9 +74,22 @@ double CityModel::raycast(Vec2 o, Vec2 d, double max_range) const {
     const size_t c = static_cast<size_t>(cy - tty * cells_) * cells_ + (cx - ttx * cells_);
     const double t_exit = std::min(tx, ty);
     double best = inf;
-    for (uint32_t k = t->offset[c]; k < t->offset[c + 1]; ++k)
-      best = std::min(best, raySegment(o, d, t->segments[t->index[k]]));
-    if (best <= t_exit + 1e-9) return best <= max_range ? best : kNoHit;
+    uint32_t best_k = 0;
+    for (uint32_t k = t->offset[c]; k < t->offset[c + 1]; ++k) {
+      const double r = raySegment(o, d, t->segments[t->index[k]]);
+      if (r < best) {
+        best = r;
+        best_k = t->index[k];
+      }
+    }
+    if (best <= t_exit + 1e-9) {
+      if (best > max_range) return false;
+      hit.range = best;
+      hit.segment = t->segments[best_k];
+      const Vec2 p = o + best * d;
+      hit.u_m = hit.segment.u0_m + norm(p - hit.segment.a);
+      return true;
+    }
     if (tx < ty) {
       t_enter = tx;
       tx += dtx;
@@ -82,7 +100,7 @@ double CityModel::raycast(Vec2 o, Vec2 d, double max_range) const {
       cy += sy;
     }
   }
-  return kNoHit;
+  return false;
 }
 
 }  // namespace urbanslam::sim

@@ -26,8 +26,12 @@ int64_t LoopTruthFinder::cellKey(Vec2 p) const {
 
 std::vector<LoopPair> LoopTruthFinder::add(const io::LaserScan& scan, const common::Pose2& vehicle) {
   const common::Pose2 sp = common::compose(vehicle, scan.sensor_pose);
-  Entry e{scan.timestamp, {sp.x, sp.y}, {}};
-  for (const Vec2& p : endPoints(scan, vehicle, options_.point_stride)) {
+  return add(scan.timestamp, {sp.x, sp.y}, endPoints(scan, vehicle, options_.point_stride));
+}
+
+std::vector<LoopPair> LoopTruthFinder::add(double t, Vec2 sensor, const std::vector<Vec2>& points) {
+  Entry e{t, sensor, {}};
+  for (const Vec2& p : points) {
     e.xy.push_back(static_cast<float>(p.x));
     e.xy.push_back(static_cast<float>(p.y));
   }

@@ -65,6 +65,24 @@ void declareSimOptions(common::OptionsSchema& s, SimOptions& o) {
   s.add("y_m", l.y_m, -10.0, 10.0, "m", "mounting: to the left");
   s.add("yaw_deg", l.yaw_deg, -180.0, 180.0, "deg", "mounting: heading");
 
+  auto& cam = o.camera;
+  s.section("camera", "Camera rendered from the city (facade textures; images go to DIR/city_Images/)");
+  s.add("enabled", cam.enabled, "simulate the camera");
+  s.add("label", cam.label, {}, "sensor label in the rawlog");
+  s.add("rate_hz", cam.rate_hz, 0.01, 100.0, "Hz", "images per second");
+  s.add("width_px", cam.width_px, 16, 8192, "px", "image width");
+  s.add("height_px", cam.height_px, 16, 8192, "px", "image height");
+  s.add("hfov_deg", cam.hfov_deg, 10.0, 170.0, "deg", "horizontal field of view (square pixels)");
+  s.add("cy_px", cam.cy_px, -1.0, 8192.0, "px", "image row of the horizon (lens shift); -1: the centre");
+  s.add("x_m", cam.x_m, -10.0, 10.0, "m", "mounting: forward of the rear axle");
+  s.add("y_m", cam.y_m, -10.0, 10.0, "m", "mounting: to the left");
+  s.add("yaw_deg", cam.yaw_deg, -180.0, 180.0, "deg", "mounting: viewing direction (0 forward, 90 left, -90 right)");
+  s.add("height_m", cam.height_m, 0.2, 10.0, "m", "mounting: height above the ground");
+  s.add("max_range_m", cam.max_range_m, 1.0, 1000.0, "m", "walls beyond are not drawn");
+  s.add("fog_distance_m", cam.fog_distance_m, 0.0, 100000.0, "m", "distance fog scale; 0: none");
+  s.add("noise_sigma", cam.noise_sigma, 0.0, 50.0, "grey levels", "pixel noise, 1 sigma");
+  s.add("noise_seed", cam.noise_seed, 0, 2147483647, "", "noise stream (combined with [city] seed)");
+
   auto& d = o.odometry;
   s.section("odometry", "Wheel odometry (wheel speed + steering encoder)");
   s.add("enabled", d.enabled, "simulate odometry");
@@ -100,12 +118,16 @@ void declareSimOptions(common::OptionsSchema& s, SimOptions& o) {
   s.add("clearance_m", t.clearance_m, 0.0, 100.0, "m", "moving objects this close to the car are left out (no collisions)");
 
   auto& p = o.loops;
-  s.section("loops", "Ground-truth loop pairs (loops.csv)");
+  s.section("loops", "Ground-truth loop pairs (loops.csv; with a camera also image_loops.csv)");
   s.add("min_gap_s", p.min_gap_s, 0.0, 1e6, "s", "pairs at least this far apart in time");
   s.add("max_distance_m", p.max_distance_m, 0.1, 1000.0, "m", "sensor positions at most this far apart");
   s.add("match_radius_m", p.match_radius_m, 0.01, 10.0, "m", "an end point overlaps when the other scan has one this close");
   s.add("min_overlap", p.min_overlap, 0.0, 1.0, "", "reported from this overlap fraction");
   s.add("point_stride", p.point_stride, 1, 100, "beams", "compare every n-th beam end point");
+  s.add("image_max_heading_deg", p.image_max_heading_deg, 0.0, 180.0, "deg",
+        "image loop pairs (image_loops.csv): viewing directions at most this far apart");
+  s.add("image_column_stride", p.image_column_stride, 1, 1000, "columns",
+        "image loop pairs: wall points of every n-th image column are compared");
 }
 
 SimOptions loadSimOptions(const std::string& path, std::string* resolved_ini) {

@@ -1,6 +1,7 @@
 #include "urbanslam/sim/SimulatedSource.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -13,6 +14,7 @@ SimulatedSource::SimulatedSource(const SimOptions& options)
   traffic_ = std::make_unique<Traffic>(city_->streets(), options.traffic);
   driver_ = std::make_unique<Driver>(city_->streets(), options);
   if (options.laser.enabled) laser_ = std::make_unique<LaserSimulator>(options.laser, *city_, traffic_.get(), seed);
+  if (options.camera.enabled) camera_ = std::make_unique<CameraRenderer>(options.camera, *city_, seed);
   if (options.odometry.enabled)
     odometry_ = std::make_unique<OdometrySimulator>(options.odometry, options.vehicle.wheelbase_m, seed);
   if (options.gps.enabled) gps_ = std::make_unique<GpsSimulator>(options.gps, seed);
@@ -28,7 +30,8 @@ void SimulatedSource::produce() {
   const double tl = laser_ ? static_cast<double>(laser_count_) / options_.laser.rate_hz : inf;
   const double to = odometry_ ? static_cast<double>(odometry_count_) / options_.odometry.rate_hz : inf;
   const double tg = gps_ ? static_cast<double>(gps_count_) / options_.gps.rate_hz : inf;
-  const double t = std::min({tl, to, tg});
+  const double tc = camera_ ? static_cast<double>(camera_count_) / options_.camera.rate_hz : inf;
+  const double t = std::min({tl, to, tg, tc});
   if (t == inf || driver_->finished()) {
     done_ = true;
     return;
@@ -46,13 +49,23 @@ void SimulatedSource::produce() {
     if (gps_->read(s, stamp, fix)) pending_.push_back(fix);
     ++gps_count_;
   }
-  if (tl <= t + eps) {
-    pending_.push_back(io::ReferencePose{stamp, s.pose});
-    pending_.push_back(laser_->scan(laser_count_, t, stamp, s.pose));
-    const double r = options_.laser.max_range_m;
+  const bool scan = tl <= t + eps, image = tc <= t + eps;
+  if (scan || image) pending_.push_back(io::ReferencePose{stamp, s.pose});
+  auto see = [&](double r) {
     for (int tx = city_->tileOf(s.pose.x - r); tx <= city_->tileOf(s.pose.x + r); ++tx)
       for (int ty = city_->tileOf(s.pose.y - r); ty <= city_->tileOf(s.pose.y + r); ++ty) seen_tiles_.insert({tx, ty});
+  };
+  if (scan) {
+    pending_.push_back(laser_->scan(laser_count_, t, stamp, s.pose));
+    see(options_.laser.max_range_m);
     ++laser_count_;
+  }
+  if (image) {
+    const auto start = std::chrono::steady_clock::now();
+    pending_.push_back(camera_->render(camera_count_, stamp, common::compose(s.pose, cameraMount(options_.camera))));
+    render_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    see(options_.camera.max_range_m);
+    ++camera_count_;
   }
 }
 

@@ -1,8 +1,10 @@
 #include "urbanslam/sim/SimulationOutputs.h"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 
 #include "urbanslam/common/AtomicFile.h"
 #include "urbanslam/common/Error.h"
@@ -24,10 +26,34 @@ SimulationSummary writeSimulation(const SimOptions& options, const std::string& 
 
   SimulationSummary sum;
   SimulatedSource source(options);
-  io::RawlogWriter rawlog(dir + "/city.rawlog", io::RawlogLayout::Observations);
+  const bool camera = options.camera.enabled;
+  if (camera) {
+    // Images of an earlier run in this folder would mix with this one's in a folder listing.
+    const std::filesystem::path images(dir + "/city_Images");
+    if (std::filesystem::is_directory(images, ec))
+      for (const auto& f : std::filesystem::directory_iterator(images, ec)) {
+        const std::string name = f.path().filename().string();
+        if (f.path().extension() == ".png" && name.rfind(options.camera.label + "_", 0) == 0)
+          std::filesystem::remove(f.path(), ec);
+      }
+  }
+  io::RawlogWriter rawlog(dir + "/city.rawlog", io::RawlogLayout::Observations, 5,
+                          camera ? io::ImageStorage::External : io::ImageStorage::Embedded);
   common::AtomicFile loops(dir + "/loops.csv");
   loops.stream() << "t_old,t_new,overlap,distance_m\n";
   LoopTruthFinder finder(options.loops);
+  // Image loop truth: the wall points the image columns see, paired like scans, and the views'
+  // directions within image_max_heading_deg (from the other side of a thin object, or along a
+  // wall from the other end, points are shared without the images looking alike).
+  std::unique_ptr<common::AtomicFile> image_loops;
+  if (camera) {
+    image_loops = std::make_unique<common::AtomicFile>(dir + "/image_loops.csv");
+    image_loops->stream() << "t_old,t_new,overlap,distance_m\n";
+  }
+  LoopTruthFinder image_finder(options.loops);
+  std::map<double, std::pair<std::string, double>> image_at;  // time -> (name, camera heading)
+  std::vector<std::pair<std::string, std::vector<std::string>>> image_truth;  // eval-image-loop format
+  const double max_heading = options.loops.image_max_heading_deg * M_PI / 180.0;
   // The truth at scan times: 32 bytes a scan (a 1000 km drive: ~3 MB), written at the end.
   std::vector<io::StampedPose> truth;
   common::Pose2 last_truth;
@@ -56,6 +82,32 @@ SimulationSummary writeSimulation(const SimOptions& options, const std::string& 
           ++sum.loop_pairs;
         }
       }
+    } else if (const auto* img = std::get_if<io::CameraImage>(&m)) {
+      ++sum.images;
+      if (have_truth) {  // yielded with the image's reference pose just before it
+        const common::Pose2 cam = common::compose(last_truth, cameraMount(options.camera));
+        std::string name = rawlog.lastImageFile();
+        name = name.substr(0, name.rfind('.'));
+        image_at[img->timestamp] = {name, cam.phi};
+        const CameraRenderer& r = *source.camera();
+        const std::vector<double> ranges = r.columnRanges(cam);
+        std::vector<Vec2> points;
+        for (size_t x = 0; x < ranges.size(); x += static_cast<size_t>(options.loops.image_column_stride)) {
+          if (!(ranges[x] < kNoHit)) continue;
+          const double a = cam.phi + r.columnBearing(static_cast<int>(x));
+          points.push_back({cam.x + ranges[x] * std::cos(a), cam.y + ranges[x] * std::sin(a)});
+        }
+        std::vector<std::string> matches;
+        for (const LoopPair& p : image_finder.add(img->timestamp, {cam.x, cam.y}, points)) {
+          const auto old = image_at.find(p.t_old);
+          if (old == image_at.end() || std::fabs(common::wrapToPi(cam.phi - old->second.second)) > max_heading) continue;
+          std::snprintf(buf, sizeof buf, "%.6f,%.6f,%.4f,%.3f\n", p.t_old, p.t_new, p.overlap, p.distance_m);
+          image_loops->stream() << buf;
+          ++sum.image_loop_pairs;
+          matches.push_back(old->second.first);
+        }
+        if (!matches.empty()) image_truth.emplace_back(name, std::move(matches));
+      }
     } else if (std::holds_alternative<io::OdometryReading>(m)) {
       ++sum.odometry;
     } else if (std::holds_alternative<io::GpsFix>(m)) {
@@ -65,6 +117,19 @@ SimulationSummary writeSimulation(const SimOptions& options, const std::string& 
   }
   rawlog.close();
   loops.commit();
+  if (image_loops) {
+    image_loops->commit();
+    common::AtomicFile gt(dir + "/image_loops.txt");
+    gt.stream() << "# urbanslam simulate: for each image that closes a loop, the earlier images showing the same\n"
+                   "# place (images in city_Images/; the pairs of image_loops.csv). For eval-image-loop --gt.\n";
+    for (const auto& [query, matches] : image_truth) {
+      gt.stream() << query;
+      for (const auto& m2 : matches) gt.stream() << ' ' << m2;
+      gt.stream() << '\n';
+    }
+    gt.commit();
+    sum.loop_images = image_truth.size();
+  }
   io::writeTum(dir + "/truth.tum", truth);
   const WallsSummary walls = writeWalls(source.city(), source.seenTiles(), dir + "/walls.csv", dir + "/walls.png");
   common::AtomicFile config(dir + "/config.ini");
@@ -78,6 +143,7 @@ SimulationSummary writeSimulation(const SimOptions& options, const std::string& 
   sum.tiles_built = source.city().tilesBuilt();
   sum.revisits_planned = source.driver().planner().revisitsPlanned();
   sum.simulate_wall_s = sim_s;
+  sum.render_wall_s = source.renderSeconds();
   sum.total_wall_s = std::chrono::duration<double>(Clock::now() - start).count();
   return sum;
 }

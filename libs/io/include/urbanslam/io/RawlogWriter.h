@@ -14,14 +14,26 @@ enum class RawlogLayout {
   SensoryFrames,  // CActionCollection (odometry increment) / CSensoryFrame pairs (classic)
 };
 
+enum class ImageStorage {
+  Embedded,  // pixels inside the rawlog
+  External,  // PNG files in "<rawlog name>_Images/" beside it, referenced by name (MRPT's
+             // convention, which RawlogViewer and our reader follow): rawlogs stay small
+};
+
 class RawlogWriter {
  public:
-  RawlogWriter(const std::string& path, RawlogLayout layout, int gz_level = 5);
+  RawlogWriter(const std::string& path, RawlogLayout layout, int gz_level = 5,
+               ImageStorage images = ImageStorage::Embedded);
   ~RawlogWriter();
   void write(const Measurement& m);
   // Flushes and renames into place. Without close(), the temporary file is removed.
   void close();
   size_t written() const;
+  // External images: the file name (inside the images folder) of the last image written, named
+  // "<label>_<number>.png" in order of writing.
+  const std::string& lastImageFile() const;
+  // The images folder (External), created by the constructor.
+  const std::string& imagesFolder() const;
 
  private:
   struct Impl;

@@ -16,7 +16,24 @@
 
 namespace urbanslam::sim {
 
-class CityModel {
+// The first wall along a ray: its distance, the segment (with its look) and the texture
+// coordinate of the hit point along it.
+struct RayHit {
+  double range = kNoHit;
+  Segment segment;
+  double u_m = 0;
+};
+
+// What a camera looks at: anything that answers rays with walls (the city, or a few known walls
+// in a test).
+class WallRayCaster {
+ public:
+  virtual ~WallRayCaster() = default;
+  // The first wall along the ray (unit dir) within max_range; false: none.
+  virtual bool raycast(Vec2 origin, Vec2 dir, double max_range, RayHit& hit) const = 0;
+};
+
+class CityModel : public WallRayCaster {
  public:
   explicit CityModel(const CityOptions& options);
 
@@ -32,6 +49,8 @@ class CityModel {
   // Distance along the ray (unit dir) to the first wall, or kNoHit within max_range. Visits only
   // the grid cells, and so the tiles, the ray crosses.
   double raycast(Vec2 origin, Vec2 dir, double max_range) const;
+  // The same walk, telling which wall was hit (false: none within max_range).
+  bool raycast(Vec2 origin, Vec2 dir, double max_range, RayHit& hit) const override;
 
   size_t tilesBuilt() const { return built_; }
   size_t tilesCached() const { return lru_.size(); }

@@ -24,6 +24,8 @@ class LoopTruthFinder {
   explicit LoopTruthFinder(const LoopTruthOptions& options);
   // Adds a scan taken at the true vehicle pose and returns the pairs it forms with earlier scans.
   std::vector<LoopPair> add(const io::LaserScan& scan, const common::Pose2& vehicle);
+  // The same for any sensor: what it saw as wall points (world frame) from its position.
+  std::vector<LoopPair> add(double t, Vec2 sensor, const std::vector<Vec2>& points);
 
   // The beam end points the overlap is computed from: every point_stride-th beam, if valid.
   static std::vector<Vec2> endPoints(const io::LaserScan& scan, const common::Pose2& vehicle, int stride);

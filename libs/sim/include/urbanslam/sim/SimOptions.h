@@ -45,6 +45,24 @@ struct LaserOptions {
   double x_m = 1.5, y_m = 0.0, yaw_deg = 0.0;  // mounting pose on the vehicle (rear axle frame)
 };
 
+// A camera rendered from the city's walls (column ray casting, procedural facade textures).
+// Looks horizontally; cy_px below the image centre shows more of the facades above the horizon,
+// as a lens shift would (the image columns stay vertical).
+struct CameraOptions {
+  bool enabled = false;
+  std::string label = "CAMERA";
+  double rate_hz = 2.0;
+  int width_px = 640, height_px = 480;
+  double hfov_deg = 90.0;        // horizontal field of view (square pixels: fy = fx)
+  double cy_px = -1.0;           // row of the horizon; < 0: the image centre
+  double x_m = 1.0, y_m = 0.0, yaw_deg = 0.0;  // mounting pose on the vehicle (rear axle frame)
+  double height_m = 1.6;         // above the ground
+  double max_range_m = 150.0;    // nothing drawn beyond (sky and ground only)
+  double fog_distance_m = 250.0; // distance fog: contrast falls by 1/e over this; 0: none
+  double noise_sigma = 2.0;      // pixel noise (grey levels, 1 sigma)
+  int noise_seed = 0;            // with the city seed: the noise stream (same city, other noise)
+};
+
 struct OdometryOptions {
   bool enabled = true;
   double rate_hz = 50.0;
@@ -88,6 +106,10 @@ struct LoopTruthOptions {
   double match_radius_m = 0.3;    // a beam end point overlaps when the other scan has one this close
   double min_overlap = 0.5;       // reported when at least this fraction overlaps
   int point_stride = 4;           // every n-th beam end point is compared
+  // Image loop pairs (image_loops.csv) use the keys above on the wall points of every
+  // image_column_stride-th image column, and need the views to point within this angle.
+  double image_max_heading_deg = 45.0;
+  int image_column_stride = 8;
 };
 
 struct SimOptions {
@@ -95,6 +117,7 @@ struct SimOptions {
   VehicleOptions vehicle;
   RouteOptions route;
   LaserOptions laser;
+  CameraOptions camera;
   OdometryOptions odometry;
   GpsOptions gps;
   TrafficOptions traffic;
@@ -106,5 +129,6 @@ void declareSimOptions(common::OptionsSchema& s, SimOptions& o);
 SimOptions loadSimOptions(const std::string& path, std::string* resolved_ini = nullptr);
 
 inline common::Pose2 laserMount(const LaserOptions& l) { return {l.x_m, l.y_m, l.yaw_deg * M_PI / 180.0}; }
+inline common::Pose2 cameraMount(const CameraOptions& c) { return {c.x_m, c.y_m, c.yaw_deg * M_PI / 180.0}; }
 
 }  // namespace urbanslam::sim

@@ -1,8 +1,11 @@
 #pragma once
-// A whole simulated drive written to a folder: city.rawlog (MRPT, observations layout),
-// truth.tum (true vehicle poses at the scan times), loops.csv (ground-truth loop pairs),
-// walls.csv + walls.png (the walls of the tiles the drive saw) and config.ini (the resolved
-// options). Every file is written under a temporary name and renamed when complete.
+// A whole simulated drive written to a folder: city.rawlog (MRPT, observations layout; camera
+// images as PNG files in city_Images/, referenced from the rawlog), truth.tum (true vehicle
+// poses at the scan and image times), loops.csv (ground-truth loop pairs of scans),
+// image_loops.csv (the same for images) and image_loops.txt (the image pairs in the ground-truth
+// format of eval-image-loop), walls.csv + walls.png (the walls of the tiles the drive saw) and
+// config.ini (the resolved options). Every file but the images is written under a temporary name
+// and renamed when complete.
 #include <functional>
 #include <string>
 
@@ -14,6 +17,8 @@ struct SimulationSummary {
   double duration_s = 0;      // simulated time
   double distance_m = 0;
   size_t scans = 0, odometry = 0, gps = 0, measurements = 0;
+  size_t images = 0, image_loop_pairs = 0, loop_images = 0;  // loop_images: images that close a loop
+  double render_wall_s = 0;    // of simulate_wall_s: rendering images
   size_t loop_pairs = 0;
   size_t wall_segments = 0;
   size_t tiles_seen = 0, tiles_built = 0;
