@@ -9,7 +9,7 @@
 #include "urbanslam/alignment/FreeSpace.h"
 #include "urbanslam/esdf/Gating.h"
 #include "urbanslam/esdf/PoseOps.h"
-#include "urbanslam/slam/Pipeline.h"
+#include "urbanslam/slam/Map.h"
 
 namespace urbanslam::slam {
 
@@ -20,35 +20,14 @@ double largestPositionSigma(const Eigen::Matrix3d& cov) {
 }
 }  // namespace
 
-void KeyframeGrid::insert(size_t index, double x, double y) {
-  cells_[key(static_cast<long>(std::floor(x / cell_m_)), static_cast<long>(std::floor(y / cell_m_)))].push_back(index);
-}
-
-void KeyframeGrid::query(double x, double y, double radius, std::vector<size_t>& out) const {
-  const long x0 = static_cast<long>(std::floor((x - radius) / cell_m_)), x1 = static_cast<long>(std::floor((x + radius) / cell_m_));
-  const long y0 = static_cast<long>(std::floor((y - radius) / cell_m_)), y1 = static_cast<long>(std::floor((y + radius) / cell_m_));
-  for (long cx = x0; cx <= x1; ++cx)
-    for (long cy = y0; cy <= y1; ++cy) {
-      const auto it = cells_.find(key(cx, cy));
-      if (it != cells_.end()) out.insert(out.end(), it->second.begin(), it->second.end());
-    }
-}
-
 LoopCloser::LoopCloser(const LoopClosureOptions& options)
-    : options_(options), grid_(std::max(1.0, options.search_radius_m)),
+    : options_(options),
       chi2_2dof_(esdf::chi2Quantile(options.mahalanobis_probability, 2)) {}
 
 void LoopCloser::setScorer(CandidateScorer scorer, std::string name) {
   scorer_ = std::move(scorer);
   detector_ = std::move(name);
 }
-
-void LoopCloser::rebuildIndex(const std::vector<Keyframe>& keyframes) {
-  grid_.clear();
-  for (const auto& k : keyframes) addToIndex(k);
-}
-
-void LoopCloser::addToIndex(const Keyframe& kf) { grid_.insert(kf.index, kf.pose.x, kf.pose.y); }
 
 // Covariance of the relative pose ⊖x_i ⊕ x_k from the (conservative) joint covariance. Kept for
 // the current keyframe: the candidate search computes it, the alignment choice reuses it.
@@ -68,7 +47,8 @@ Eigen::Matrix3d LoopCloser::relativeCovariance(esdf::Esdf& filter, size_t i, siz
   return s;
 }
 
-std::vector<size_t> LoopCloser::candidates(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t current) {
+std::vector<size_t> LoopCloser::candidates(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, const KeyframeGrid& grid,
+                                            size_t current) {
   const auto& cur = keyframes[current];
   if (current < static_cast<size_t>(options_.min_keyframe_gap)) return {};
   const size_t newest_allowed = current - static_cast<size_t>(options_.min_keyframe_gap);
@@ -78,7 +58,7 @@ std::vector<size_t> LoopCloser::candidates(esdf::Esdf& filter, const std::vector
   const double sigma = largestPositionSigma(c);
   const double radius = options_.search_radius_m + 3 * sigma;
   std::vector<size_t> near;
-  grid_.query(cur.pose.x, cur.pose.y, radius, near);
+  grid.query(cur.pose.x, cur.pose.y, radius, near);
   std::vector<std::pair<double, size_t>> initial;
   for (size_t i : near) {
     if (i > newest_allowed) continue;

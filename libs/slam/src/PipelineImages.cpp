@@ -4,7 +4,6 @@
 #include <opencv2/core.hpp>
 
 #include "urbanslam/common/Timing.h"
-#include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/slam/Pipeline.h"
 #include "urbanslam/vision_loop/LoopDetector.h"
 #include "urbanslam/vision_loop/VocabularyFile.h"
@@ -35,16 +34,16 @@ void Pipeline::onCameraImage(const io::CameraImage& image, double progress) {
   none.timestamp = image.timestamp;
   none.label = image.label;
   addKeyframe(std::move(none));
-  attachImage(images_.imageKeyframe(keyframes_.size() - 1, image));
+  attachImage(images_.imageKeyframe(map_.size() - 1, image));
   const double ms = sw.milliseconds();
   stats_.keyframe_ms.push_back(ms);
-  stats_.recordStep(ms, keyframes_.size());
-  StepEvent ev{stats_.scans_used, keyframes_.size(), stats_.last_timestamp, ms, progress};
+  stats_.recordStep(ms, map_.size());
+  StepEvent ev{stats_.scans_used, map_.size(), stats_.last_timestamp, ms, progress};
   for (auto* o : observers_) o->onStep(ev);
 }
 
 void Pipeline::attachImage(const AssignedImage& assigned) {
-  Keyframe& kf = keyframes_[assigned.keyframe];
+  Keyframe& kf = map_.keyframe(assigned.keyframe);
   kf.has_image = true;
   ++stats_.image_keyframes;
   for (auto* o : observers_) o->onKeyframeImage({assigned.keyframe, &assigned.image});
@@ -58,42 +57,7 @@ void Pipeline::attachImage(const AssignedImage& assigned) {
   kf.image_words = bag;
   const vision_loop::LoopResult r = image_detector_->process(std::move(features), std::move(bag));
   image_keyframes_.push_back(assigned.keyframe);
-  if (r.detected()) proposeImageClosure(image_keyframes_[r.match], assigned.keyframe, r.normalized_score);
-}
-
-void Pipeline::proposeImageClosure(size_t earlier, size_t current, double score) {
-  ++stats_.image_proposals;
-  ImageMatchEvent ev{current, earlier, score, false, ""};
-  const bool filter = options_.estimator.type == "esdf";
-  if (filter && options_.loop_closure.enabled && keyframes_[earlier].hasScan() && keyframes_[current].hasScan()) {
-    // The same path as a laser candidate: alignment, gating, confirmation by a second closure.
-    common::Stopwatch sw;
-    expirePending(current);
-    const bool confirm = options_.loop_closure.confirm_window > 0;
-    const Detection detection{"image", score};
-    LoopClosureRecord r = closer_.tryClose(*esdf_, keyframes_, earlier, current, !confirm, &detection);
-    ++stats_.closures_tried;
-    const std::string reason = r.reason;
-    const Admission a = admit(std::move(r), current);
-    ev.accepted = a == Admission::Accepted;
-    ev.fate = a == Admission::Accepted ? "accepted" : a == Admission::Pending ? "pending" : (reason.empty() ? "gating" : reason);
-    if (ev.accepted) recoverAll();
-    stats_.closure_ms.push_back(sw.milliseconds());
-  } else {
-    // Without scans (or a filter) the pair cannot be aligned: a proposal on record, never a
-    // constraint.
-    LoopClosureRecord r;
-    r.from = earlier;
-    r.to = current;
-    r.from_time = keyframes_[earlier].timestamp;
-    r.to_time = keyframes_[current].timestamp;
-    r.detector = "image";
-    r.score = score;
-    r.reason = !filter ? "no_filter" : !options_.loop_closure.enabled ? "loop_closure_disabled" : "no_scans";
-    ev.fate = r.reason;
-    reportClosure(r);
-  }
-  for (auto* o : observers_) o->onImageMatch(ev);
+  if (r.detected()) global_.proposeImageClosure(image_keyframes_[r.match], assigned.keyframe, r.normalized_score);
 }
 
 }  // namespace urbanslam::slam

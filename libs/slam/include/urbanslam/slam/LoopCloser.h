@@ -12,6 +12,7 @@
 #include "urbanslam/alignment/Aligner.h"
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/io/LaserScan.h"
+#include "urbanslam/slam/KeyframeGrid.h"
 #include "urbanslam/slam/PipelineOptions.h"
 
 namespace urbanslam::slam {
@@ -46,32 +47,15 @@ struct Detection {
   double score = 0;
 };
 
-// A uniform grid over keyframe positions: the initial candidate set in constant time.
-class KeyframeGrid {
- public:
-  explicit KeyframeGrid(double cell_m) : cell_m_(cell_m) {}
-  void clear() { cells_.clear(); }
-  void insert(size_t index, double x, double y);
-  // Indices of keyframes whose cell lies within `radius` of (x, y) (a superset of the disk).
-  void query(double x, double y, double radius, std::vector<size_t>& out) const;
-
- private:
-  long long key(long cx, long cy) const { return (static_cast<long long>(cx) << 32) ^ (cy & 0xffffffffLL); }
-  double cell_m_;
-  std::unordered_map<long long, std::vector<size_t>> cells_;
-};
-
 class LoopCloser {
  public:
   explicit LoopCloser(const LoopClosureOptions& options);
 
   void setScorer(CandidateScorer scorer, std::string name);
-  // Keyframe positions changed (after a full recovery): rebuild the grid.
-  void rebuildIndex(const std::vector<Keyframe>& keyframes);
-  void addToIndex(const Keyframe& kf);
 
-  // The final candidate set for keyframe `current`, nearest (Mahalanobis) first.
-  std::vector<size_t> candidates(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t current);
+  // The final candidate set for keyframe `current`, nearest (Mahalanobis) first; `grid` is the
+  // map's spatial index of the keyframes.
+  std::vector<size_t> candidates(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, const KeyframeGrid& grid, size_t current);
   // Detection, alignment and gating of one candidate. With `commit`, a closure that passes is
   // added to the filter; without, it is only tested (accepted = passed) for later confirmation.
   LoopClosureRecord tryClose(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current,
@@ -83,7 +67,6 @@ class LoopCloser {
                  const alignment::AlignmentResult& a, alignment::AlignerOptions ao);
 
   LoopClosureOptions options_;
-  KeyframeGrid grid_;
   CandidateScorer scorer_;
   std::string detector_ = "pose";
   double chi2_2dof_;

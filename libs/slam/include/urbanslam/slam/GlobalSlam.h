@@ -1,0 +1,66 @@
+#pragma once
+// Global SLAM (thesis ch. 5): the one place that changes the filter. A new keyframe enters as a
+// delayed pose (ESDF prediction with augmentation, constant time) with local SLAM's constraint;
+// then the loop-closure candidates (near the estimate, Mahalanobis-gated), the optional laser
+// classifier, alignment, the innovation gate, confirmation by a second agreeing closure, the
+// update, and the full recovery after it. Tree of Words proposals take the same path from the
+// alignment on.
+#include <array>
+#include <deque>
+#include <memory>
+#include <vector>
+
+#include "urbanslam/slam/LocalSlam.h"
+#include "urbanslam/slam/LoopCloser.h"
+#include "urbanslam/slam/Map.h"
+#include "urbanslam/slam/Observer.h"
+#include "urbanslam/slam/PipelineOptions.h"
+#include "urbanslam/slam/PipelineStats.h"
+
+namespace urbanslam::laser_loop {
+class LoopDetector;
+}
+
+namespace urbanslam::slam {
+
+class GlobalSlam {
+ public:
+  // Reports closures and corrected poses to `observers` and counts them in `stats` (both owned
+  // by the caller and outliving this).
+  GlobalSlam(const PipelineOptions& options, Map& map, PipelineStats& stats, const std::vector<PipelineObserver*>& observers);
+  ~GlobalSlam();
+
+  void setCandidateScorer(CandidateScorer scorer, std::string name) { closer_.setScorer(std::move(scorer), std::move(name)); }
+  // The keyframe joins the map with the constraint from the previous one. Returns its marginal
+  // covariance (row-major; zero without a filter or for the first keyframe).
+  std::array<double, 9> addKeyframe(Keyframe kf, const KeyframeConstraint& constraint);
+  // Loop closures of keyframe `current` with earlier ones, when [loop_closure] asks for it now.
+  void closeLoops(size_t current);
+  // A Tree of Words proposal between two keyframes, through alignment, gating and confirmation
+  // when both have scans (else recorded with the reason it cannot be); observers hear its fate.
+  void proposeImageClosure(size_t earlier, size_t current, double score);
+  // End of input: hypotheses still awaiting confirmation are dropped, the last poses recovered.
+  void finish();
+
+  const std::vector<LoopClosureRecord>& closures() const { return closures_; }
+
+ private:
+  enum class Admission { Rejected, Pending, Accepted };
+  Admission admit(LoopClosureRecord r, size_t current);
+  void expirePending(size_t current);
+  bool consistent(const LoopClosureRecord& a, const LoopClosureRecord& b) const;
+  void reportClosure(const LoopClosureRecord& r);
+  void recoverAll();
+
+  const PipelineOptions& options_;
+  Map& map_;
+  PipelineStats& stats_;
+  const std::vector<PipelineObserver*>& observers_;
+  LoopCloser closer_;
+  std::unique_ptr<laser_loop::LoopDetector> laser_detector_;  // [loop_closure] detector = laser
+  std::deque<LoopClosureRecord> pending_;  // passed alignment + gate, awaiting confirmation
+  std::vector<LoopClosureRecord> closures_;
+  bool dirty_since_recovery_ = false;
+};
+
+}  // namespace urbanslam::slam

@@ -1,0 +1,104 @@
+#pragma once
+// The map: what a run builds and what outlives it. The keyframes (each with its scan and image
+// words) and their current pose estimates, the pose graph's edges, the spatial index over the
+// keyframes, the filter's information form (the ESDF; none in dead reckoning), and the scans
+// and odometry readings hung from keyframes, from which the trajectory at every sensor time is
+// rebuilt on demand. Local and global SLAM read it; only global SLAM changes the filter.
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "urbanslam/io/MapOutputs.h"
+#include "urbanslam/slam/KeyframeGrid.h"
+#include "urbanslam/vision_loop/BagOfWords.h"
+
+namespace urbanslam::esdf {
+class Esdf;
+}
+
+namespace urbanslam::slam {
+
+struct Keyframe {
+  size_t index = 0;
+  double timestamp = 0;
+  common::Pose2 pose;   // current estimate
+  io::LaserScan scan;   // kept so the map can be rebuilt from the current estimates; empty
+                        // for keyframes made from camera images alone
+  bool has_image = false;              // an image was attached (nearest in time)
+  vision_loop::BagOfWords image_words;  // its Tree of Words vector (tree_of_words only); no pixels
+  bool hasScan() const { return !scan.ranges.empty(); }
+};
+
+// A constraint between two keyframes as it went into the filter (for the g2o output).
+struct GraphEdge {
+  size_t from = 0, to = 0;
+  common::Pose2 measurement;
+  Eigen::Matrix3d information = Eigen::Matrix3d::Identity();
+  bool loop_closure = false;
+};
+
+// A scan whose pose is known relative to a keyframe: every keyframe (offset identity) and the
+// scans between keyframes that matched the local submap. The trajectory between keyframes is
+// spread between anchors, so it follows the scans rather than the odometry alone.
+struct ScanAnchor {
+  double timestamp = 0;
+  size_t keyframe = 0;    // the keyframe it hangs from
+  common::Pose2 offset;   // its pose in that keyframe's frame
+  common::Pose2 odom;     // odometry pose at its time
+};
+
+class Map {
+ public:
+  // `filter`: the estimator behind the poses (nullptr: dead reckoning, poses composed from the
+  // constraints). `index_cell_m`: the spatial index's cell.
+  Map(std::unique_ptr<esdf::Esdf> filter, double index_cell_m);
+  ~Map();
+
+  const std::vector<Keyframe>& keyframes() const { return keyframes_; }
+  size_t size() const { return keyframes_.size(); }
+  bool empty() const { return keyframes_.empty(); }
+  const Keyframe& back() const { return keyframes_.back(); }
+  Keyframe& keyframe(size_t i) { return keyframes_[i]; }
+  void addKeyframe(Keyframe kf);
+
+  const std::vector<GraphEdge>& edges() const { return edges_; }
+  void addEdge(const GraphEdge& e) { edges_.push_back(e); }
+
+  // Spatial index over the keyframes' current positions.
+  const KeyframeGrid& index() const { return index_; }
+  void reindex();
+
+  esdf::Esdf* filter() { return filter_.get(); }
+  const esdf::Esdf* filter() const { return filter_.get(); }
+  // Copies the filter's current means of keyframes [from, size()) into their poses.
+  void pullPoses(size_t from = 0);
+
+  // The trajectory at sensor times.
+  void addAnchor(const ScanAnchor& anchor);
+  void addOdometry(double timestamp, const common::Pose2& odom);
+  // Estimated pose at every odometry (or drive) reading's time and at every anchored scan (at a
+  // scan's time this is the scan's pose), from the current keyframe estimates and the odometry
+  // between the scans.
+  std::vector<io::StampedPose> odometryTrajectory() const;
+  // Estimated pose at every anchored scan: the keyframes and the scans matched between them.
+  std::vector<io::StampedPose> scanTrajectory() const;
+  std::vector<io::PosedScan> posedKeyframes() const;
+  size_t anchors() const { return anchors_.size(); }
+  double lastAnchorTime() const { return anchors_.empty() ? 0.0 : anchors_.back().timestamp; }
+
+ private:
+  struct OdometrySample {
+    double timestamp;
+    common::Pose2 odom;   // odometry pose at the reading
+    size_t anchor;        // last anchor before it (npos: none yet)
+  };
+
+  std::vector<Keyframe> keyframes_;
+  std::vector<GraphEdge> edges_;
+  KeyframeGrid index_;
+  std::unique_ptr<esdf::Esdf> filter_;
+  std::vector<ScanAnchor> anchors_;
+  std::vector<OdometrySample> odometry_;
+};
+
+}  // namespace urbanslam::slam

@@ -1,0 +1,87 @@
+#include "urbanslam/slam/LocalSlam.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace urbanslam::slam {
+
+namespace {
+constexpr double kDeg = M_PI / 180.0;
+}  // namespace
+
+LocalSlam::LocalSlam(const PipelineOptions& options)
+    : keyframes_(options.keyframes),
+      options_(options.local),
+      motion_model_(options.motion.model),
+      motion_(options.motion, options.vehicle),
+      submap_(options.local) {}
+
+bool LocalSlam::addOdometry(const io::OdometryReading& m) {
+  if (motion_model_ == "steering") return false;
+  motion_.addOdometry(m);
+  return true;
+}
+
+bool LocalSlam::addDrive(const io::DriveReading& m) {
+  if (motion_model_ == "odometry") return false;
+  motion_.addDrive(m);
+  return true;
+}
+
+bool LocalSlam::isKeyframe(const Map& map) const {
+  const common::Pose2& d = motion_.increment();
+  return map.empty() || !have_scan_keyframe_ || std::hypot(d.x, d.y) >= keyframes_.min_translation_m ||
+         std::abs(d.phi) >= keyframes_.min_rotation_deg * kDeg;
+}
+
+KeyframeConstraint LocalSlam::keyframeConstraint(const io::LaserScan& scan, const Map& map) const {
+  KeyframeConstraint c;
+  c.z = motion_.increment();
+  c.cov = motion_.covariance();
+  c.cov.diagonal() += Eigen::Vector3d(1e-8, 1e-8, 1e-10);  // no motion at all is still a valid constraint
+  // Scan matching needs scans on both sides (camera-only keyframes have none).
+  if (!options_.scan_matching || scan.ranges.empty() || map.empty() || !map.back().hasScan()) return c;
+  const alignment::PriorMatchResult r = matchSubmap(scan, c.z, c.cov, map);
+  if (!r.valid) {
+    c.match = KeyframeConstraint::Match::Rejected;
+    return c;
+  }
+  c.match = KeyframeConstraint::Match::Used;
+  // The posterior of the increment given the motion and the scan replaces the motion's.
+  c.z = r.pose;
+  c.cov = options_.covariance_scale * r.cov;
+  const double sxy = options_.min_sigma_xy_m, sphi = options_.min_sigma_phi_deg * kDeg;
+  c.cov(0, 0) = std::max(c.cov(0, 0), sxy * sxy);
+  c.cov(1, 1) = std::max(c.cov(1, 1), sxy * sxy);
+  c.cov(2, 2) = std::max(c.cov(2, 2), sphi * sphi);
+  return c;
+}
+
+std::optional<ScanAnchor> LocalSlam::placeScan(const io::LaserScan& scan, const Map& map) const {
+  if (!options_.scan_matching || !options_.match_every_scan || scan.ranges.empty() || map.empty() || !map.back().hasScan())
+    return std::nullopt;
+  if (map.anchors() > 0 && std::abs(scan.timestamp - map.lastAnchorTime()) < options_.match_min_interval_s) return std::nullopt;
+  // Its pose in the last keyframe's frame, for the trajectory at sensor times only (the filter
+  // keeps one pose per keyframe).
+  Eigen::Matrix3d cov = motion_.covariance();
+  cov.diagonal() += Eigen::Vector3d(1e-8, 1e-8, 1e-10);
+  const alignment::PriorMatchResult r = matchSubmap(scan, motion_.increment(), cov, map);
+  if (!r.valid) return std::nullopt;
+  return ScanAnchor{scan.timestamp, map.size() - 1, r.pose, motion_.odometryPose()};
+}
+
+void LocalSlam::keyframeAdded(const io::LaserScan& scan) {
+  if (options_.scan_matching) submap_.addKeyframe(scan);
+  have_scan_keyframe_ = have_scan_keyframe_ || !scan.ranges.empty();
+  motion_.reset();
+}
+
+alignment::PriorMatchResult LocalSlam::matchSubmap(const io::LaserScan& scan, const common::Pose2& z, const Eigen::Matrix3d& cov,
+                                                   const Map& map) const {
+  std::vector<common::Pose2> poses;
+  const auto& kf = map.keyframes();
+  for (size_t i = kf.size() - std::min(kf.size(), submap_.size()); i < kf.size(); ++i) poses.push_back(kf[i].pose);
+  return submap_.match(scan, z, cov, poses);
+}
+
+}  // namespace urbanslam::slam
