@@ -16,13 +16,15 @@
 namespace urbanslam::cli {
 
 int simulateCommand(const Argv& args) {
-  ArgParser ap("urbanslam simulate [--ini FILE] --out DIR [--quiet] [--json]",
+  ArgParser ap("urbanslam simulate [--ini FILE] --out DIR [--no-rawlog] [--quiet] [--json]",
                "Simulates a drive through a city generated from a seed: 2D laser (walls, trees, parked and\n"
                "moving cars, pedestrians), a camera (textured facades; optional), wheel odometry and optionally\n"
                "GPS, with the ground truth.");
   ap.addOption("ini", "FILE", "simulation settings ([city], [vehicle], [route], [laser], [camera], [odometry], "
                               "[gps], [traffic], [loops]); default: built-in defaults");
   ap.addOption("out", "DIR", "output folder (created if needed)");
+  ap.addFlag("no-rawlog", "write only the ground truth (no city.rawlog, no images): to score a run that streamed\n"
+                         "the same ini with `urbanslam run --simulate` (the simulation is deterministic)");
   ap.addFlag("quiet", "no progress bar and no summary on stderr");
   ap.addFlag("json", "print a summary as one JSON object on stdout");
   ap.addEpilog(
@@ -42,7 +44,8 @@ int simulateCommand(const Argv& args) {
 
   common::ProgressBar bar("simulate", 1000, !quiet);
   const sim::SimulationSummary s = sim::writeSimulation(
-      options, ap.option("out"), resolved, [&](double f) { bar.update(static_cast<uint64_t>(f * 1000)); });
+      options, ap.option("out"), resolved, [&](double f) { bar.update(static_cast<uint64_t>(f * 1000)); },
+      !ap.flag("no-rawlog"));
   bar.finish();
 
   common::Json j = common::Json::object();

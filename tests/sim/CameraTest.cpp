@@ -165,6 +165,10 @@ TEST(CameraRenderer, RepeatedDesignsLookTheSameAndOtherDesignsDiffer) {
     for (int ty = 0; ty < 5; ++ty)
       for (const Segment& s : city.tile(tx, ty)->segments) {
         if (s.look.kind != SurfaceKind::Facade || s.b.x - s.a.x < 6 || std::fabs(s.b.y - s.a.y) > 1e-9) continue;
+        // Only facades with open ground in front (a street, not an alley between two buildings),
+        // where the views below stand.
+        const Vec2 mid = 0.5 * (s.a + s.b);
+        if (city.raycast({mid.x, mid.y - 0.01}, {0, -1}, 8.0) != kNoHit) continue;
         copies[{s.look.id, std::lround(norm(s.b - s.a) * 1000), std::lround(s.u0_m * 1000)}].push_back(s);
       }
   // Render each copy from 7 m in front of its middle (outward normal: the right of its direction).

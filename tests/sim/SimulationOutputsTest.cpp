@@ -57,6 +57,35 @@ TEST(SimulationOutputs, SameSeedGivesByteIdenticalOutputs) {
   EXPECT_NE(slurp((d1 / "truth.tum").string()), slurp((d3 / "truth.tum").string()));
 }
 
+// Without the rawlog the ground truth must be the very same bytes: a run that streamed the
+// simulation is scored against it.
+TEST(SimulationOutputs, TruthWithoutRawlogIsByteIdenticalToAFullRun) {
+  for (const bool camera : {false, true}) {
+    SimOptions o = smallDrive();
+    if (camera) {
+      o.route.route_length_km = 0.15;
+      o.camera.enabled = true;
+      o.camera.rate_hz = 1.0;
+    }
+    const auto full = test::scratchDir(camera ? "sim_full_cam" : "sim_full");
+    const auto truth = test::scratchDir(camera ? "sim_truth_cam" : "sim_truth");
+    const auto s1 = writeSimulation(o, full.string(), "[city]\nseed = 11\n");
+    const auto s2 = writeSimulation(o, truth.string(), "[city]\nseed = 11\n", {}, false);
+    EXPECT_EQ(s1.scans, s2.scans);
+    EXPECT_EQ(s1.loop_pairs, s2.loop_pairs);
+    EXPECT_TRUE(std::filesystem::exists(full / "city.rawlog"));
+    EXPECT_FALSE(std::filesystem::exists(truth / "city.rawlog"));
+    EXPECT_FALSE(std::filesystem::exists(truth / "city_Images"));
+    std::vector<std::string> files = {"truth.tum", "loops.csv", "walls.csv", "walls.png", "config.ini"};
+    if (camera) files.insert(files.end(), {"image_loops.csv", "image_loops.txt"});
+    for (const std::string& f : files) {
+      const std::string a = slurp((full / f).string()), b = slurp((truth / f).string());
+      EXPECT_FALSE(a.empty()) << f;
+      EXPECT_TRUE(a == b) << f << " differs without the rawlog (camera " << camera << ")";
+    }
+  }
+}
+
 TEST(SimulationOutputs, RawlogReadsBackWithTheProjectReader) {
   const auto dir = test::scratchDir("sim_readback");
   const SimOptions o = smallDrive();

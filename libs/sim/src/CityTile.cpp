@@ -31,6 +31,9 @@ CityTile CityTile::build(const StreetGrid& grid, int tx, int ty, double tile_m, 
     for (int i = std::max(0, i0); i <= i1 + 1; ++i)
       for (int j = std::max(0, j0); j <= j1 + 1; ++j)
         if (grid.edge(axis, i, j) == EdgeState::DeadEnd) generateDeadEnd(grid, axis, i, j, raw);
+  for (int i = std::max(0, i0); i <= i1 + 1; ++i)
+    for (int j = std::max(0, j0); j <= j1 + 1; ++j)
+      if (grid.isRoundabout({i, j})) generateRoundabout(grid, {i, j}, raw);
   for (const Segment& s : raw) {
     Segment c;
     if (clipSegment(s, t.box, c)) t.segments.push_back(c);

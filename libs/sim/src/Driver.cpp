@@ -23,15 +23,33 @@ Driver::Driver(const StreetGrid& grid, const SimOptions& options)
   state_.pose = {a.x, a.y, std::atan2(b.y - a.y, b.x - a.x)};
 }
 
+double Driver::clearance(NodeId n) const {
+  // How far from an intersection's centre the lanes of its pieces start: past the cross street,
+  // the wider crossing of an avenue, or a roundabout's ring.
+  if (grid_.isRoundabout(n)) return grid_.ringOuterRadius() + 1.0;
+  for (const NodeId& m : grid_.neighbours(n))
+    if (grid_.pieceHalfWidth(n, m) > grid_.streetWidth() / 2) return (grid_.streetWidth() / 2 + grid_.avenueHalfWidth()) / 2;
+  return grid_.streetWidth() / 2;
+}
+
 void Driver::extendPath() {
   while (nodes_.size() < 3) nodes_.push_back(planner_.advance());
   const Vec2 a = grid_.node(nodes_[0]), b = grid_.node(nodes_[1]), c = grid_.node(nodes_[2]);
-  const Vec2 d = (1.0 / norm(b - a)) * (b - a), e = (1.0 / norm(c - b)) * (c - b);
+  const double len = norm(b - a);
+  const Vec2 d = (1.0 / len) * (b - a), e = (1.0 / norm(c - b)) * (c - b);
   const Vec2 right{d.y, -d.x};
-  const double h = grid_.streetWidth() / 2, off = grid_.laneOffset();
-  const Vec2 entry = a + h * d + off * right, exit = b - h * d + off * right;
+  const double off = grid_.pieceLaneOffset(nodes_[0], nodes_[1]);
+  // Short pieces (an avenue crossing next to a grid intersection) share what length they have.
+  double ra = clearance(nodes_[0]), rb = clearance(nodes_[1]);
+  if (ra + rb > 0.8 * len) {
+    const double f = 0.8 * len / (ra + rb);
+    ra *= f;
+    rb *= f;
+  }
+  const Vec2 entry = a + ra * d + off * right, exit = b - rb * d + off * right;
+  const bool roundabout = grid_.isRoundabout(nodes_[1]);
   // Turning at b: limit the speed at the lane's end and at the next lane's start.
-  const bool turn = std::fabs(cross(d, e)) > 0.5;
+  const bool turn = roundabout || std::fabs(cross(d, e)) > 0.5 || dot(d, e) < 0;
   const double cruise = route_.speed_mps, limit = turn ? std::min(route_.turn_speed_mps, cruise) : cruise;
   auto push = [&](Vec2 p, double lim) {
     const double s = path_.empty() ? 0.0 : path_.back().s + norm(p - path_.back().p);
@@ -41,6 +59,23 @@ void Driver::extendPath() {
   if (path_.empty()) path_.push_back({entry, 0.0, cruise});
   else push(entry, path_.back().speed_limit);  // the chord across the intersection
   push(exit, limit);
+  if (roundabout) {
+    // Counter-clockwise round the island (right-hand traffic) on the ring lane's centre line,
+    // from where the arriving lane meets it to where the leaving lane does.
+    const double rc = grid_.ringRadius();
+    const double off_out = grid_.pieceLaneOffset(nodes_[1], nodes_[2]);
+    const Vec2 right_e{e.y, -e.x};
+    const Vec2 in = -std::sqrt(rc * rc - off * off) * d + off * right;
+    const Vec2 out = std::sqrt(rc * rc - off_out * off_out) * e + off_out * right_e;
+    const double a0 = std::atan2(in.y, in.x);
+    double sweep = std::atan2(out.y, out.x) - a0;
+    while (sweep <= 0) sweep += 2 * M_PI;
+    const int steps = std::max(2, static_cast<int>(std::ceil(sweep / (15.0 * M_PI / 180.0))));
+    for (int k = 0; k <= steps; ++k) {
+      const double ang = a0 + sweep * k / steps;
+      push(b + Vec2{rc * std::cos(ang), rc * std::sin(ang)}, limit);
+    }
+  }
   nodes_.pop_front();
 }
 

@@ -21,10 +21,23 @@ RoutePlanner::RoutePlanner(const StreetGrid& grid, const RouteOptions& options, 
 
 NodeId RoutePlanner::advance() {
   auto options = grid_.neighbours(current_);
-  std::vector<NodeId> forward;
+  // Forward: not back where we came from, and no hairpin turn off a diagonal avenue while a
+  // gentler way exists.
+  const Vec2 here = grid_.node(current_), back = grid_.node(previous_);
+  const Vec2 d = here - back;
+  auto turnAngle = [&](const NodeId& n) {
+    const Vec2 e = grid_.node(n) - here;
+    return std::fabs(std::atan2(cross(d, e), dot(d, e)));
+  };
+  std::vector<NodeId> forward, gentle;
   for (const NodeId& n : options)
     if (n != previous_) forward.push_back(n);
   if (forward.empty()) forward = options;  // cannot happen with the grid's dead-end rule
+  if (current_ != previous_) {
+    for (const NodeId& n : forward)
+      if (turnAngle(n) < 125.0 * M_PI / 180.0) gentle.push_back(n);
+    if (!gentle.empty()) forward = gentle;
+  }
 
   if (budget_ <= 0 || (returning_ && current_ == target_)) {
     returning_ = false;
@@ -34,8 +47,10 @@ NodeId RoutePlanner::advance() {
       if (target_ != current_) {
         returning_ = true;
         ++revisits_;
-        const int manhattan = std::abs(target_.i - current_.i) + std::abs(target_.j - current_.j);
-        budget_ = 2 * manhattan + 6;  // gives up when dead ends make the greedy walk circle
+        // Street pieces to get there (about one per grid pitch, along the grid), and some spare:
+        // gives up when dead ends make the greedy walk circle.
+        const Vec2 g = grid_.node(target_) - here;
+        budget_ = 2 * static_cast<int>(std::lround((std::fabs(g.x) + std::fabs(g.y)) / grid_.pitch())) + 6;
       }
     }
     if (!returning_) budget_ = rng_.uniformInt(options_.explore_min_edges, options_.explore_max_edges);
@@ -46,20 +61,26 @@ NodeId RoutePlanner::advance() {
     const Vec2 goal = grid_.node(target_);
     double best = 1e300;
     for (const NodeId& n : forward) {
-      const double d = norm(grid_.node(n) - goal) + rng_.uniform(0, 1.0);  // random tie breaks
-      if (d < best) {
-        best = d;
+      const double dist = norm(grid_.node(n) - goal) + rng_.uniform(0, 1.0);  // random tie breaks
+      if (dist < best) {
+        best = dist;
         next = n;
       }
     }
   } else {
-    const NodeId straight{2 * current_.i - previous_.i, 2 * current_.j - previous_.j};
+    // Straight on: the way out that turns least, if it hardly turns (avenue crossings included).
     std::vector<NodeId> turns;
     bool has_straight = false;
-    for (const NodeId& n : forward) {
-      if (n == straight) has_straight = true;
-      else turns.push_back(n);
-    }
+    NodeId straight{};
+    double least = 20.0 * M_PI / 180.0;
+    for (const NodeId& n : forward)
+      if (current_ != previous_ && turnAngle(n) < least) {
+        least = turnAngle(n);
+        straight = n;
+        has_straight = true;
+      }
+    for (const NodeId& n : forward)
+      if (!has_straight || n != straight) turns.push_back(n);
     if (has_straight && (turns.empty() || rng_.chance(options_.straight_probability))) next = straight;
     else if (!turns.empty()) next = turns[rng_.next() % turns.size()];
   }

@@ -1,5 +1,7 @@
 #include "urbanslam/sim/SimOptions.h"
 
+#include <algorithm>
+
 #include "urbanslam/common/Error.h"
 #include "urbanslam/common/IniFile.h"
 
@@ -16,7 +18,8 @@ void declareSimOptions(common::OptionsSchema& s, SimOptions& o) {
   s.add("tile_size_m", c.tile_size_m, 50.0, 1000.0, "m", "side of the lazily built tiles");
   s.add("cell_size_m", c.cell_size_m, 0.5, 50.0, "m", "ray-casting grid cell inside a tile");
   s.add("cache_tiles", c.cache_tiles, 9, 100000, "tiles", "tiles kept in memory (least recently used dropped)");
-  s.add("park_probability", c.park_probability, 0.0, 1.0, "", "a block is a park or square");
+  s.add("park_probability", c.park_probability, 0.0, 1.0, "", "a block is a park (trees)");
+  s.add("square_probability", c.square_probability, 0.0, 1.0, "", "a block is a paved square (fountain, benches, lamp posts)");
   s.add("dead_end_probability", c.dead_end_probability, 0.0, 1.0, "", "a street piece is closed half-way");
   s.add("repeated_design_probability", c.repeated_design_probability, 0.0, 1.0, "", "a facade copies one of design_count designs");
   s.add("design_count", c.design_count, 1, 100, "", "number of repeated facade designs");
@@ -27,6 +30,15 @@ void declareSimOptions(common::OptionsSchema& s, SimOptions& o) {
   s.add("tree_probability", c.tree_probability, 0.0, 1.0, "", "a sidewalk has a row of trees");
   s.add("lamp_post_spacing_m", c.lamp_post_spacing_m, 0.0, 1000.0, "m", "gap between lamp posts; 0: none");
   s.add("parked_car_probability", c.parked_car_probability, 0.0, 1.0, "", "a parking slot is taken");
+  s.add("avenue_spacing_m", c.avenue_spacing_m, 0.0, 100000.0, "m",
+        "parallel diagonal avenues across the grid this far apart (0: none; else at least 300)");
+  s.add("avenue_width_m", c.avenue_width_m, 16.0, 60.0, "m", "an avenue's width, facade to facade");
+  s.add("roundabout_probability", c.roundabout_probability, 0.0, 1.0, "", "a grid intersection is a roundabout (driven counter-clockwise)");
+  s.add("roundabout_island_radius_m", c.roundabout_island_radius_m, 2.0, 20.0, "m", "radius of a roundabout's central island");
+  s.add("buildings_per_block_min", c.buildings_per_block_min, 1, 50, "", "separate buildings on a block, at least ...");
+  s.add("buildings_per_block_max", c.buildings_per_block_max, 1, 50, "", "... at most");
+  s.add("alley_width_m", c.alley_width_m, 0.5, 20.0, "m", "gap between neighbouring buildings of a block");
+  s.add("building_setback_max_m", c.building_setback_max_m, 0.0, 20.0, "m", "a building may stand back from the street up to this");
 
   auto& v = o.vehicle;
   s.section("vehicle", "The simulated car (bicycle model)");
@@ -140,6 +152,11 @@ SimOptions loadSimOptions(const std::string& path, std::string* resolved_ini) {
     throw common::ConfigError(where + ": [city] block_min_m: larger than block_max_m");
   if (o.city.facade_min_m > o.city.facade_max_m)
     throw common::ConfigError(where + ": [city] facade_min_m: larger than facade_max_m");
+  if (o.city.buildings_per_block_min > o.city.buildings_per_block_max)
+    throw common::ConfigError(where + ": [city] buildings_per_block_min: larger than buildings_per_block_max");
+  // Avenues closer than a block's length could split one street piece twice.
+  if (o.city.avenue_spacing_m > 0 && o.city.avenue_spacing_m < std::max(300.0, 2 * (o.city.block_max_m + o.city.street_width_m)))
+    throw common::ConfigError(where + ": [city] avenue_spacing_m: below 300 m or twice a block's pitch (0 turns avenues off)");
   if (o.route.explore_min_edges > o.route.explore_max_edges)
     throw common::ConfigError(where + ": [route] explore_min_edges: larger than explore_max_edges");
   if (o.gps.outage_min_s > o.gps.outage_max_s)

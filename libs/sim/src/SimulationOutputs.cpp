@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <memory>
 
 #include "urbanslam/common/AtomicFile.h"
 #include "urbanslam/common/Error.h"
@@ -17,7 +18,7 @@
 namespace urbanslam::sim {
 
 SimulationSummary writeSimulation(const SimOptions& options, const std::string& dir, const std::string& resolved_ini,
-                                  const std::function<void(double)>& progress) {
+                                  const std::function<void(double)>& progress, bool write_rawlog) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   std::error_code ec;
@@ -27,7 +28,7 @@ SimulationSummary writeSimulation(const SimOptions& options, const std::string& 
   SimulationSummary sum;
   SimulatedSource source(options);
   const bool camera = options.camera.enabled;
-  if (camera) {
+  if (camera && write_rawlog) {
     // Images of an earlier run in this folder would mix with this one's in a folder listing.
     const std::filesystem::path images(dir + "/city_Images");
     if (std::filesystem::is_directory(images, ec))
@@ -37,8 +38,10 @@ SimulationSummary writeSimulation(const SimOptions& options, const std::string& 
           std::filesystem::remove(f.path(), ec);
       }
   }
-  io::RawlogWriter rawlog(dir + "/city.rawlog", io::RawlogLayout::Observations, 5,
-                          camera ? io::ImageStorage::External : io::ImageStorage::Embedded);
+  std::unique_ptr<io::RawlogWriter> rawlog;
+  if (write_rawlog)
+    rawlog = std::make_unique<io::RawlogWriter>(dir + "/city.rawlog", io::RawlogLayout::Observations, 5,
+                                                camera ? io::ImageStorage::External : io::ImageStorage::Embedded);
   common::AtomicFile loops(dir + "/loops.csv");
   loops.stream() << "t_old,t_new,overlap,distance_m\n";
   LoopTruthFinder finder(options.loops);
@@ -67,7 +70,7 @@ SimulationSummary writeSimulation(const SimOptions& options, const std::string& 
     const bool more = source.next(m);
     sim_s += std::chrono::duration<double>(Clock::now() - t0).count();
     if (!more) break;
-    rawlog.write(m);
+    if (rawlog) rawlog->write(m);
     ++sum.measurements;
     if (const auto* ref = std::get_if<io::ReferencePose>(&m)) {
       truth.push_back({ref->timestamp, ref->pose});
@@ -86,7 +89,10 @@ SimulationSummary writeSimulation(const SimOptions& options, const std::string& 
       ++sum.images;
       if (have_truth) {  // yielded with the image's reference pose just before it
         const common::Pose2 cam = common::compose(last_truth, cameraMount(options.camera));
-        std::string name = rawlog.lastImageFile();
+        // The image file's name without the extension (LABEL_000123), as the rawlog names it; the
+        // same without a rawlog, so image_loops.txt does not depend on writing one.
+        std::snprintf(buf, sizeof buf, "_%06zu", sum.images - 1);
+        std::string name = rawlog ? rawlog->lastImageFile() : img->label + buf;
         name = name.substr(0, name.rfind('.'));
         image_at[img->timestamp] = {name, cam.phi};
         const CameraRenderer& r = *source.camera();
@@ -115,7 +121,7 @@ SimulationSummary writeSimulation(const SimOptions& options, const std::string& 
     }
     if (progress && k % 256 == 0) progress(source.progress());
   }
-  rawlog.close();
+  if (rawlog) rawlog->close();
   loops.commit();
   if (image_loops) {
     image_loops->commit();

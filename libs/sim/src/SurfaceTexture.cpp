@@ -75,6 +75,8 @@ double facadeHeight(uint32_t id, SurfaceKind kind) {
     case SurfaceKind::ParkedCar: return r.uniform(1.4, 1.6);
     case SurfaceKind::Barrier: return r.uniform(2.5, 3.5);
     case SurfaceKind::Fountain: return r.uniform(0.8, 1.2);
+    case SurfaceKind::Bench: return r.uniform(0.45, 0.55);
+    case SurfaceKind::Island: return r.uniform(0.9, 1.3);  // a planted kerb, hedge on top
   }
   return 3.0;
 }
@@ -243,6 +245,11 @@ uint8_t SurfaceTexture::at(const Column& c, double hh) const {
     case SurfaceKind::Fountain:
       if (hh > look_.height_m - 0.15) return 215;
       return std::fmod(c.u + 100.0, 0.6) < 0.05 ? 110 : 170;
+    case SurfaceKind::Bench:
+      return std::fmod(c.u + 100.0, 0.5) < 0.04 || hh < 0.1 ? 40 : clampTone(wall_);  // slats on dark legs
+    case SurfaceKind::Island:
+      if (hh < 0.25) return 200;  // the kerb stone
+      return clampTone(50 + static_cast<int>(h(look_.id, kTagBlock, floorInt(c.u / 0.1), floorInt(hh / 0.1)) % 50));
   }
   return 128;
 }

@@ -55,6 +55,8 @@ std::vector<MovingObject> Traffic::near(Vec2 centre, double radius, double t, Ve
           if (axis == 0 ? grid_.edge(0, node, l) != EdgeState::Open : grid_.edge(1, l, node) != EdgeState::Open) continue;
           const Vec2 p = axis == 0 ? Vec2{along, c + lateral} : Vec2{c + lateral, along};
           if (norm(p - centre) > radius + 3 || norm(p - ego) < options_.clearance_m) continue;
+          // The streams follow the grid's lines: none through a roundabout's island and ring.
+          if (grid_.nearRoundabout(p, grid_.ringOuterRadius() + 3.0)) continue;
           MovingObject m;
           m.centre = p;
           const double heading = (axis == 0 ? 0.0 : M_PI / 2) + (st.speed < 0 ? M_PI : 0.0);

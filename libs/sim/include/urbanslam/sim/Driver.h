@@ -38,6 +38,7 @@ class Driver {
     double speed_limit = 0; // at this point (slow through turns)
   };
   void extendPath();
+  double clearance(NodeId n) const;
   void control();
 
   const StreetGrid& grid_;

@@ -20,7 +20,9 @@ inline double cross(Vec2 a, Vec2 b) { return a.x * b.y - a.y * b.x; }
 inline double norm(Vec2 a) { return std::hypot(a.x, a.y); }
 
 // What a wall is made of, for the camera (the laser sees only geometry).
-enum class SurfaceKind : uint8_t { Facade, Featureless, Pillar, Tree, LampPost, ParkedCar, Barrier, Fountain };
+enum class SurfaceKind : uint8_t {
+  Facade, Featureless, Pillar, Tree, LampPost, ParkedCar, Barrier, Fountain, Bench, Island
+};
 
 // The appearance of a surface: `id` selects its procedural texture (facades of one repeated
 // design share it), height_m is how tall it stands (the map is 2D).

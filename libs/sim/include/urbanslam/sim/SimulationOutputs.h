@@ -27,8 +27,10 @@ struct SimulationSummary {
   double total_wall_s = 0;     // ... plus writing the outputs
 };
 
-// progress: called now and then with the fraction of the route driven.
+// progress: called now and then with the fraction of the route driven. write_rawlog false: only
+// the ground truth (truth.tum, loops, image loops, walls, config.ini), byte-identical to a full
+// run's, to score a run that streamed the same simulation (`urbanslam run --simulate`).
 SimulationSummary writeSimulation(const SimOptions& options, const std::string& dir, const std::string& resolved_ini,
-                                  const std::function<void(double)>& progress = {});
+                                  const std::function<void(double)>& progress = {}, bool write_rawlog = true);
 
 }  // namespace urbanslam::sim
