@@ -24,7 +24,7 @@ struct RouteOptions {
   double turn_speed_mps = 4.0;     // speed through a turn
   double lookahead_min_m = 4.0;    // pure pursuit look-ahead: at least this ...
   double lookahead_s = 0.6;        // ... or this many seconds of travel
-  double revisit_probability = 0.6;  // after exploring, head back to an earlier intersection
+  double revisit_probability = 0.9;  // after exploring, head back to an earlier intersection
   int explore_min_edges = 2;       // street pieces driven freely before deciding to return
   int explore_max_edges = 12;
   double straight_probability = 0.5;  // at an intersection while exploring
@@ -70,7 +70,7 @@ struct OdometryOptions {
   // correlation_length_m), as real wheel odometry's do (tyre load, floor, slip): white noise per
   // reading would average out at high rates and depend on rate_hz.
   double sigma_per_m = 0.04;           // distance scale error (1 sigma)
-  double sigma_per_rad = 0.27;         // heading error per radian turned (1 sigma)
+  double sigma_per_rad = 0.15;         // heading error per radian turned (1 sigma)
   double sigma_phi_per_m_rad = 0.032;  // heading drift per metre travelled (1 sigma)
   double correlation_length_m = 2.0;   // distance over which those errors decorrelate
   double scale_bias = 0.01;         // wheel radius error: distance reads (1 + this) too long

@@ -1,0 +1,106 @@
+// scale_bench (--city CITY_INI | --log LOG) [--ini PIPELINE_INI] --out DIR
+// Runs the SLAM pipeline on a simulated city streamed from the simulator (no file) or on a log,
+// records every step's time with the map's size at that step, and writes DIR/steps.csv
+// (keyframes, step_ms, wall_s), DIR/step_time.png (p50 / p99 / max of the step time per bin of
+// map size), the run's usual outputs (so `urbanslam eval DIR --truth SIM_DIR` scores it) and
+// one JSON summary on stdout.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "urbanslam/common/Error.h"
+#include "urbanslam/common/Json.h"
+#include "urbanslam/common/Timing.h"
+#include "urbanslam/laser_loop/LinePlot.h"
+#include "urbanslam/sim/SimOptions.h"
+#include "urbanslam/sim/SimulatedSource.h"
+#include "urbanslam/slam/Pipeline.h"
+#include "urbanslam/slam/PipelineOptions.h"
+#include "urbanslam/slam/RunOutputs.h"
+#include "urbanslam/vision_loop/ImageLoopOptions.h"
+
+using namespace urbanslam;
+
+namespace {
+
+struct StepRecorder : slam::PipelineObserver {
+  std::vector<size_t> keyframes;
+  std::vector<double> step_ms;
+  void onStep(const slam::StepEvent& e) override {
+    keyframes.push_back(e.keyframes);
+    step_ms.push_back(e.step_ms);
+  }
+};
+
+double percentileOf(std::vector<double> v, double p) {
+  if (v.empty()) return 0;
+  const size_t k = static_cast<size_t>(p / 100.0 * static_cast<double>(v.size() - 1));
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
+  return v[k];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string city, log, ini = std::string(URBANSLAM_SOURCE_DIR) + "/ini/default.ini", out;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string a = argv[i];
+    if (a == "--city") city = argv[i + 1];
+    else if (a == "--log") log = argv[i + 1];
+    else if (a == "--ini") ini = argv[i + 1];
+    else if (a == "--out") out = argv[i + 1];
+  }
+  if (out.empty() || city.empty() == log.empty()) {
+    std::cerr << "usage: scale_bench (--city CITY_INI | --log LOG) [--ini PIPELINE_INI] --out DIR\n";
+    return 2;
+  }
+  try {
+    std::string resolved;
+    slam::PipelineOptions options = slam::loadPipelineOptions(ini, &resolved);
+    if (options.loop_closure.laser_model.empty())
+      options.loop_closure.laser_model = std::string(URBANSLAM_SOURCE_DIR) + "/share/laser_loop/default.model";
+    if (options.image_loop.vocabulary.empty())
+      options.image_loop.vocabulary = std::string(URBANSLAM_SOURCE_DIR) + "/" + vision_loop::kDefaultVocabularyPath;
+    std::unique_ptr<io::DataSource> source =
+        city.empty() ? io::openDataSource(log) : std::make_unique<sim::SimulatedSource>(sim::loadSimOptions(city));
+    slam::Pipeline pipeline(options);
+    StepRecorder rec;
+    pipeline.addObserver(&rec);
+    pipeline.run(*source);
+    std::filesystem::create_directories(out);
+    const common::Json stats = slam::writeRunOutputs(pipeline, out, {city.empty() ? log : city, source->format(), ini, resolved});
+
+    std::ofstream csv(out + "/steps.csv");
+    csv << "keyframes,step_ms\n";
+    for (size_t i = 0; i < rec.step_ms.size(); ++i) csv << rec.keyframes[i] << "," << rec.step_ms[i] << "\n";
+    // Step time per bin of map size: 40 bins over the run.
+    const size_t n = rec.keyframes.empty() ? 0 : rec.keyframes.back();
+    const size_t bins = 40, width = std::max<size_t>(1, (n + bins - 1) / bins);
+    laser_loop::PlotSeries p50{"p50", {}, {}, 0x2060e0}, p99{"p99", {}, {}, 0x2020c0}, mx{"max", {}, {}, 0x808080};
+    std::vector<std::vector<double>> per(bins + 1);
+    for (size_t i = 0; i < rec.step_ms.size(); ++i) per[std::min(bins, rec.keyframes[i] / width)].push_back(rec.step_ms[i]);
+    for (size_t b = 0; b <= bins; ++b) {
+      if (per[b].empty()) continue;
+      const double x = static_cast<double>((b + 0.5) * width);
+      p50.x.push_back(x), p50.y.push_back(percentileOf(per[b], 50));
+      p99.x.push_back(x), p99.y.push_back(percentileOf(per[b], 99));
+      mx.x.push_back(x), mx.y.push_back(percentileOf(per[b], 100));
+    }
+    laser_loop::writePlotPng(out + "/step_time.png", {{"step time against map size", "keyframes", "ms", {p50, p99, mx}}});
+    common::Json j = common::Json::object();
+    j["input"] = city.empty() ? log : city;
+    j["keyframes"] = n;
+    j["timing"] = stats.at("timing");
+    j["counts"] = stats.at("counts");
+    std::cout << j.dump() << "\n";
+  } catch (const common::InputError& e) {
+    std::cerr << "scale_bench: " << e.what() << "\n";
+    return 2;
+  }
+  return 0;
+}

@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# The pipeline at growing scale: simulated cities of 1, 10 and 100 km2 streamed from the
+# simulator (no file), and the real raw logs, each with ini/default.ini.
+#
+#   bench/scale/run_scale.sh [BUILD_DIR] [OUT_DIR]
+#
+# Environment: CITIES="1 10 100" (km2), ROUTE_KM="3 10 30" (drive length per city),
+# LOGS="intel aces fr079 csail" (raw Freiburg logs, needs ../shared/data; "" for none).
+# Per run: OUT_DIR/NAME/ holds the run's outputs, steps.csv and step_time.png (step time against
+# the map's size); the cities are scored against their truth (simulate --no-rawlog writes it).
+# Prints one table: keyframes, step p50/p99/max, p99 per decade of map size, peak RSS, real-time
+# factor, ATE, map accuracy (p95), closures accepted/false and the share of true revisits closed.
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/../.."
+BUILD=${1:-build}
+OUT=${2:-$BUILD/scale_eval}
+U=$BUILD/apps/urbanslam/urbanslam
+B=$BUILD/bench/scale/scale_bench
+CITIES=(${CITIES-1 10 100})
+ROUTES=(${ROUTE_KM-3 10 30})
+LOGS=${LOGS-intel aces fr079 csail}
+D=../shared/data/freiburg_slam_benchmark/raw_logs
+mkdir -p "$OUT"
+
+rows=()
+for i in "${!CITIES[@]}"; do
+  a=${CITIES[$i]} km=${ROUTES[$i]} name=city-${CITIES[$i]}km2
+  sed -e "s/^area_km2 .*/area_km2 = $a/" -e "s/^route_length_km .*/route_length_km = $km/" ini/city-1km2.ini > "$OUT/$name.ini"
+  "$U" simulate --quiet --no-rawlog --ini "$OUT/$name.ini" --out "$OUT/$name-truth" > /dev/null
+  "$B" --city "$OUT/$name.ini" --out "$OUT/$name" > "$OUT/$name.json"
+  "$U" eval "$OUT/$name" --truth "$OUT/$name-truth" --json > "$OUT/$name.eval.json"
+  rows+=("$name")
+done
+for log in $LOGS; do
+  [ -f "$D/$log.clf.gz" ] || continue
+  "$B" --log "$D/$log.clf.gz" --ini "ini/$log.ini" --out "$OUT/$log" > "$OUT/$log.json"
+  rows+=("$log")
+done
+
+python3 - "$OUT" "${rows[@]}" <<'PY'
+import json, os, sys
+out, names = sys.argv[1], sys.argv[2:]
+print("%-14s %9s %7s %7s %7s %28s %7s %6s %7s %7s %6s %6s %6s" % ("run", "keyframes", "p50_ms", "p99_ms", "max_ms",
+      "p99_ms by keyframes 1e2/3/4/5/6", "rss_mb", "rtf", "ate_m", "map_p95", "loops", "false", "recall"))
+for n in names:
+    r = json.load(open(os.path.join(out, n + ".json")))
+    t, c = r["timing"], r["counts"]
+    dec = t.get("step_ms_p99_by_keyframes", {})
+    by = "/".join("%.0f" % dec["1e%d" % k] if "1e%d" % k in dec else "-" for k in range(2, 7))
+    e = {}
+    p = os.path.join(out, n + ".eval.json")
+    if os.path.exists(p): e = json.load(open(p))
+    f = lambda v, fmt: fmt % v if v is not None else "-"
+    print("%-14s %9d %7.1f %7.1f %7.1f %28s %7.0f %6.1f %7s %7s %6d %6s %6s" % (n, r["keyframes"], t["step_ms_p50"], t["step_ms_p99"],
+          t["step_ms_max"], by, t["peak_rss_mb"], t["real_time_factor"], f(e.get("ate_rmse_m"), "%.2f"),
+          f(e.get("map", {}).get("p95_m"), "%.2f"), c["loop_closures_accepted"], f(e.get("loops_false"), "%d"),
+          f(e.get("loops_recall", {}).get("recall"), "%.2f")))
+PY
