@@ -1,6 +1,7 @@
 #include "urbanslam/sim/RoutePlanner.h"
 
 #include <cmath>
+#include <algorithm>
 #include <cstdlib>
 
 namespace urbanslam::sim {
@@ -42,8 +43,15 @@ NodeId RoutePlanner::advance() {
   if (budget_ <= 0 || (returning_ && current_ == target_)) {
     returning_ = false;
     if (history_.size() > 4 && rng_.chance(options_.revisit_probability)) {
-      // Any earlier intersection: near ones give small loops, old ones large loops.
-      target_ = history_[rng_.next() % (history_.size() - 3)];
+      // Back to a recent intersection (a loop round a block or two), or to any earlier one (old
+      // ones give loops of kilometres).
+      const size_t older = history_.size() - 3;  // the last three are where the car just was
+      if (rng_.chance(options_.small_loop_probability)) {
+        const size_t back = 1 + rng_.next() % std::min<size_t>(8, older);
+        target_ = history_[older - back];
+      } else {
+        target_ = history_[rng_.next() % older];
+      }
       if (target_ != current_) {
         returning_ = true;
         ++revisits_;

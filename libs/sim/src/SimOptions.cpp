@@ -56,6 +56,7 @@ void declareSimOptions(common::OptionsSchema& s, SimOptions& o) {
   s.add("lookahead_min_m", r.lookahead_min_m, 0.5, 50.0, "m", "pure pursuit look-ahead distance, at least");
   s.add("lookahead_s", r.lookahead_s, 0.0, 10.0, "s", "pure pursuit look-ahead in seconds of travel");
   s.add("revisit_probability", r.revisit_probability, 0.0, 1.0, "", "after exploring, drive back to an earlier intersection");
+  s.add("small_loop_probability", r.small_loop_probability, 0.0, 1.0, "", "a return goes to one of the last few intersections (a loop round a block or two) rather than any earlier one");
   s.add("explore_min_edges", r.explore_min_edges, 1, 1000, "", "street pieces explored before deciding, at least");
   s.add("explore_max_edges", r.explore_max_edges, 1, 1000, "", "... at most");
   s.add("straight_probability", r.straight_probability, 0.0, 1.0, "", "go straight at an intersection while exploring");

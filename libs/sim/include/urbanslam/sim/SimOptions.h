@@ -25,6 +25,7 @@ struct RouteOptions {
   double lookahead_min_m = 4.0;    // pure pursuit look-ahead: at least this ...
   double lookahead_s = 0.6;        // ... or this many seconds of travel
   double revisit_probability = 0.9;  // after exploring, head back to an earlier intersection
+  double small_loop_probability = 0.5;  // ... and then to one of the last few (a block-sized loop)
   int explore_min_edges = 2;       // street pieces driven freely before deciding to return
   int explore_max_edges = 12;
   double straight_probability = 0.5;  // at an intersection while exploring
