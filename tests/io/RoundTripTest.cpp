@@ -6,7 +6,10 @@
 #include <mrpt/obs/CRawlog.h>
 #include <mrpt/serialization/CArchive.h>
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 
 #include "TestPaths.h"
 #include "urbanslam/io/DataSource.h"
@@ -154,4 +157,45 @@ TEST(RoundTrip, VictoriaParkDriveAndGpsSurvive) {
   const auto sa = only<io::LaserScan>(a), sb = only<io::LaserScan>(b);
   ASSERT_EQ(sa.size(), 250u);
   for (size_t i = 0; i < sa.size(); ++i) expectSameScan(sa[i], sb[i]);
+}
+
+// Images stored beside the rawlog: nothing of an unfinished writer is left behind, and a
+// finished one replaces the images folder of an earlier rawlog of the same name whole.
+TEST(RoundTrip, ExternalImagesFolderIsReplacedWholeAtClose) {
+  namespace fs = std::filesystem;
+  const fs::path dir = test::scratchDir("rt_images");
+  const std::string out = (dir / "cam.rawlog").string();
+  const auto image = [](double t, uint8_t v) {
+    io::CameraImage im;
+    im.timestamp = t;
+    im.label = "CAMERA";
+    im.width = 8, im.height = 6;
+    im.pixels = std::make_shared<const std::vector<uint8_t>>(48, v);
+    return io::Measurement(im);
+  };
+  {
+    io::RawlogWriter w(out, io::RawlogLayout::Observations, 5, io::ImageStorage::External);
+    w.write(image(1.0, 10));
+    // not closed: as if the run was interrupted
+  }
+  for (const auto& e : fs::directory_iterator(dir)) ADD_FAILURE() << "left behind: " << e.path();
+  fs::create_directories(dir / "cam_Images");
+  std::ofstream(dir / "cam_Images" / "CAMERA_000007.png") << "an earlier run's image";
+  {
+    io::RawlogWriter w(out, io::RawlogLayout::Observations, 5, io::ImageStorage::External);
+    w.write(image(1.0, 10));
+    w.write(image(2.0, 200));
+    w.close();
+  }
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir / "cam_Images")) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"CAMERA_000000.png", "CAMERA_000001.png"}));
+  // Read back: the pixels come from the files beside the rawlog.
+  auto src = io::openDataSource(out);
+  io::Measurement m;
+  std::vector<uint8_t> firsts;
+  while (src->next(m))
+    if (const auto* im = std::get_if<io::CameraImage>(&m)) firsts.push_back(im->pixels->at(0));
+  EXPECT_EQ(firsts, (std::vector<uint8_t>{10, 200}));
 }

@@ -32,6 +32,7 @@ struct RawlogWriter::Impl {
   bool closed = false;
   ImageStorage images = ImageStorage::Embedded;
   std::string images_dir, last_image;
+  std::string images_temp;  // the images are written here and the folder renamed at close()
   size_t image_count = 0;
 
   // The observation for m; an image is first saved beside the rawlog when stored externally.
@@ -43,7 +44,7 @@ struct RawlogWriter::Impl {
     char name[64];
     std::snprintf(name, sizeof name, "_%06zu.png", image_count++);
     last_image = img->label + name;
-    const std::string file = images_dir + "/" + last_image;
+    const std::string file = images_temp + "/" + last_image;
     if (!obs->image.saveToFile(file)) throw InputError(file + ": cannot write image");
     obs->image.setExternalStorage(last_image);  // drops the pixels; the rawlog keeps the name
     return obs;
@@ -69,8 +70,11 @@ RawlogWriter::RawlogWriter(const std::string& path, RawlogLayout layout, int gz_
   if (images == ImageStorage::External) {
     const std::filesystem::path p(path);
     impl_->images_dir = (p.parent_path() / (p.stem().string() + "_Images")).string();
+    // A folder of its own until close(): an interrupted run leaves no images that look like a
+    // finished run's, and a rerun never mixes its images with an earlier run's.
+    impl_->images_temp = common::temporaryPathFor(impl_->images_dir);
     std::error_code ec;
-    std::filesystem::create_directories(impl_->images_dir, ec);
+    std::filesystem::create_directories(impl_->images_temp, ec);
     if (ec) throw InputError(impl_->images_dir + ": cannot create the images folder (" + ec.message() + ")");
   }
   impl_->temp = common::temporaryPathFor(path);
@@ -83,6 +87,8 @@ RawlogWriter::~RawlogWriter() {
   if (!impl_->closed) {
     impl_->out.close();
     std::remove(impl_->temp.c_str());
+    std::error_code ec;
+    if (!impl_->images_temp.empty()) std::filesystem::remove_all(impl_->images_temp, ec);
   }
 }
 
@@ -123,6 +129,13 @@ void RawlogWriter::close() {
   if (impl_->closed) return;
   impl_->flushFrame();
   impl_->out.close();
+  if (!impl_->images_temp.empty()) {
+    // The images first: the rawlog in place is what marks the output complete.
+    std::error_code ec;
+    std::filesystem::remove_all(impl_->images_dir, ec);
+    std::filesystem::rename(impl_->images_temp, impl_->images_dir, ec);
+    if (ec) throw InputError(impl_->images_dir + ": cannot rename the finished images folder into place (" + ec.message() + ")");
+  }
   if (std::rename(impl_->temp.c_str(), impl_->path.c_str()) != 0)
     throw InputError(impl_->path + ": cannot rename the finished file into place");
   impl_->closed = true;

@@ -28,16 +28,6 @@ SimulationSummary writeSimulation(const SimOptions& options, const std::string& 
   SimulationSummary sum;
   SimulatedSource source(options);
   const bool camera = options.camera.enabled;
-  if (camera && write_rawlog) {
-    // Images of an earlier run in this folder would mix with this one's in a folder listing.
-    const std::filesystem::path images(dir + "/city_Images");
-    if (std::filesystem::is_directory(images, ec))
-      for (const auto& f : std::filesystem::directory_iterator(images, ec)) {
-        const std::string name = f.path().filename().string();
-        if (f.path().extension() == ".png" && name.rfind(options.camera.label + "_", 0) == 0)
-          std::filesystem::remove(f.path(), ec);
-      }
-  }
   std::unique_ptr<io::RawlogWriter> rawlog;
   if (write_rawlog)
     rawlog = std::make_unique<io::RawlogWriter>(dir + "/city.rawlog", io::RawlogLayout::Observations, 5,
