@@ -279,8 +279,8 @@ void MainFrame::showError(const std::string& message) {
 
 bool MainFrame::openLog(const std::string& path) {
   try {
-    auto worker = std::make_unique<PipelineWorker>(path, options_.ini, options_.home + "/share/laser_loop/default.model",
-                                                   options_.home + "/" + vision_loop::kDefaultVocabularyPath);
+    auto worker = std::make_unique<PipelineWorker>(path, options_.ini, slam::defaultLaserModelPath(options_.home),
+                                                   slam::defaultVocabularyPath(options_.home));
     worker_.reset();  // the previous run's thread ends first
     worker_ = std::move(worker);
   } catch (const std::exception& e) {

@@ -59,10 +59,7 @@ int runCommand(const Argv& args) {
   const bool quiet = ap.flag("quiet");
   std::string resolved;
   slam::PipelineOptions options = slam::loadPipelineOptions(ini, &resolved);
-  if (options.loop_closure.laser_model.empty())
-    options.loop_closure.laser_model = projectHome() + "/share/laser_loop/default.model";
-  if (options.image_loop.vocabulary.empty())
-    options.image_loop.vocabulary = projectHome() + "/" + vision_loop::kDefaultVocabularyPath;
+  slam::resolveDefaultPaths(options, projectHome());
 
   // The simulator is a data source like a file reader: a drive of any length streams through.
   std::unique_ptr<io::DataSource> source =

@@ -22,7 +22,6 @@
 #include "urbanslam/slam/Pipeline.h"
 #include "urbanslam/slam/PipelineOptions.h"
 #include "urbanslam/slam/RunOutputs.h"
-#include "urbanslam/vision_loop/ImageLoopOptions.h"
 
 using namespace urbanslam;
 
@@ -62,10 +61,7 @@ int main(int argc, char** argv) {
   try {
     std::string resolved;
     slam::PipelineOptions options = slam::loadPipelineOptions(ini, &resolved);
-    if (options.loop_closure.laser_model.empty())
-      options.loop_closure.laser_model = std::string(URBANSLAM_SOURCE_DIR) + "/share/laser_loop/default.model";
-    if (options.image_loop.vocabulary.empty())
-      options.image_loop.vocabulary = std::string(URBANSLAM_SOURCE_DIR) + "/" + vision_loop::kDefaultVocabularyPath;
+    slam::resolveDefaultPaths(options, URBANSLAM_SOURCE_DIR);
     std::unique_ptr<io::DataSource> source =
         city.empty() ? io::openDataSource(log) : std::make_unique<sim::SimulatedSource>(sim::loadSimOptions(city));
     slam::Pipeline pipeline(options);

@@ -1,6 +1,8 @@
 #include "urbanslam/slam/PipelineOptions.h"
 
 #include "urbanslam/common/IniFile.h"
+#include "urbanslam/laser_loop/LoopDetector.h"
+#include "urbanslam/vision_loop/ImageLoopOptions.h"
 
 namespace urbanslam::slam {
 
@@ -109,6 +111,15 @@ PipelineOptions loadPipelineOptions(const std::string& ini_path, std::string* re
   if (!ini_path.empty()) schema.load(common::IniFile::load(ini_path));
   if (resolved_ini) *resolved_ini = schema.toIni();
   return o;
+}
+
+std::string defaultLaserModelPath(const std::string& home) { return home + "/" + laser_loop::kDefaultModelPath; }
+
+std::string defaultVocabularyPath(const std::string& home) { return home + "/" + vision_loop::kDefaultVocabularyPath; }
+
+void resolveDefaultPaths(PipelineOptions& options, const std::string& home) {
+  if (options.loop_closure.laser_model.empty()) options.loop_closure.laser_model = defaultLaserModelPath(home);
+  if (options.image_loop.vocabulary.empty()) options.image_loop.vocabulary = defaultVocabularyPath(home);
 }
 
 }  // namespace urbanslam::slam

@@ -149,4 +149,11 @@ common::Json optionsToJson(const PipelineOptions& options);
 // `resolved_ini` (optional) receives the resolved configuration as ini text.
 PipelineOptions loadPipelineOptions(const std::string& ini_path, std::string* resolved_ini = nullptr);
 
+// The shipped data files under the project home (the repository, or $URBANSLAM_HOME), in one
+// place for every program: the laser classifier's model and the Tree of Words vocabulary.
+std::string defaultLaserModelPath(const std::string& home);
+std::string defaultVocabularyPath(const std::string& home);
+// Fills an empty [loop_closure] laser_model and [image_loop] vocabulary with those.
+void resolveDefaultPaths(PipelineOptions& options, const std::string& home);
+
 }  // namespace urbanslam::slam
