@@ -2,6 +2,8 @@
 // inputs that must fail cleanly.
 #include <gtest/gtest.h>
 
+#include "urbanslam/common/RigidFit.h"
+
 #include <cmath>
 #include <limits>
 #include <random>
@@ -53,10 +55,10 @@ TEST(LeastSquares, ExactTransformFromPairs) {
   std::vector<Eigen::Vector2d> src = {{0, 0}, {1, 0}, {0, 2}, {-3, 1}}, dst;
   for (const auto& s : src) dst.push_back(R * s);
   uc::Pose2 est;
-  ASSERT_TRUE(ua::leastSquaresTransform(src, dst, {1, 1, 1, 1}, &est));
+  ASSERT_TRUE(uc::fitRigid2D(src, dst, {1, 1, 1, 1}, &est));
   expectNear(est, T, 1e-12, 1e-12, "closed form");
-  EXPECT_FALSE(ua::leastSquaresTransform({{0, 0}}, {{1, 1}}, {1}, &est));
-  EXPECT_FALSE(ua::leastSquaresTransform(src, dst, {0, 0, 0, 0}, &est));
+  EXPECT_FALSE(uc::fitRigid2D({{0, 0}}, {{1, 1}}, {1}, &est));
+  EXPECT_FALSE(uc::fitRigid2D(src, dst, {0, 0, 0, 0}, &est));
 }
 
 class MethodTest : public ::testing::TestWithParam<ua::Method> {};

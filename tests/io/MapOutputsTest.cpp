@@ -146,7 +146,9 @@ TEST(MapOutputs, SimpleMapReadsBackScansAndPoses) {
     ASSERT_EQ(back[i].scan.ranges.size(), e.scans[i].ranges.size());
     for (size_t k = 0; k < e.scans[i].ranges.size(); ++k) {
       EXPECT_EQ(back[i].scan.valid[k], e.scans[i].valid[k]) << "scan " << i << " beam " << k;
-      if (e.scans[i].valid[k]) EXPECT_NEAR(back[i].scan.ranges[k], e.scans[i].ranges[k], 1e-4);
+      if (e.scans[i].valid[k]) {
+        EXPECT_NEAR(back[i].scan.ranges[k], e.scans[i].ranges[k], 1e-4);
+      }
     }
     EXPECT_NEAR(back[i].scan.angle_increment_rad, e.scans[i].angle_increment_rad, 1e-7);
   }

@@ -8,6 +8,7 @@
 
 #include "urbanslam/alignment/Icp.h"
 #include "urbanslam/common/Timing.h"
+#include "urbanslam/common/RigidFit.h"
 
 namespace urbanslam::alignment {
 
@@ -387,7 +388,7 @@ RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, c
       rj.push_back(ref.source[ref.selected[c.state]]);
     }
     Pose2 T2;
-    if (static_cast<int>(src.size()) < min_assoc || !leastSquaresTransform(src, dst, w, &T2)) break;
+    if (static_cast<int>(src.size()) < min_assoc || !common::fitRigid2D(src, dst, w, &T2)) break;
     T = T2;
     double unused = 0;
     bestPerNode(T, &pick, &unused);

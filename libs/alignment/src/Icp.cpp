@@ -7,41 +7,11 @@
 
 #include "urbanslam/alignment/IndexedReference.h"
 #include "urbanslam/alignment/NearestNeighbours.h"
+#include "urbanslam/common/RigidFit.h"
 
 namespace urbanslam::alignment {
 
 using common::Pose2;
-
-bool leastSquaresTransform(const std::vector<Eigen::Vector2d>& src,
-                           const std::vector<Eigen::Vector2d>& dst, const std::vector<double>& weights,
-                           Pose2* transform) {
-  if (src.size() < 2 || src.size() != dst.size() || weights.size() != src.size()) return false;
-  double W = 0;
-  Eigen::Vector2d ms = Eigen::Vector2d::Zero(), md = Eigen::Vector2d::Zero();
-  for (size_t i = 0; i < src.size(); ++i) {
-    W += weights[i];
-    ms += weights[i] * src[i];
-    md += weights[i] * dst[i];
-  }
-  if (!(W > 0)) return false;
-  ms /= W;
-  md /= W;
-  double sxx = 0, sxy = 0, syx = 0, syy = 0;
-  for (size_t i = 0; i < src.size(); ++i) {
-    const Eigen::Vector2d a = src[i] - ms, b = dst[i] - md;
-    sxx += weights[i] * a.x() * b.x();
-    sxy += weights[i] * a.x() * b.y();
-    syx += weights[i] * a.y() * b.x();
-    syy += weights[i] * a.y() * b.y();
-  }
-  // The rotation maximising sum w (R a) . b has tan(phi) = (sxy - syx) / (sxx + syy).
-  const double phi = std::atan2(sxy - syx, sxx + syy);
-  const double c = std::cos(phi), s = std::sin(phi);
-  transform->phi = phi;
-  transform->x = md.x() - (c * ms.x() - s * ms.y());
-  transform->y = md.y() - (s * ms.x() + c * ms.y());
-  return std::isfinite(transform->x) && std::isfinite(transform->y) && std::isfinite(phi);
-}
 
 namespace {
 
@@ -138,7 +108,7 @@ RegistrationResult icpWithIndex(const PointSet& reference, const NearestNeighbou
     }
     Pose2 next = pose;
     if (!point_to_line) {
-      if (!leastSquaresTransform(src, dst, w, &next)) break;
+      if (!common::fitRigid2D(src, dst, w, &next)) break;
     } else {
       // Gauss-Newton on (x, y, phi): line pairs give a scalar residual along the normal, pairs
       // without a line the 2D point residual.

@@ -9,6 +9,7 @@
 #include <unordered_map>
 
 #include "urbanslam/common/Error.h"
+#include "urbanslam/common/RigidFit.h"
 
 namespace urbanslam::esdf {
 
@@ -23,24 +24,17 @@ TrajectoryError trajectoryError(const std::vector<PoseGraphVertex>& est, const s
     if (it != by_id.end()) pairs.emplace_back(&v.pose, it->second);
   }
   if (pairs.size() < 2) throw common::InputError("trajectory error: fewer than two vertex ids in common with the reference");
-  // Closed-form rigid alignment (2D Kabsch): centre both point sets; the rotation angle is the
-  // argument of sum conj(p) q over the centred points seen as complex numbers.
-  Eigen::Vector2d cp = Eigen::Vector2d::Zero(), cq = Eigen::Vector2d::Zero();
+  // The estimate rigidly aligned onto the reference (the project's one closed-form fit).
+  std::vector<Eigen::Vector2d> src, dst;
   for (const auto& [p, q] : pairs) {
-    cp += p->head<2>();
-    cq += q->head<2>();
+    src.push_back(p->head<2>());
+    dst.push_back(q->head<2>());
   }
-  cp /= static_cast<double>(pairs.size());
-  cq /= static_cast<double>(pairs.size());
-  double s_cos = 0, s_sin = 0;
-  for (const auto& [p, q] : pairs) {
-    const Eigen::Vector2d a = p->head<2>() - cp, b = q->head<2>() - cq;
-    s_cos += a.x() * b.x() + a.y() * b.y();
-    s_sin += a.x() * b.y() - a.y() * b.x();
-  }
-  const double theta = std::atan2(s_sin, s_cos);
+  common::Pose2 fit;
+  if (!common::fitRigid2D(src, dst, {}, &fit)) throw common::InputError("trajectory error: the alignment onto the reference is not finite");
+  const double theta = fit.phi;
   const Eigen::Matrix2d r = Eigen::Rotation2Dd(theta).toRotationMatrix();
-  const Eigen::Vector2d t = cq - r * cp;
+  const Eigen::Vector2d t(fit.x, fit.y);
   TrajectoryError out;
   out.matched = pairs.size();
   out.alignment = {t.x(), t.y(), theta};

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "urbanslam/common/Error.h"
+#include "urbanslam/common/RigidFit.h"
 
 namespace urbanslam::slam {
 
@@ -230,23 +231,14 @@ TrajectoryMetrics trajectoryMetrics(const std::vector<io::StampedPose>& estimate
   }
   m.matched = e.size();
   if (e.size() < 2) return m;
-  // Closed-form 2D rigid alignment (Horn): rotation from the cross-covariance of centred points.
-  Eigen::Vector2d ce(0, 0), cr(0, 0);
+  // The estimate rigidly aligned onto the reference (the project's one closed-form fit).
+  std::vector<Eigen::Vector2d> src, dst;
   for (size_t i = 0; i < e.size(); ++i) {
-    ce += Eigen::Vector2d(e[i].x, e[i].y);
-    cr += Eigen::Vector2d(r[i].x, r[i].y);
+    src.emplace_back(e[i].x, e[i].y);
+    dst.emplace_back(r[i].x, r[i].y);
   }
-  ce /= static_cast<double>(e.size());
-  cr /= static_cast<double>(e.size());
-  double sxx = 0, sxy = 0;
-  for (size_t i = 0; i < e.size(); ++i) {
-    const Eigen::Vector2d a = Eigen::Vector2d(e[i].x, e[i].y) - ce, b = Eigen::Vector2d(r[i].x, r[i].y) - cr;
-    sxx += a.x() * b.x() + a.y() * b.y();
-    sxy += a.x() * b.y() - a.y() * b.x();
-  }
-  const double th = std::atan2(sxy, sxx), c = std::cos(th), s = std::sin(th);
-  const Eigen::Vector2d t = cr - Eigen::Vector2d(c * ce.x() - s * ce.y(), s * ce.x() + c * ce.y());
-  const Pose2 align{t.x(), t.y(), th};
+  Pose2 align;
+  if (!common::fitRigid2D(src, dst, {}, &align)) return m;
   m.alignment = align;
   double sum2 = 0;
   for (size_t i = 0; i < e.size(); ++i) {

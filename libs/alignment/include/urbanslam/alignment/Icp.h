@@ -52,10 +52,4 @@ RegistrationResult icpWithIndex(const PointSet& reference, const NearestNeighbou
                                 const std::vector<LineNormal>& normals, const PointSet& moving,
                                 const common::Pose2& guess, const IcpOptions& options);
 
-// Closed-form weighted least-squares rigid transform mapping src[i] onto dst[i] (Arun/Umeyama in
-// 2D). Returns false when the total weight is zero or there are fewer than two pairs.
-bool leastSquaresTransform(const std::vector<Eigen::Vector2d>& src,
-                           const std::vector<Eigen::Vector2d>& dst, const std::vector<double>& weights,
-                           common::Pose2* transform);
-
 }  // namespace urbanslam::alignment
