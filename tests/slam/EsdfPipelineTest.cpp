@@ -99,7 +99,7 @@ TEST(EsdfPipeline, WrongPlaceClosureIsGatedOut) {
   const size_t factors_before = f.factorCount();
   const slam::LoopClosureRecord r = closer.tryClose(f, keyframes, i, k);
   EXPECT_FALSE(r.accepted);
-  EXPECT_EQ(r.reason, "gating") << "rms " << r.rms_m;
+  EXPECT_EQ(r.reason, slam::ClosureReason::Gating) << "rms " << r.rms_m;
   EXPECT_GT(r.mahalanobis2, r.gate_threshold);
   EXPECT_EQ(f.factorCount(), factors_before);  // nothing touched the filter
 }

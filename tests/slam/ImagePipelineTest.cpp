@@ -96,7 +96,7 @@ TEST(ImagePipeline, ProposesTheGroundTruthLoopsOfTheRtabmapExcerpt) {
     if (correct) found.insert(q);
     // Without scans a proposal cannot be aligned: on record, never a constraint.
     EXPECT_FALSE(c.accepted);
-    EXPECT_EQ(c.reason, "no_scans");
+    EXPECT_EQ(c.reason, slam::ClosureReason::NoScans);
     EXPECT_LT(c.from, c.to);
   }
   const double precision = tp + fp ? double(tp) / double(tp + fp) : 0.0, recall = double(found.size()) / double(gt.size());

@@ -77,7 +77,7 @@ TEST(LoopCloser, AliasedMinimumAlongACorridorIsRefused) {
   off.max_free_space_conflict = 1;
   auto f1 = filterWith(p.keyframes[0].pose, drifted);
   const auto wrong = slam::LoopCloser(off).tryClose(*f1, p.keyframes, 0, 1, false);
-  ASSERT_TRUE(wrong.accepted) << wrong.reason;
+  ASSERT_TRUE(wrong.accepted) << slam::reasonName(wrong.reason);
   EXPECT_GT(distance(p.truth, wrong.measurement), 1.0);  // a false closure against the reference
 
   slam::LoopClosureOptions on = off;
@@ -85,12 +85,12 @@ TEST(LoopCloser, AliasedMinimumAlongACorridorIsRefused) {
   auto f2 = filterWith(p.keyframes[0].pose, drifted);
   const auto refused = slam::LoopCloser(on).tryClose(*f2, p.keyframes, 0, 1, false);
   EXPECT_FALSE(refused.accepted);
-  EXPECT_EQ(refused.reason, "ambiguous");
+  EXPECT_EQ(refused.reason, slam::ClosureReason::Ambiguous);
 
   // From a correct estimate the same test lets the true closure through.
   auto f3 = filterWith(p.keyframes[0].pose, p.truth);
   const auto right = slam::LoopCloser(on).tryClose(*f3, p.keyframes, 0, 1, false);
-  EXPECT_TRUE(right.accepted) << right.reason;
+  EXPECT_TRUE(right.accepted) << slam::reasonName(right.reason);
   EXPECT_LT(distance(p.truth, right.measurement), 0.1);
   EXPECT_LT(std::abs(common::between(p.truth, right.measurement).phi), 2 * kDeg);
 }
@@ -110,14 +110,14 @@ TEST(LoopCloser, CorridorSlideConflictsWithFreeSpace) {
   o.max_free_space_conflict = 1;
   auto f1 = filterWith(p.keyframes[0].pose, drifted);
   const auto wrong = slam::LoopCloser(o).tryClose(*f1, p.keyframes, 0, 1, false);
-  ASSERT_TRUE(wrong.accepted) << wrong.reason;
+  ASSERT_TRUE(wrong.accepted) << slam::reasonName(wrong.reason);
   EXPECT_GT(distance(p.truth, wrong.measurement), 1.0);
 
   o.max_free_space_conflict = 0.2;
   auto f2 = filterWith(p.keyframes[0].pose, drifted);
   const auto refused = slam::LoopCloser(o).tryClose(*f2, p.keyframes, 0, 1, false);
   EXPECT_FALSE(refused.accepted);
-  EXPECT_EQ(refused.reason, "free_space");
+  EXPECT_EQ(refused.reason, slam::ClosureReason::FreeSpace);
   EXPECT_GT(refused.free_space_conflict, 0.2);
 
   // At the reference pose the two scans agree on free space. (PL-ICP started there slides to the

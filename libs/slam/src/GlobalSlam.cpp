@@ -66,7 +66,7 @@ std::array<double, 9> GlobalSlam::addKeyframe(Keyframe kf, const KeyframeConstra
 
 void GlobalSlam::finish() {
   for (LoopClosureRecord r : pending_) {  // hypotheses still waiting for a confirmation
-    r.reason = "unconfirmed";
+    r.reason = ClosureReason::Unconfirmed;
     r.accepted = false;
     reportClosure(r);
   }
@@ -77,7 +77,7 @@ void GlobalSlam::finish() {
 void GlobalSlam::reportClosure(const LoopClosureRecord& r) {
   ++(r.accepted ? stats_.closures_accepted : stats_.closures_rejected);
   closures_.push_back(r);
-  const LoopClosureEvent e{r.from, r.to, r.to_time, r.detector, r.score, r.accepted, r.reason};
+  const LoopClosureEvent e{r.from, r.to, r.to_time, r.detector, r.score, r.accepted, reasonName(r.reason)};
   for (auto* o : observers_) o->onLoopClosure(e);
 }
 
@@ -104,7 +104,7 @@ void GlobalSlam::expirePending(size_t current) {
     LoopClosureRecord r = pending_.front();
     pending_.pop_front();
     r.accepted = false;
-    r.reason = "unconfirmed";
+    r.reason = ClosureReason::Unconfirmed;
     reportClosure(r);
   }
 }
@@ -140,7 +140,7 @@ GlobalSlam::Admission GlobalSlam::admit(LoopClosureRecord r, size_t current) {
                                             c->information, true);
     c->accepted = res.accepted;
     c->mahalanobis2 = res.gate.mahalanobis2;
-    if (!res.accepted) c->reason = "gating";
+    if (!res.accepted) c->reason = ClosureReason::Gating;
     if (c->accepted) {
       map_.addEdge({c->from, c->to, c->measurement, c->information, true});
       accepted = true;
@@ -200,10 +200,10 @@ void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double scor
     const Detection detection{"image", score};
     LoopClosureRecord r = closer_.tryClose(*map_.filter(), map_.keyframes(), earlier, current, !confirm, &detection);
     ++stats_.closures_tried;
-    const std::string reason = r.reason;
+    const ClosureReason reason = r.reason;
     const Admission a = admit(std::move(r), current);
     ev.accepted = a == Admission::Accepted;
-    ev.fate = a == Admission::Accepted ? "accepted" : a == Admission::Pending ? "pending" : (reason.empty() ? "gating" : reason);
+    ev.fate = a == Admission::Accepted ? "accepted" : a == Admission::Pending ? "pending" : (reason == ClosureReason::None ? "gating" : reasonName(reason));
     if (ev.accepted) recoverAll();
     stats_.closure_ms.push_back(sw.milliseconds());
   } else {
@@ -216,8 +216,8 @@ void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double scor
     r.to_time = map_.keyframes()[current].timestamp;
     r.detector = "image";
     r.score = score;
-    r.reason = !filter ? "no_filter" : !options_.loop_closure.enabled ? "loop_closure_disabled" : "no_scans";
-    ev.fate = r.reason;
+    r.reason = !filter ? ClosureReason::NoFilter : !options_.loop_closure.enabled ? ClosureReason::LoopClosureDisabled : ClosureReason::NoScans;
+    ev.fate = reasonName(r.reason);
     reportClosure(r);
   }
   for (auto* o : observers_) o->onImageMatch(ev);

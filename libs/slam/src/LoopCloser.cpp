@@ -20,6 +20,22 @@ double largestPositionSigma(const Eigen::Matrix3d& cov) {
 }
 }  // namespace
 
+const char* reasonName(ClosureReason reason) {
+  switch (reason) {
+    case ClosureReason::None: return "";
+    case ClosureReason::Classifier: return "classifier";
+    case ClosureReason::Alignment: return "alignment";
+    case ClosureReason::Ambiguous: return "ambiguous";
+    case ClosureReason::FreeSpace: return "free_space";
+    case ClosureReason::Gating: return "gating";
+    case ClosureReason::Unconfirmed: return "unconfirmed";
+    case ClosureReason::NoScans: return "no_scans";
+    case ClosureReason::NoFilter: return "no_filter";
+    case ClosureReason::LoopClosureDisabled: return "loop_closure_disabled";
+  }
+  return "";
+}
+
 LoopCloser::LoopCloser(const LoopClosureOptions& options)
     : options_(options),
       chi2_2dof_(esdf::chi2Quantile(options.mahalanobis_probability, 2)) {}
@@ -122,7 +138,7 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
   } else if (scorer_) {
     r.score = scorer_(earlier, current);
     if (r.score < options_.laser_threshold) {
-      r.reason = "classifier";
+      r.reason = ClosureReason::Classifier;
       return r;
     }
   }
@@ -154,11 +170,11 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
   const double matched = a.matchedFraction();
   if (!scorer_ && !detection) r.score = matched;
   if (!good(a)) {
-    r.reason = "alignment";
+    r.reason = ClosureReason::Alignment;
     return r;
   }
   if (options_.ambiguity_offset_m > 0 && ambiguous(filter, keyframes, earlier, current, a, ao)) {
-    r.reason = "ambiguous";
+    r.reason = ClosureReason::Ambiguous;
     return r;
   }
   alignment::FreeSpaceOptions fo;
@@ -166,7 +182,7 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
   fo.no_return_free_m = options_.free_space_no_return_m;
   r.free_space_conflict = alignment::mutualFreeSpaceConflict(keyframes[earlier].scan, keyframes[current].scan, a.transform, fo);
   if (r.free_space_conflict > options_.max_free_space_conflict) {
-    r.reason = "free_space";
+    r.reason = ClosureReason::FreeSpace;
     return r;
   }
   // Innovation gate, then the information-form update.
@@ -182,7 +198,7 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
   r.mahalanobis2 = gate.mahalanobis2;
   r.gate_threshold = gate.threshold;
   r.accepted = gate.accepted;
-  if (!r.accepted) r.reason = "gating";
+  if (!r.accepted) r.reason = ClosureReason::Gating;
   return r;
 }
 

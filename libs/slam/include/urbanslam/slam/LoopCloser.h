@@ -19,6 +19,22 @@ namespace urbanslam::slam {
 
 struct Keyframe;
 
+// Why a loop-closure hypothesis did not become a constraint.
+enum class ClosureReason {
+  None,                 // accepted (or not decided yet)
+  Classifier,           // the laser classifier's score was below its threshold
+  Alignment,            // the scans could not be aligned well enough
+  Ambiguous,            // another alignment explains the scans about as well
+  FreeSpace,            // one scan's points lie where the other scan's beams passed through
+  Gating,               // the innovation gate refused it
+  Unconfirmed,          // no second closure agreed with it in time
+  NoScans,              // an image proposal between keyframes without laser scans
+  NoFilter,             // an image proposal in dead reckoning
+  LoopClosureDisabled,  // an image proposal with [loop_closure] enabled = false
+};
+// Its name in loop_closures.csv and in observer events ("" for None).
+const char* reasonName(ClosureReason reason);
+
 // One loop-closure hypothesis and what became of it (a row of loop_closures.csv).
 struct LoopClosureRecord {
   size_t from = 0, to = 0;           // earlier keyframe, current keyframe
@@ -26,9 +42,7 @@ struct LoopClosureRecord {
   std::string detector;              // which source proposed it: "pose" (near the estimate; alignment + gating verify), "laser" or "image"
   double score = 0;                  // classifier margin, image normalised score, or alignment matched fraction
   bool accepted = false;
-  // When not accepted: classifier | alignment | ambiguous | free_space | gating | unconfirmed, or for image proposals that
-  // could not be verified: no_scans (a keyframe has no laser scan) | no_filter (dead reckoning).
-  std::string reason;
+  ClosureReason reason = ClosureReason::None;  // when not accepted
   common::Pose2 measurement;         // aligned relative pose (from -> to)
   Eigen::Matrix3d information = Eigen::Matrix3d::Identity();  // as added to the filter
   double rms_m = 0, mahalanobis2 = 0, gate_threshold = 0;

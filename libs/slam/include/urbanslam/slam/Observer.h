@@ -32,10 +32,10 @@ struct PosesUpdatedEvent {
 struct LoopClosureEvent {
   size_t from_keyframe = 0, to_keyframe = 0;  // earlier, current
   double timestamp = 0;
-  std::string detector;      // "laser", "image"
+  std::string detector;      // which source proposed it: "pose", "laser" or "image"
   double score = 0;
   bool accepted = false;
-  std::string reason;        // why rejected: "classifier", "alignment", "gating"; empty if accepted
+  std::string reason;        // why rejected: reasonName() of slam::ClosureReason (LoopCloser.h); empty if accepted
 };
 
 // The image chosen for a keyframe (the nearest in time, within [loop_closure]
@@ -53,8 +53,8 @@ struct ImageMatchEvent {
   double score = 0;        // normalised score (similarity relative to the previous frame's)
   bool accepted = false;   // the closure went into the filter
   // "accepted"; "pending" (passed alignment and gating, awaiting a confirming closure; the
-  // final fate follows as a LoopClosureEvent with detector "image"); else why not:
-  // alignment | gating | no_scans | no_filter | loop_closure_disabled.
+  // final fate follows as a LoopClosureEvent with detector "image"); else why not: the
+  // reasonName() of its slam::ClosureReason.
   std::string fate;
 };
 
