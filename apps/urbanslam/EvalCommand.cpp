@@ -11,9 +11,9 @@
 #include "urbanslam/io/DataSource.h"
 #include "urbanslam/io/MapOutputs.h"
 #include "urbanslam/laser_loop/LinePlot.h"
-#include "urbanslam/slam/ClosureEvidence.h"
-#include "urbanslam/slam/Evaluation.h"
-#include "urbanslam/slam/MapAccuracy.h"
+#include "urbanslam/evaluation/ClosureEvidence.h"
+#include "urbanslam/evaluation/Evaluation.h"
+#include "urbanslam/evaluation/MapAccuracy.h"
 
 namespace urbanslam::cli {
 
@@ -43,7 +43,7 @@ std::vector<io::StampedPose> loadReference(const std::string& path, bool& positi
 }
 
 // One closure that disagrees with a reference (the corrected log's poses or the relations).
-common::Json closureJson(const slam::FalseClosure& f) {
+common::Json closureJson(const evaluation::FalseClosure& f) {
   common::Json e = common::Json::object();
   e["from_keyframe"] = f.from_keyframe;
   e["to_keyframe"] = f.to_keyframe;
@@ -70,7 +70,7 @@ void evaluateAgainstSimulation(const fs::path& run, const fs::path& sim, const c
   const auto keyframes = io::readSimpleMap(simplemap.string());
   std::vector<io::PosedScan> posed;
   for (const auto& k : keyframes) posed.push_back({k.pose, &k.scan});
-  const auto acc = slam::mapAccuracy(io::mapPoints(posed), to_truth, slam::readWallsCsv((sim / "walls.csv").string()));
+  const auto acc = evaluation::mapAccuracy(io::mapPoints(posed), to_truth, evaluation::readWallsCsv((sim / "walls.csv").string()));
   common::Json m = common::Json::object();
   m["points"] = acc.points;
   m["mean_m"] = acc.mean_m;
@@ -80,8 +80,8 @@ void evaluateAgainstSimulation(const fs::path& run, const fs::path& sim, const c
   m["beyond_1_m"] = acc.beyond_1_m;
   j["map"] = std::move(m);
   if (fs::exists(run / "loop_closures.csv")) {
-    const auto r = slam::loopRecall(slam::readLoopClosuresCsv((run / "loop_closures.csv").string()),
-                                    slam::readTrueLoopsCsv((sim / "loops.csv").string()));
+    const auto r = evaluation::loopRecall(evaluation::readLoopClosuresCsv((run / "loop_closures.csv").string()),
+                                    evaluation::readTrueLoopsCsv((sim / "loops.csv").string()));
     common::Json l = common::Json::object();
     l["revisited_scans"] = r.revisited_scans;
     l["closed_scans"] = r.closed_scans;
@@ -153,16 +153,16 @@ int evalCommand(const Argv& args) {
   else if (fs::exists(dir / "reference.tum")) reference = io::readTum((dir / "reference.tum").string());
 
   if (ap.has("relations")) {
-    const auto rel = slam::readRelations(ap.option("relations"));
+    const auto rel = evaluation::readRelations(ap.option("relations"));
     double offset = 0;
     if (ap.has("time-offset")) offset = ap.optionDouble("time-offset");
     else {
       std::vector<double> log_times;  // the log's own timestamps (not estimated values)
       for (const auto& p : estimate) log_times.push_back(p.timestamp);
-      offset = slam::findRelationTimeOffset(reference.empty() ? estimate : reference, rel, log_times);
+      offset = evaluation::findRelationTimeOffset(reference.empty() ? estimate : reference, rel, log_times);
     }
     const auto block = [&](const std::vector<io::StampedPose>& traj, const fs::path& path) {
-      const auto m = slam::relationMetrics(traj, rel, offset, max_gap);
+      const auto m = evaluation::relationMetrics(traj, rel, offset, max_gap);
       common::Json r = common::Json::object();
       r["file"] = ap.option("relations");
       r["trajectory"] = path.filename().string();
@@ -191,10 +191,10 @@ int evalCommand(const Argv& args) {
     if (fs::exists(scans_path) || ap.has("scans")) {
       std::vector<double> scan_times;
       for (const auto& p : io::readTum(scans_path.string())) scan_times.push_back(p.timestamp);
-      const auto by = slam::relationsByScans(estimate, rel, offset, scan_times, max_gap);
+      const auto by = evaluation::relationsByScans(estimate, rel, offset, scan_times, max_gap);
       common::Json& b = r["by_scans"];
       b["scans"] = scans_path.string();
-      const auto cls = [](const slam::RelationClass& c) {
+      const auto cls = [](const evaluation::RelationClass& c) {
         common::Json o = common::Json::object();
         o["n"] = c.n;
         o["abs_trans_mean_m"] = c.abs_trans_mean_m;
@@ -209,7 +209,7 @@ int evalCommand(const Argv& args) {
     // carried over the short legs by the odometry-time trajectory (it follows the turns between
     // sparse scans; at the scans it is their poses).
     if (fs::exists(dir / "loop_closures.csv")) {
-      const auto lc = slam::checkLoopsWithRelations(slam::readLoopClosuresCsv((dir / "loop_closures.csv").string()), estimate, rel, offset);
+      const auto lc = evaluation::checkLoopsWithRelations(evaluation::readLoopClosuresCsv((dir / "loop_closures.csv").string()), estimate, rel, offset);
       common::Json& l = j["relations"]["loops"];
       l["accepted"] = lc.accepted;
       l["checked"] = lc.checked;
@@ -219,13 +219,13 @@ int evalCommand(const Argv& args) {
       l["contradicted_list"] = std::move(list);
     }
     if (!reference.empty()) {
-      const auto mr = slam::relationMetrics(reference, rel, offset, 5.0);  // reference poses are sparse
+      const auto mr = evaluation::relationMetrics(reference, rel, offset, 5.0);  // reference poses are sparse
       j["relations"]["reference_abs_trans_mean_m"] = mr.abs_trans_m.mean;
       j["relations"]["reference_abs_rot_mean_deg"] = mr.abs_rot_deg.mean;
     }
   }
   if (!reference_path.empty()) {
-    const auto tm = slam::trajectoryMetrics(estimate, reference, positions_only, positions_only ? 2.0 : 1.0);
+    const auto tm = evaluation::trajectoryMetrics(estimate, reference, positions_only, positions_only ? 2.0 : 1.0);
     j["reference"] = reference_path;
     if (ap.has("truth")) evaluateAgainstSimulation(dir, truth_dir, tm.alignment, j);
     j["positions_only"] = positions_only;
@@ -235,7 +235,7 @@ int evalCommand(const Argv& args) {
     j["rpe_trans_rmse_m"] = tm.rpe_trans_rmse_m;
     j["rpe_rot_rmse_deg"] = tm.rpe_rot_rmse_deg;
     if (fs::exists(dir / "loop_closures.csv")) {
-      const auto lm = slam::classifyLoopClosures(slam::readLoopClosuresCsv((dir / "loop_closures.csv").string()), reference,
+      const auto lm = evaluation::classifyLoopClosures(evaluation::readLoopClosuresCsv((dir / "loop_closures.csv").string()), reference,
                                                  positions_only, ap.optionDouble("loop-tolerance-m"),
                                                  ap.optionDouble("loop-tolerance-deg"));
       j["loops_accepted"] = lm.accepted;
@@ -254,7 +254,7 @@ int evalCommand(const Argv& args) {
         common::Json e = closureJson(f);
         const auto in_map = [&](long k) { return k >= 0 && static_cast<size_t>(k) < keyframes.size(); };
         if (weigh && in_map(f.from_keyframe) && in_map(f.to_keyframe)) {
-          const auto ev = slam::weighClosure(keyframes[static_cast<size_t>(f.from_keyframe)].scan,
+          const auto ev = evaluation::weighClosure(keyframes[static_cast<size_t>(f.from_keyframe)].scan,
                                              keyframes[static_cast<size_t>(f.to_keyframe)].scan, f.measurement, f.reference);
           common::Json s = common::Json::object();
           s["verdict"] = ev.verdict;

@@ -5,7 +5,7 @@
 #include "TestPaths.h"
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/esdf/PoseOps.h"
-#include "urbanslam/slam/Evaluation.h"
+#include "urbanslam/evaluation/Evaluation.h"
 #include "urbanslam/slam/Pipeline.h"
 
 using namespace urbanslam;
@@ -22,7 +22,7 @@ std::unique_ptr<slam::Pipeline> runOn(const std::string& log, slam::PipelineOpti
 double ateAgainstReference(const slam::Pipeline& p) {
   std::vector<io::StampedPose> kf;
   for (const auto& k : p.keyframes()) kf.push_back({k.timestamp, k.pose});
-  return slam::trajectoryMetrics(kf, p.referenceTrajectory(), false).ate_rmse_m;
+  return evaluation::trajectoryMetrics(kf, p.referenceTrajectory(), false).ate_rmse_m;
 }
 
 // Rebuilds the filter from the constraints the pipeline reported (independent of its internals).

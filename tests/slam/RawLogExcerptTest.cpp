@@ -6,7 +6,7 @@
 #include <memory>
 
 #include "TestPaths.h"
-#include "urbanslam/slam/Evaluation.h"
+#include "urbanslam/evaluation/Evaluation.h"
 #include "urbanslam/slam/Pipeline.h"
 
 using namespace urbanslam;
@@ -14,19 +14,19 @@ using namespace urbanslam;
 namespace {
 
 struct ExcerptRun {
-  slam::RelationMetrics relations;
-  slam::RelationLoopCheck loops;
+  evaluation::RelationMetrics relations;
+  evaluation::RelationLoopCheck loops;
 };
 
 ExcerptRun runExcerpt(const slam::PipelineOptions& o) {
   slam::Pipeline p(o);
   auto src = io::openDataSource(test::repoPath("rawlogs/fr079-raw-excerpt.clf.gz"));
   p.run(*src);
-  const auto rel = slam::readRelations(test::repoPath("rawlogs/fr079-raw-excerpt.relations"));
-  std::vector<slam::LoopRow> rows;
+  const auto rel = evaluation::readRelations(test::repoPath("rawlogs/fr079-raw-excerpt.relations"));
+  std::vector<evaluation::LoopRow> rows;
   for (const auto& c : p.loopClosures())
     rows.push_back({static_cast<long>(c.from), static_cast<long>(c.to), c.from_time, c.to_time, c.accepted, c.measurement});
-  return {slam::relationMetrics(p.scanTrajectory(), rel, 0.0, 1e9), slam::checkLoopsWithRelations(rows, p.odometryTrajectory(), rel, 0.0)};
+  return {evaluation::relationMetrics(p.scanTrajectory(), rel, 0.0, 1e9), evaluation::checkLoopsWithRelations(rows, p.odometryTrajectory(), rel, 0.0)};
 }
 
 }  // namespace

@@ -9,7 +9,7 @@
 #include "urbanslam/common/Pose2.h"
 #include "urbanslam/io/MapOutputs.h"
 
-namespace urbanslam::slam {
+namespace urbanslam::evaluation {
 
 struct WallSegment {
   double x1 = 0, y1 = 0, x2 = 0, y2 = 0;
@@ -47,4 +47,4 @@ struct LoopRecall {
 struct LoopRow;
 LoopRecall loopRecall(const std::vector<LoopRow>& closures, const std::vector<TrueLoop>& truth, double tolerance_s = 2.0);
 
-}  // namespace urbanslam::slam
+}  // namespace urbanslam::evaluation

@@ -12,7 +12,7 @@
 #include "urbanslam/common/Json.h"
 #include "urbanslam/io/MapOutputs.h"
 
-namespace urbanslam::slam {
+namespace urbanslam::evaluation {
 
 struct Relation {
   double t1 = 0, t2 = 0;
@@ -122,4 +122,4 @@ RelationLoopCheck checkLoopsWithRelations(const std::vector<LoopRow>& loops, con
                                           const std::vector<Relation>& rel, double time_offset_s, double bridge_s = 3.0,
                                           double tol_m = 0.5, double tol_deg = 5.0);
 
-}  // namespace urbanslam::slam
+}  // namespace urbanslam::evaluation

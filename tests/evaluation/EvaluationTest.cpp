@@ -7,7 +7,7 @@
 #include "TestPaths.h"
 #include "urbanslam/common/Error.h"
 #include "urbanslam/io/DataSource.h"
-#include "urbanslam/slam/Evaluation.h"
+#include "urbanslam/evaluation/Evaluation.h"
 
 using namespace urbanslam;
 
@@ -27,14 +27,14 @@ std::vector<io::StampedPose> circle(double offset_t = 0) {
 // Relation metric by hand: a trajectory with a known constant error in each relation.
 TEST(Evaluation, RelationMetricMatchesHandComputedErrors) {
   const auto traj = circle();
-  std::vector<slam::Relation> rel;
+  std::vector<evaluation::Relation> rel;
   for (int i = 0; i + 10 < 200; i += 10) {
     const auto expected = common::between(traj[static_cast<size_t>(i)].pose, traj[static_cast<size_t>(i + 10)].pose);
     // Expected perturbed on the left by d = (0.1 m, 0, 2°): error = between ⋅ (d ⋅ between)^-1 = d^-1.
     rel.push_back({traj[static_cast<size_t>(i)].timestamp, traj[static_cast<size_t>(i + 10)].timestamp,
                    common::compose({0.1, 0, 2 * M_PI / 180}, expected)});
   }
-  const auto m = slam::relationMetrics(traj, rel, 0);
+  const auto m = evaluation::relationMetrics(traj, rel, 0);
   ASSERT_EQ(m.used, rel.size());
   EXPECT_NEAR(m.abs_rot_deg.mean, 2.0, 1e-9);
   EXPECT_NEAR(m.abs_rot_deg.std, 0.0, 1e-9);
@@ -46,19 +46,19 @@ TEST(Evaluation, RelationMetricMatchesHandComputedErrors) {
 
 TEST(Evaluation, TimeOffsetIsRecoveredFromTheReference) {
   const auto ref = circle();
-  std::vector<slam::Relation> rel;
+  std::vector<evaluation::Relation> rel;
   const double base = 976052896.8;
   for (int i = 0; i + 5 < 200; i += 3)
     rel.push_back({base + ref[static_cast<size_t>(i)].timestamp, base + ref[static_cast<size_t>(i + 5)].timestamp,
                    common::between(ref[static_cast<size_t>(i)].pose, ref[static_cast<size_t>(i + 5)].pose)});
-  EXPECT_NEAR(slam::findRelationTimeOffset(ref, rel), base, 1e-3);
+  EXPECT_NEAR(evaluation::findRelationTimeOffset(ref, rel), base, 1e-3);
   // Relations already in the trajectory's time base need no offset.
-  std::vector<slam::Relation> same_base = rel;
+  std::vector<evaluation::Relation> same_base = rel;
   for (auto& r : same_base) {
     r.t1 -= base;
     r.t2 -= base;
   }
-  EXPECT_EQ(slam::findRelationTimeOffset(ref, same_base), 0.0);
+  EXPECT_EQ(evaluation::findRelationTimeOffset(ref, same_base), 0.0);
 }
 
 // The breakdown puts each relation in the class its times give it among the scans, and the
@@ -69,7 +69,7 @@ TEST(Evaluation, RelationsAreSplitByWhereTheyFallAmongTheScans) {
   const double base = 1000.0;  // the relations' time base (offset) is applied to the scans too
   std::vector<double> scans;
   for (size_t i = 0; i < traj.size(); i += 20) scans.push_back(traj[i].timestamp);
-  std::vector<slam::Relation> rel;
+  std::vector<evaluation::Relation> rel;
   const auto add = [&](size_t i, size_t j, double d) {
     rel.push_back({base + traj[i].timestamp, base + traj[j].timestamp, common::compose({d, 0, 0}, common::between(traj[i].pose, traj[j].pose))});
   };
@@ -82,7 +82,7 @@ TEST(Evaluation, RelationsAreSplitByWhereTheyFallAmongTheScans) {
   add(5, 195, 0.4);    // 19.5 s: after the last scan (18 s), not inside an interval
   add(195, 199, 0.4);
   rel.push_back({base + 50.0, base + 51.0, {}});  // outside the trajectory: skipped, not counted
-  const auto by = slam::relationsByScans(traj, rel, base, scans);
+  const auto by = evaluation::relationsByScans(traj, rel, base, scans);
   EXPECT_EQ(by.at_scans.n, 2u);
   EXPECT_EQ(by.one_interval.n, 2u);
   EXPECT_EQ(by.other.n, 4u);
@@ -90,22 +90,22 @@ TEST(Evaluation, RelationsAreSplitByWhereTheyFallAmongTheScans) {
   EXPECT_NEAR(by.one_interval.abs_trans_mean_m, 0.2, 1e-9);
   EXPECT_NEAR(by.other.abs_trans_mean_m, 0.4, 1e-9);
   EXPECT_NEAR(by.at_scans.share_m, 0.2 / 8, 1e-9);
-  const auto m = slam::relationMetrics(traj, rel, base);
+  const auto m = evaluation::relationMetrics(traj, rel, base);
   ASSERT_EQ(m.used, 8u);
   EXPECT_NEAR(by.at_scans.share_m + by.one_interval.share_m + by.other.share_m, m.abs_trans_m.mean, 1e-12);
   // An end 1 ms off a scan is at it (the default tolerance is 2 ms); 5 ms off, it is not.
   std::vector<double> near = scans;
   for (double& t : near) t += 0.001;
-  EXPECT_EQ(slam::relationsByScans(traj, rel, base, near).at_scans.n, 2u);
+  EXPECT_EQ(evaluation::relationsByScans(traj, rel, base, near).at_scans.n, 2u);
   for (double& t : near) t += 0.004;
-  EXPECT_EQ(slam::relationsByScans(traj, rel, base, near).at_scans.n, 0u);
+  EXPECT_EQ(evaluation::relationsByScans(traj, rel, base, near).at_scans.n, 0u);
 }
 
 TEST(Evaluation, AteIsZeroAfterARigidMotionAndSeesNoise) {
   const auto ref = circle();
   auto est = ref;
   for (auto& p : est) p.pose = common::compose({3, -2, 0.7}, p.pose);
-  const auto m = slam::trajectoryMetrics(est, ref, false);
+  const auto m = evaluation::trajectoryMetrics(est, ref, false);
   EXPECT_EQ(m.matched, ref.size());
   EXPECT_NEAR(m.ate_rmse_m, 0, 1e-9);
   EXPECT_NEAR(m.rpe_rot_rmse_deg, 0, 1e-9);
@@ -115,19 +115,19 @@ TEST(Evaluation, AteIsZeroAfterARigidMotionAndSeesNoise) {
     p.pose.x += n(rng);
     p.pose.y += n(rng);
   }
-  const auto noisy = slam::trajectoryMetrics(est, ref, false);
+  const auto noisy = evaluation::trajectoryMetrics(est, ref, false);
   EXPECT_NEAR(noisy.ate_rmse_m, 0.1 * std::sqrt(2.0), 0.03);
 }
 
 TEST(Evaluation, LoopClosuresAreClassifiedAgainstTheReference) {
   const auto ref = circle();
-  std::vector<slam::LoopRow> loops;
+  std::vector<evaluation::LoopRow> loops;
   const auto truth = common::between(ref[10].pose, ref[150].pose);
   loops.push_back({10, 150, ref[10].timestamp, ref[150].timestamp, true, truth});
   loops.push_back({11, 150, ref[10].timestamp, ref[150].timestamp, true, common::compose(truth, {2.0, 0, 0})});
   loops.push_back({10, 150, ref[10].timestamp, ref[150].timestamp, false, truth});
   loops.push_back({0, 150, -50, ref[150].timestamp, true, truth});
-  const auto m = slam::classifyLoopClosures(loops, ref, false);
+  const auto m = evaluation::classifyLoopClosures(loops, ref, false);
   EXPECT_EQ(m.accepted, 3u);
   EXPECT_EQ(m.true_positive, 1u);
   EXPECT_EQ(m.false_positive, 1u);
@@ -142,8 +142,8 @@ TEST(Evaluation, LoopClosuresAreClassifiedAgainstTheReference) {
 TEST(Evaluation, MalformedRelationsFileIsAnError) {
   const auto d = test::scratchDir("relations_bad");
   std::ofstream(d / "r.relations") << "1 2 3\n";
-  EXPECT_THROW(slam::readRelations((d / "r.relations").string()), common::InputError);
-  EXPECT_THROW(slam::readRelations((d / "none").string()), common::InputError);
+  EXPECT_THROW(evaluation::readRelations((d / "r.relations").string()), common::InputError);
+  EXPECT_THROW(evaluation::readRelations((d / "none").string()), common::InputError);
 }
 
 // The real thing: the relation file of Intel against the corrected log's own poses.
@@ -155,7 +155,7 @@ TEST(Evaluation, IntelRelationsAgainstTheCorrectedLog) {
   io::Measurement m;
   while (src->next(m))
     if (auto* r = std::get_if<io::ReferencePose>(&m)) ref.push_back({r->timestamp, r->pose});
-  const auto relations = slam::readRelations(rel);
+  const auto relations = evaluation::readRelations(rel);
   EXPECT_EQ(relations.size(), 2984u);
   std::vector<double> odometry_times;
   {
@@ -163,8 +163,8 @@ TEST(Evaluation, IntelRelationsAgainstTheCorrectedLog) {
     while (s2->next(m))
       if (auto* o = std::get_if<io::OdometryReading>(&m)) odometry_times.push_back(o->timestamp);
   }
-  const double off = slam::findRelationTimeOffset(ref, relations, odometry_times);
-  const auto metrics = slam::relationMetrics(ref, relations, off, 5.0);  // scans ~3 s apart
+  const double off = evaluation::findRelationTimeOffset(ref, relations, odometry_times);
+  const auto metrics = evaluation::relationMetrics(ref, relations, off, 5.0);  // scans ~3 s apart
   EXPECT_GT(metrics.used, 2500u);
   // Relation times are odometry/scan times of the raw log: the offset is exact to the ms.
   EXPECT_NEAR(off, 976052857.337, 0.002);
@@ -186,20 +186,20 @@ TEST(Evaluation, TimeOffsetWithoutSharedTimestampsFollowsTheFit) {
     p = common::compose(p, {speed(rng), 0, turn(rng)});
   }
   const double base = 1211.4;
-  std::vector<slam::Relation> rel;
+  std::vector<evaluation::Relation> rel;
   std::vector<double> log_times;
   for (const auto& p : ref) log_times.push_back(p.timestamp);
   for (int i = 0; i + 6 < 200; i += 2) {
     // Relations between instants half-way between log samples (0.05 s after them).
     const double t1 = ref[static_cast<size_t>(i)].timestamp + 0.05, t2 = ref[static_cast<size_t>(i + 5)].timestamp + 0.05;
     common::Pose2 p1, p2;
-    ASSERT_TRUE(slam::interpolatePose(ref, t1, 1.0, p1));
-    ASSERT_TRUE(slam::interpolatePose(ref, t2, 1.0, p2));
+    ASSERT_TRUE(evaluation::interpolatePose(ref, t1, 1.0, p1));
+    ASSERT_TRUE(evaluation::interpolatePose(ref, t2, 1.0, p2));
     rel.push_back({base + t1, base + t2, common::between(p1, p2)});
   }
-  const double off = slam::findRelationTimeOffset(ref, rel, log_times);
+  const double off = evaluation::findRelationTimeOffset(ref, rel, log_times);
   EXPECT_NEAR(off, base, 0.005);
-  EXPECT_LT(slam::relationMetrics(ref, rel, off).abs_trans_m.mean, 1e-3);
+  EXPECT_LT(evaluation::relationMetrics(ref, rel, off).abs_trans_m.mean, 1e-3);
 }
 
 // A closure between two visits of a circle, checked against a relation a second away from it:
@@ -213,8 +213,8 @@ TEST(Evaluation, LoopsCheckedAgainstRelations) {
   };
   for (double t = 0; t <= 130; t += 0.5) nodes.push_back({t, truth(t)});
   // The relation between t = 10 and t = 73.8 (one lap and a little later): exact.
-  const std::vector<slam::Relation> rel{{10.0, 73.8, common::between(truth(10.0), truth(73.8))}};
-  slam::LoopRow good, bad, far;
+  const std::vector<evaluation::Relation> rel{{10.0, 73.8, common::between(truth(10.0), truth(73.8))}};
+  evaluation::LoopRow good, bad, far;
   good.accepted = bad.accepted = far.accepted = true;
   good.from_time = bad.from_time = 11.0;
   good.to_time = bad.to_time = 75.0;
@@ -222,7 +222,7 @@ TEST(Evaluation, LoopsCheckedAgainstRelations) {
   bad.measurement = common::compose(good.measurement, {0.8, 0.0, 0.0});  // 0.8 m along the path
   far.from_time = 40.0;  // no relation near these times
   far.to_time = 100.0;
-  const auto c = slam::checkLoopsWithRelations({good, bad, far}, nodes, rel, 0.0);
+  const auto c = evaluation::checkLoopsWithRelations({good, bad, far}, nodes, rel, 0.0);
   EXPECT_EQ(c.accepted, 3u);
   EXPECT_EQ(c.checked, 2u);
   ASSERT_EQ(c.contradicted, 1u);

@@ -1,4 +1,4 @@
-#include "urbanslam/slam/MapAccuracy.h"
+#include "urbanslam/evaluation/MapAccuracy.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,9 +7,9 @@
 #include <unordered_map>
 
 #include "urbanslam/common/Error.h"
-#include "urbanslam/slam/Evaluation.h"
+#include "urbanslam/evaluation/Evaluation.h"
 
-namespace urbanslam::slam {
+namespace urbanslam::evaluation {
 
 namespace {
 
@@ -163,4 +163,4 @@ LoopRecall loopRecall(const std::vector<LoopRow>& closures, const std::vector<Tr
   return r;
 }
 
-}  // namespace urbanslam::slam
+}  // namespace urbanslam::evaluation

@@ -1,11 +1,11 @@
-#include "urbanslam/slam/ClosureEvidence.h"
+#include "urbanslam/evaluation/ClosureEvidence.h"
 
 #include <cmath>
 
 #include "urbanslam/alignment/Aligner.h"
 #include "urbanslam/alignment/FreeSpace.h"
 
-namespace urbanslam::slam {
+namespace urbanslam::evaluation {
 
 namespace {
 
@@ -37,4 +37,4 @@ ClosureEvidence weighClosure(const io::LaserScan& a, const io::LaserScan& b, con
   return e;
 }
 
-}  // namespace urbanslam::slam
+}  // namespace urbanslam::evaluation

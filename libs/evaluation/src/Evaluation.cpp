@@ -1,4 +1,4 @@
-#include "urbanslam/slam/Evaluation.h"
+#include "urbanslam/evaluation/Evaluation.h"
 
 #include <Eigen/Core>
 #include <algorithm>
@@ -10,7 +10,7 @@
 #include "urbanslam/common/Error.h"
 #include "urbanslam/common/RigidFit.h"
 
-namespace urbanslam::slam {
+namespace urbanslam::evaluation {
 
 using common::Pose2;
 
@@ -367,4 +367,4 @@ RelationLoopCheck checkLoopsWithRelations(const std::vector<LoopRow>& loops, con
   return c;
 }
 
-}  // namespace urbanslam::slam
+}  // namespace urbanslam::evaluation

@@ -8,7 +8,7 @@
 #include "urbanslam/common/Pose2.h"
 #include "urbanslam/io/LaserScan.h"
 
-namespace urbanslam::slam {
+namespace urbanslam::evaluation {
 
 struct ClosureEvidence {
   // run: PL-ICP started at the reference's relative pose converges to the run's measurement
@@ -32,4 +32,4 @@ constexpr double kSamePoseDeg = 1.0;
 ClosureEvidence weighClosure(const io::LaserScan& a, const io::LaserScan& b, const common::Pose2& run,
                              const common::Pose2& reference);
 
-}  // namespace urbanslam::slam
+}  // namespace urbanslam::evaluation

@@ -3,10 +3,10 @@
 #include <cmath>
 #include <random>
 
-#include "urbanslam/slam/Evaluation.h"
-#include "urbanslam/slam/MapAccuracy.h"
+#include "urbanslam/evaluation/Evaluation.h"
+#include "urbanslam/evaluation/MapAccuracy.h"
 
-namespace urbanslam::slam {
+namespace urbanslam::evaluation {
 namespace {
 
 // Points at known perpendicular offsets from the walls of a square room (and one beyond an
@@ -63,4 +63,4 @@ TEST(MapAccuracy, LoopRecallCountsRevisitedScansJoinedByAClosure) {
 }
 
 }  // namespace
-}  // namespace urbanslam::slam
+}  // namespace urbanslam::evaluation

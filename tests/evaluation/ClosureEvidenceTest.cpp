@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "../alignment/SyntheticScan.h"
-#include "urbanslam/slam/ClosureEvidence.h"
+#include "urbanslam/evaluation/ClosureEvidence.h"
 
 using namespace urbanslam;
 namespace sim = urbanslam::alignment::test;
@@ -33,7 +33,7 @@ const common::Pose2 kOff{0.3, -0.2, 3.0 * M_PI / 180};  // a reference 0.36 m / 
 // The reference is off, the run is right: PL-ICP from the reference's pose returns to the run's.
 TEST(ClosureEvidence, ScansFavourTheRunWhenTheReferenceIsOff) {
   const Pair p = roomPair();
-  const auto e = slam::weighClosure(p.a, p.b, p.truth, common::compose(p.truth, kOff));
+  const auto e = evaluation::weighClosure(p.a, p.b, p.truth, common::compose(p.truth, kOff));
   EXPECT_EQ(e.verdict, "run");
   const auto d = common::between(p.truth, e.from_reference);
   EXPECT_LT(std::hypot(d.x, d.y), 0.03);
@@ -45,13 +45,13 @@ TEST(ClosureEvidence, ScansFavourTheRunWhenTheReferenceIsOff) {
 // The run is off, the reference is right: PL-ICP stays at the reference's pose.
 TEST(ClosureEvidence, ScansFavourTheReferenceWhenTheRunIsOff) {
   const Pair p = roomPair();
-  const auto e = slam::weighClosure(p.a, p.b, common::compose(p.truth, kOff), p.truth);
+  const auto e = evaluation::weighClosure(p.a, p.b, common::compose(p.truth, kOff), p.truth);
   EXPECT_EQ(e.verdict, "reference");
   EXPECT_LE(e.reference_conflict, e.run_conflict);
 }
 
 TEST(ClosureEvidence, AKeyframeWithoutAScanSaysNothing) {
   const Pair p = roomPair();
-  const auto e = slam::weighClosure(p.a, io::LaserScan{}, p.truth, common::compose(p.truth, kOff));
+  const auto e = evaluation::weighClosure(p.a, io::LaserScan{}, p.truth, common::compose(p.truth, kOff));
   EXPECT_EQ(e.verdict, "no_scans");
 }
