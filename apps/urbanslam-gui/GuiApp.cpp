@@ -44,9 +44,12 @@ class GuiApp : public wxApp {
       if (a == "--help" || a == "-h") {
         std::cout << kUsage;
         std::exit(0);
-      } else if (a == "--ini") o.ini = value();
-      else if (a == "--screenshot") o.screenshot = value();
-      else if (a == "--autorun") o.autorun = true;
+      } else if (a == "--ini")
+        o.ini = value();
+      else if (a == "--screenshot")
+        o.screenshot = value();
+      else if (a == "--autorun")
+        o.autorun = true;
       else if (a == "--speed") {
         const std::string v = value();
         char* end = nullptr;
@@ -55,8 +58,7 @@ class GuiApp : public wxApp {
           std::cerr << "urbanslam-gui: error: --speed expects a number >= 0, got '" << v << "'\n";
           std::exit(2);
         }
-      }
-      else if (a == "--snapshot-at") {
+      } else if (a == "--snapshot-at") {
         const std::string v = value();
         const auto colon = v.find(':');
         char* end = nullptr;
@@ -67,12 +69,13 @@ class GuiApp : public wxApp {
         }
         o.snapshot_at_keyframes = n;
         o.snapshot_path = v.substr(colon + 1);
-      }
-      else if (a == "--exit-when-done") o.exit_when_done = true;
+      } else if (a == "--exit-when-done")
+        o.exit_when_done = true;
       else if (a.rfind("--", 0) == 0) {
         std::cerr << "urbanslam-gui: error: unknown option " << a << " (see --help)\n";
         std::exit(2);
-      } else o.log = a;
+      } else
+        o.log = a;
     }
     if (o.log.empty()) o.log = home + "/rawlogs/intel.rawlog";
     frame_ = new urbanslam::gui::MainFrame(o);

@@ -25,10 +25,36 @@ namespace urbanslam::gui {
 namespace {
 
 enum Ids {
-  kOpen = wxID_HIGHEST + 1, kLoadIni, kPlay, kPause, kStep, kRestart, kSpeedMax, kSpeedReal, kSpeed10, kFit, kTop, kOrbit,
-  kLayerPoints, kLayerTrajectory, kLayerScan, kLayerUncertainty, kLayerAccepted, kLayerRejected, kLayerCandidates,
-  kColourAge, kColourHeight, kExportPly, kExportPcd, kExportXyz, kExportTum, kExportGrid, kExportSimplemap,
-  kExportAll, kExportScreenshot, kExportGraph
+  kOpen = wxID_HIGHEST + 1,
+  kLoadIni,
+  kPlay,
+  kPause,
+  kStep,
+  kRestart,
+  kSpeedMax,
+  kSpeedReal,
+  kSpeed10,
+  kFit,
+  kTop,
+  kOrbit,
+  kLayerPoints,
+  kLayerTrajectory,
+  kLayerScan,
+  kLayerUncertainty,
+  kLayerAccepted,
+  kLayerRejected,
+  kLayerCandidates,
+  kColourAge,
+  kColourHeight,
+  kExportPly,
+  kExportPcd,
+  kExportXyz,
+  kExportTum,
+  kExportGrid,
+  kExportSimplemap,
+  kExportAll,
+  kExportScreenshot,
+  kExportGraph
 };
 
 // Dropping a file on the window opens it (the first one).
@@ -154,32 +180,92 @@ void MainFrame::buildMenus() {
   bar->Append(view, "&View");
   SetMenuBar(bar);
 
-  Bind(wxEVT_MENU, [this](wxCommandEvent&) {
-    wxFileDialog dlg(this, "Open log", "", "", "Logs (*.rawlog;*.log;*.gz;*.clf;*.zip)|*.rawlog;*.log;*.gz;*.clf;*.zip|All files|*",
-                     wxFD_OPEN | wxFD_FILE_MUST_EXIST);
-    if (dlg.ShowModal() == wxID_OK) openLog(dlg.GetPath().ToStdString());
-  }, kOpen);
-  Bind(wxEVT_MENU, [this](wxCommandEvent& e) {
-    const wxString f = history_.GetHistoryFile(static_cast<size_t>(e.GetId() - wxID_FILE1));
-    if (!f.empty()) openLog(f.ToStdString());
-  }, wxID_FILE1, wxID_FILE9);
-  Bind(wxEVT_MENU, [this](wxCommandEvent&) {
-    wxFileDialog dlg(this, "Load ini", "", "", "ini files (*.ini)|*.ini|All files|*", wxFD_OPEN | wxFD_FILE_MUST_EXIST);
-    if (dlg.ShowModal() == wxID_OK) loadIni(dlg.GetPath().ToStdString());
-  }, kLoadIni);
-  Bind(wxEVT_MENU, [this](wxCommandEvent&) { Close(); }, wxID_EXIT);
-  Bind(wxEVT_MENU, [this](wxCommandEvent&) { if (worker_) worker_->play(); }, kPlay);
-  Bind(wxEVT_MENU, [this](wxCommandEvent&) { if (worker_) worker_->pause(); }, kPause);
-  Bind(wxEVT_MENU, [this](wxCommandEvent&) { if (worker_) worker_->stepKeyframe(); }, kStep);
-  Bind(wxEVT_MENU, [this](wxCommandEvent&) { restart(); }, kRestart);
-  Bind(wxEVT_MENU, [this](wxCommandEvent&) { if (worker_) worker_->setSpeed(0); }, kSpeedMax);
-  Bind(wxEVT_MENU, [this](wxCommandEvent&) { if (worker_) worker_->setSpeed(1); }, kSpeedReal);
-  Bind(wxEVT_MENU, [this](wxCommandEvent&) { if (worker_) worker_->setSpeed(10); }, kSpeed10);
-  Bind(wxEVT_MENU, [this](wxCommandEvent&) { canvas_->fitToMap(); }, kFit);
-  Bind(wxEVT_MENU, [this](wxCommandEvent&) { canvas_->setTopView(true); canvas_->fitToMap(); }, kTop);
-  Bind(wxEVT_MENU, [this](wxCommandEvent&) { canvas_->setTopView(false); canvas_->fitToMap(); }, kOrbit);
+  Bind(
+      wxEVT_MENU,
+      [this](wxCommandEvent&) {
+        wxFileDialog dlg(this, "Open log", "", "", "Logs (*.rawlog;*.log;*.gz;*.clf;*.zip)|*.rawlog;*.log;*.gz;*.clf;*.zip|All files|*",
+                         wxFD_OPEN | wxFD_FILE_MUST_EXIST);
+        if (dlg.ShowModal() == wxID_OK) openLog(dlg.GetPath().ToStdString());
+      },
+      kOpen);
+  Bind(
+      wxEVT_MENU,
+      [this](wxCommandEvent& e) {
+        const wxString f = history_.GetHistoryFile(static_cast<size_t>(e.GetId() - wxID_FILE1));
+        if (!f.empty()) openLog(f.ToStdString());
+      },
+      wxID_FILE1, wxID_FILE9);
+  Bind(
+      wxEVT_MENU,
+      [this](wxCommandEvent&) {
+        wxFileDialog dlg(this, "Load ini", "", "", "ini files (*.ini)|*.ini|All files|*", wxFD_OPEN | wxFD_FILE_MUST_EXIST);
+        if (dlg.ShowModal() == wxID_OK) loadIni(dlg.GetPath().ToStdString());
+      },
+      kLoadIni);
+  Bind(
+      wxEVT_MENU, [this](wxCommandEvent&) { Close(); }, wxID_EXIT);
+  Bind(
+      wxEVT_MENU,
+      [this](wxCommandEvent&) {
+        if (worker_) worker_->play();
+      },
+      kPlay);
+  Bind(
+      wxEVT_MENU,
+      [this](wxCommandEvent&) {
+        if (worker_) worker_->pause();
+      },
+      kPause);
+  Bind(
+      wxEVT_MENU,
+      [this](wxCommandEvent&) {
+        if (worker_) worker_->stepKeyframe();
+      },
+      kStep);
+  Bind(
+      wxEVT_MENU, [this](wxCommandEvent&) { restart(); }, kRestart);
+  Bind(
+      wxEVT_MENU,
+      [this](wxCommandEvent&) {
+        if (worker_) worker_->setSpeed(0);
+      },
+      kSpeedMax);
+  Bind(
+      wxEVT_MENU,
+      [this](wxCommandEvent&) {
+        if (worker_) worker_->setSpeed(1);
+      },
+      kSpeedReal);
+  Bind(
+      wxEVT_MENU,
+      [this](wxCommandEvent&) {
+        if (worker_) worker_->setSpeed(10);
+      },
+      kSpeed10);
+  Bind(
+      wxEVT_MENU, [this](wxCommandEvent&) { canvas_->fitToMap(); }, kFit);
+  Bind(
+      wxEVT_MENU,
+      [this](wxCommandEvent&) {
+        canvas_->setTopView(true);
+        canvas_->fitToMap();
+      },
+      kTop);
+  Bind(
+      wxEVT_MENU,
+      [this](wxCommandEvent&) {
+        canvas_->setTopView(false);
+        canvas_->fitToMap();
+      },
+      kOrbit);
   const auto layer = [this](int id, bool Layers::*member) {
-    Bind(wxEVT_MENU, [this, member](wxCommandEvent& e) { layers_.*member = e.IsChecked(); refreshView(true); }, id);
+    Bind(
+        wxEVT_MENU,
+        [this, member](wxCommandEvent& e) {
+          layers_.*member = e.IsChecked();
+          refreshView(true);
+        },
+        id);
   };
   layer(kLayerPoints, &Layers::map_points);
   layer(kLayerTrajectory, &Layers::trajectory);
@@ -188,70 +274,113 @@ void MainFrame::buildMenus() {
   layer(kLayerAccepted, &Layers::closures_accepted);
   layer(kLayerRejected, &Layers::closures_rejected);
   layer(kLayerCandidates, &Layers::candidates);
-  Bind(wxEVT_MENU, [this](wxCommandEvent&) { layers_.colouring = PointColouring::KeyframeAge; refreshView(true); }, kColourAge);
-  Bind(wxEVT_MENU, [this](wxCommandEvent&) { layers_.colouring = PointColouring::Height; refreshView(true); }, kColourHeight);
+  Bind(
+      wxEVT_MENU,
+      [this](wxCommandEvent&) {
+        layers_.colouring = PointColouring::KeyframeAge;
+        refreshView(true);
+      },
+      kColourAge);
+  Bind(
+      wxEVT_MENU,
+      [this](wxCommandEvent&) {
+        layers_.colouring = PointColouring::Height;
+        refreshView(true);
+      },
+      kColourHeight);
 
   // Exports use the same writers as `urbanslam run`.
   const auto cloud = [](const slam::Pipeline& p) { return io::mapPoints(p.posedKeyframes(), p.options().map.point_decimation); };
-  Bind(wxEVT_MENU, [this, cloud](wxCommandEvent&) {
-    exportWith("Export point cloud", "PLY (*.ply)|*.ply", "map.ply",
-               [cloud](const slam::Pipeline& p, const std::string& f) { io::writePly(f, cloud(p), io::PlyEncoding::BinaryLittleEndian); });
-  }, kExportPly);
-  Bind(wxEVT_MENU, [this, cloud](wxCommandEvent&) {
-    exportWith("Export point cloud", "PCD (*.pcd)|*.pcd", "map.pcd",
-               [cloud](const slam::Pipeline& p, const std::string& f) { io::writePcd(f, cloud(p)); });
-  }, kExportPcd);
-  Bind(wxEVT_MENU, [this, cloud](wxCommandEvent&) {
-    exportWith("Export point cloud", "XYZ (*.xyz)|*.xyz", "map.xyz",
-               [cloud](const slam::Pipeline& p, const std::string& f) { io::writeXyz(f, cloud(p)); });
-  }, kExportXyz);
-  Bind(wxEVT_MENU, [this](wxCommandEvent&) {
-    exportWith("Export trajectory", "TUM (*.tum;*.txt)|*.tum;*.txt", "trajectory.tum", [](const slam::Pipeline& p, const std::string& f) {
-      std::vector<io::StampedPose> t;
-      for (const auto& k : p.keyframes()) t.push_back({k.timestamp, k.pose});
-      io::writeTum(f, t);
-    });
-  }, kExportTum);
-  Bind(wxEVT_MENU, [this](wxCommandEvent&) {
-    exportWith("Export occupancy grid", "PNG (*.png)|*.png", "grid.png", [](const slam::Pipeline& p, const std::string& f) {
-      io::OccupancyGridOptions g;
-      g.resolution_m = p.options().map.grid_resolution_m;
-      std::string prefix = f;
-      if (prefix.size() > 4 && prefix.substr(prefix.size() - 4) == ".png") prefix.resize(prefix.size() - 4);
-      io::writeOccupancyGrid(prefix, p.posedKeyframes(), g);
-    });
-  }, kExportGrid);
-  Bind(wxEVT_MENU, [this](wxCommandEvent&) {
-    exportWith("Export simplemap", "MRPT simplemap (*.simplemap)|*.simplemap", "map.simplemap",
-               [](const slam::Pipeline& p, const std::string& f) { io::writeSimpleMap(f, p.posedKeyframes()); });
-  }, kExportSimplemap);
-  Bind(wxEVT_MENU, [this](wxCommandEvent&) {
-    exportWith("Export pose graph", "g2o (*.g2o)|*.g2o", "pose_graph.g2o",
-               [](const slam::Pipeline& p, const std::string& f) { slam::writePoseGraphG2o(p, f); });
-  }, kExportGraph);
-  Bind(wxEVT_MENU, [this](wxCommandEvent&) {
-    if (!worker_) return;
-    wxDirDialog dlg(this, "Export every output into a folder");
-    if (dlg.ShowModal() != wxID_OK) return;
-    const std::string dir = dlg.GetPath().ToStdString();
-    try {
-      worker_->withPipeline([&](const slam::Pipeline& p) {
-        slam::writeRunOutputs(p, dir, {worker_->logPath(), worker_->inputFormat(), worker_->iniPath(), worker_->resolvedIni()});
-      });
-      SetStatusText("exported to " + dir, 0);
-    } catch (const std::exception& e) {
-      showError(e.what());
-    }
-  }, kExportAll);
-  Bind(wxEVT_MENU, [this](wxCommandEvent&) {
-    wxFileDialog dlg(this, "Save screenshot", "", "view.png", "PNG (*.png)|*.png", wxFD_SAVE | wxFD_OVERWRITE_PROMPT);
-    if (dlg.ShowModal() != wxID_OK) return;
-    const std::string path = dlg.GetPath().ToStdString();
-    canvas_->requestScreenshot(path, [this, path](bool ok) {
-      if (ok) SetStatusText("saved " + path, 0);
-      else showError(path + ": cannot write");
-    });
-  }, kExportScreenshot);
+  Bind(
+      wxEVT_MENU,
+      [this, cloud](wxCommandEvent&) {
+        exportWith("Export point cloud", "PLY (*.ply)|*.ply", "map.ply", [cloud](const slam::Pipeline& p, const std::string& f) {
+          io::writePly(f, cloud(p), io::PlyEncoding::BinaryLittleEndian);
+        });
+      },
+      kExportPly);
+  Bind(
+      wxEVT_MENU,
+      [this, cloud](wxCommandEvent&) {
+        exportWith("Export point cloud", "PCD (*.pcd)|*.pcd", "map.pcd",
+                   [cloud](const slam::Pipeline& p, const std::string& f) { io::writePcd(f, cloud(p)); });
+      },
+      kExportPcd);
+  Bind(
+      wxEVT_MENU,
+      [this, cloud](wxCommandEvent&) {
+        exportWith("Export point cloud", "XYZ (*.xyz)|*.xyz", "map.xyz",
+                   [cloud](const slam::Pipeline& p, const std::string& f) { io::writeXyz(f, cloud(p)); });
+      },
+      kExportXyz);
+  Bind(
+      wxEVT_MENU,
+      [this](wxCommandEvent&) {
+        exportWith("Export trajectory", "TUM (*.tum;*.txt)|*.tum;*.txt", "trajectory.tum",
+                   [](const slam::Pipeline& p, const std::string& f) {
+                     std::vector<io::StampedPose> t;
+                     for (const auto& k : p.keyframes()) t.push_back({k.timestamp, k.pose});
+                     io::writeTum(f, t);
+                   });
+      },
+      kExportTum);
+  Bind(
+      wxEVT_MENU,
+      [this](wxCommandEvent&) {
+        exportWith("Export occupancy grid", "PNG (*.png)|*.png", "grid.png", [](const slam::Pipeline& p, const std::string& f) {
+          io::OccupancyGridOptions g;
+          g.resolution_m = p.options().map.grid_resolution_m;
+          std::string prefix = f;
+          if (prefix.size() > 4 && prefix.substr(prefix.size() - 4) == ".png") prefix.resize(prefix.size() - 4);
+          io::writeOccupancyGrid(prefix, p.posedKeyframes(), g);
+        });
+      },
+      kExportGrid);
+  Bind(
+      wxEVT_MENU,
+      [this](wxCommandEvent&) {
+        exportWith("Export simplemap", "MRPT simplemap (*.simplemap)|*.simplemap", "map.simplemap",
+                   [](const slam::Pipeline& p, const std::string& f) { io::writeSimpleMap(f, p.posedKeyframes()); });
+      },
+      kExportSimplemap);
+  Bind(
+      wxEVT_MENU,
+      [this](wxCommandEvent&) {
+        exportWith("Export pose graph", "g2o (*.g2o)|*.g2o", "pose_graph.g2o",
+                   [](const slam::Pipeline& p, const std::string& f) { slam::writePoseGraphG2o(p, f); });
+      },
+      kExportGraph);
+  Bind(
+      wxEVT_MENU,
+      [this](wxCommandEvent&) {
+        if (!worker_) return;
+        wxDirDialog dlg(this, "Export every output into a folder");
+        if (dlg.ShowModal() != wxID_OK) return;
+        const std::string dir = dlg.GetPath().ToStdString();
+        try {
+          worker_->withPipeline([&](const slam::Pipeline& p) {
+            slam::writeRunOutputs(p, dir, {worker_->logPath(), worker_->inputFormat(), worker_->iniPath(), worker_->resolvedIni()});
+          });
+          SetStatusText("exported to " + dir, 0);
+        } catch (const std::exception& e) {
+          showError(e.what());
+        }
+      },
+      kExportAll);
+  Bind(
+      wxEVT_MENU,
+      [this](wxCommandEvent&) {
+        wxFileDialog dlg(this, "Save screenshot", "", "view.png", "PNG (*.png)|*.png", wxFD_SAVE | wxFD_OVERWRITE_PROMPT);
+        if (dlg.ShowModal() != wxID_OK) return;
+        const std::string path = dlg.GetPath().ToStdString();
+        canvas_->requestScreenshot(path, [this, path](bool ok) {
+          if (ok)
+            SetStatusText("saved " + path, 0);
+          else
+            showError(path + ": cannot write");
+        });
+      },
+      kExportScreenshot);
 }
 
 void MainFrame::buildToolbar() {
@@ -347,8 +476,9 @@ void MainFrame::refreshView(bool force) {
     camera_page_shown_ = true;  // a log with images: show them (once; the user may switch away)
     notebook_->SetSelection(2);
   }
-  SetStatusText(wxString::Format("%zu keyframes, %.0f %%%s", last_snapshot_.stats.keyframes,
-                                 100 * last_snapshot_.stats.progress, last_snapshot_.finished ? " - finished" : ""), 0);
+  SetStatusText(wxString::Format("%zu keyframes, %.0f %%%s", last_snapshot_.stats.keyframes, 100 * last_snapshot_.stats.progress,
+                                 last_snapshot_.finished ? " - finished" : ""),
+                0);
 }
 
 void MainFrame::onTimer(wxTimerEvent&) {
@@ -384,14 +514,15 @@ void MainFrame::finishAutomaticRun() {
     // What the camera panel shows (from the model), so tests need not read pixels.
     const CameraView cam = cameraView(last_snapshot_, layers_.selected_keyframe);
     const auto id = [](const CameraFrame& f) { return f.image && f.keyframe ? static_cast<long>(*f.keyframe) : -1L; };
-    std::printf("{\"keyframes_drawn\":%zu,\"keyframes\":%zu,\"map_points_drawn\":%zu,\"image_keyframes\":%zu,"
-                "\"image_matches\":%zu,\"camera_current_keyframe\":%ld,\"camera_matched_keyframe\":%ld,"
-                "\"camera_match_score\":%.4f,\"camera_match_fate\":\"%s\",\"screenshot\":\"%s\",\"screenshot_ok\":%s}\n",
-                d.keyframes_drawn, pipeline_keyframes, d.map_points.size(),
-                static_cast<size_t>(std::count_if(last_snapshot_.keyframes.begin(), last_snapshot_.keyframes.end(),
-                                                  [](const KeyframeView& k) { return k.image != nullptr; })),
-                last_snapshot_.image_matches.size(), id(cam.current), id(cam.matched), cam.match ? cam.match->score : 0.0,
-                cam.match ? cam.match->fate.c_str() : "", options_.screenshot.c_str(), screenshot_ok ? "true" : "false");
+    std::printf(
+        "{\"keyframes_drawn\":%zu,\"keyframes\":%zu,\"map_points_drawn\":%zu,\"image_keyframes\":%zu,"
+        "\"image_matches\":%zu,\"camera_current_keyframe\":%ld,\"camera_matched_keyframe\":%ld,"
+        "\"camera_match_score\":%.4f,\"camera_match_fate\":\"%s\",\"screenshot\":\"%s\",\"screenshot_ok\":%s}\n",
+        d.keyframes_drawn, pipeline_keyframes, d.map_points.size(),
+        static_cast<size_t>(std::count_if(last_snapshot_.keyframes.begin(), last_snapshot_.keyframes.end(),
+                                          [](const KeyframeView& k) { return k.image != nullptr; })),
+        last_snapshot_.image_matches.size(), id(cam.current), id(cam.matched), cam.match ? cam.match->score : 0.0,
+        cam.match ? cam.match->fate.c_str() : "", options_.screenshot.c_str(), screenshot_ok ? "true" : "false");
     std::fflush(stdout);
     if (!screenshot_ok) g_exit_code = 1;
     Close(true);

@@ -25,8 +25,7 @@ mrpt::opengl::CSetOfLines::Ptr makeLines(const Rgb& c, float width) {
 MapCanvas::MapCanvas(wxWindow* parent) : CWxGLCanvasBase(parent, wxID_ANY, wxDefaultPosition, wxSize(800, 600)) {
   auto scene = getOpenGLSceneRef();
   auto vp = scene->getViewport();
-  vp->setCustomBackgroundColor({palette::kBackground.r / 255.f, palette::kBackground.g / 255.f,
-                                palette::kBackground.b / 255.f});
+  vp->setCustomBackgroundColor({palette::kBackground.r / 255.f, palette::kBackground.g / 255.f, palette::kBackground.b / 255.f});
   auto grid = mrpt::opengl::CGridPlaneXY::Create(-200, 200, -200, 200, 0, 10);
   grid->setColor_u8(mrpt::img::TColor(60, 64, 72));
   scene->insert(grid);
@@ -42,8 +41,8 @@ MapCanvas::MapCanvas(wxWindow* parent) : CWxGLCanvasBase(parent, wxID_ANY, wxDef
   candidates_ = makeLines(palette::kCandidate, 1);
   robot_ = makeLines(palette::kCurrentScan, 2);
   ellipse_ = makeLines(palette::kCurrentScan, 1);
-  for (const auto& o : std::initializer_list<mrpt::opengl::CRenderizable::Ptr>{
-           points_, trajectory_, rejected_, accepted_, candidates_, scan_, selected_, ellipse_, robot_})
+  for (const auto& o : std::initializer_list<mrpt::opengl::CRenderizable::Ptr>{points_, trajectory_, rejected_, accepted_, candidates_,
+                                                                               scan_, selected_, ellipse_, robot_})
     scene->insert(o);
   setTopView(true);
   Bind(wxEVT_LEFT_DOWN, &MapCanvas::onLeftDown, this);
@@ -87,8 +86,7 @@ void MapCanvas::setDrawList(const DrawList& d) {
     for (int i = 0; i < kSegments; ++i) {
       const double t0 = 2 * M_PI * i / kSegments, t1 = 2 * M_PI * (i + 1) / kSegments;
       const double x0 = el.a * std::cos(t0), y0 = el.b * std::sin(t0), x1 = el.a * std::cos(t1), y1 = el.b * std::sin(t1);
-      ellipse_->appendLine(el.cx + c * x0 - s * y0, el.cy + s * x0 + c * y0, 0.06, el.cx + c * x1 - s * y1,
-                           el.cy + s * x1 + c * y1, 0.06);
+      ellipse_->appendLine(el.cx + c * x0 - s * y0, el.cy + s * x0 + c * y0, 0.06, el.cx + c * x1 - s * y1, el.cy + s * x1 + c * y1, 0.06);
     }
   }
   bounds_ = d.bounds;

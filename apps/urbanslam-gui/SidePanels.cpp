@@ -59,9 +59,9 @@ void StatsPanel::update(const MapSnapshot& s, const std::string& input, const st
   std::snprintf(buf, sizeof buf,
                 "input      %s\nini        %s\n\nscans      %zu\nkeyframes  %zu\nclosures   %zu accepted, %zu rejected\n"
                 "log time   %.1f s\nprocessing %.3f s\nreal time  %.0fx\nprogress   %.0f %%%s",
-                input.c_str(), ini.c_str(), st.scans, st.keyframes, st.closures_accepted, st.closures_rejected,
-                st.log_time_s, st.processing_s, st.processing_s > 0 ? st.log_time_s / st.processing_s : 0.0,
-                100 * st.progress, s.finished ? "  (finished)" : "");
+                input.c_str(), ini.c_str(), st.scans, st.keyframes, st.closures_accepted, st.closures_rejected, st.log_time_s,
+                st.processing_s, st.processing_s > 0 ? st.log_time_s / st.processing_s : 0.0, 100 * st.progress,
+                s.finished ? "  (finished)" : "");
   text_->SetLabel(buf);
   plot_->setData(st.step_ms);
   Layout();
@@ -165,10 +165,10 @@ KeyframePanel::KeyframePanel(wxWindow* parent) : wxPanel(parent) {
 void KeyframePanel::show(const MapSnapshot& s, size_t index) {
   if (index >= s.keyframes.size()) return;
   const auto& k = s.keyframes[index];
-  text_->SetLabel(wxString::Format("keyframe   %zu\ntime       %.3f s\nx          %.3f m\ny          %.3f m\n"
-                                   "heading    %.2f deg\nscan       %zu points",
-                                   k.index, k.timestamp, k.pose.x, k.pose.y, k.pose.phi * 180 / M_PI,
-                                   k.points ? k.points->size() : 0));
+  text_->SetLabel(
+      wxString::Format("keyframe   %zu\ntime       %.3f s\nx          %.3f m\ny          %.3f m\n"
+                       "heading    %.2f deg\nscan       %zu points",
+                       k.index, k.timestamp, k.pose.x, k.pose.y, k.pose.phi * 180 / M_PI, k.points ? k.points->size() : 0));
   Layout();
 }
 

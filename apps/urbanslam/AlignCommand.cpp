@@ -30,8 +30,7 @@ long parseIndex(const std::string& name, const std::string& text) {
   } catch (const std::exception&) {
     pos = 0;
   }
-  if (pos != text.size() || v < 0)
-    throw common::InputError(name + ": '" + text + "' is not a scan index (0, 1, 2, ...)");
+  if (pos != text.size() || v < 0) throw common::InputError(name + ": '" + text + "' is not a scan index (0, 1, 2, ...)");
   return v;
 }
 
@@ -65,10 +64,14 @@ int alignCommand(const Argv& args) {
   ap.addPositional("LOG", "any supported log (MRPT rawlog, CARMEN log, GMapping gfs log, Victoria Park folder/zip)");
   ap.addPositional("A", "index of the reference scan");
   ap.addPositional("B", "index of the scan to align onto A");
-  ap.addOption("method", "M", "prior (the guess as a prior: correlative search + point-to-line with the prior, local SLAM's matcher) | icp | plicp | crf | crf+icp (CRF-match coarse, ICP refine)", "prior");
+  ap.addOption("method", "M",
+               "prior (the guess as a prior: correlative search + point-to-line with the prior, local SLAM's matcher) | icp | plicp | crf "
+               "| crf+icp (CRF-match coarse, ICP refine)",
+               "prior");
   ap.addOption("prior-sigma", "M,DEG", "method prior: how far off the guess may be (1 sigma: metres on x and y, degrees)", "0.5,15");
   ap.addOption("guess", "x,y,phi", "initial guess of B in A (metres, metres, radians)", "0,0,0");
-  ap.addOption("covariance", "C", "line (line variance, thesis) | hessian | sampling (methods other than prior, which gives its posterior)", "line");
+  ap.addOption("covariance", "C", "line (line variance, thesis) | hessian | sampling (methods other than prior, which gives its posterior)",
+               "line");
   ap.addFlag("json", "print one JSON object: x, y, phi, cov, iterations, time_ms, converged, ...");
   ap.addEpilog("Exit code 0 also when the alignment fails (converged: false, with a reason); 2 for bad input.");
   if (!ap.parse(args)) return 0;
@@ -137,8 +140,7 @@ int alignCommand(const Argv& args) {
   }
   if (!have_a || !have_b) {
     std::ostringstream os;
-    os << "scan index " << (!have_a ? ia : ib) << " is out of range: " << log << " has " << index
-       << " laser scans";
+    os << "scan index " << (!have_a ? ia : ib) << " is out of range: " << log << " has " << index << " laser scans";
     throw common::InputError(os.str());
   }
 
@@ -183,28 +185,29 @@ int alignCommand(const Argv& args) {
     return 0;
   }
   char line[256];
-  std::printf("scans %ld -> %ld of %s (%d / %d points), method %s\n", ia, ib, log.c_str(), r.points_a,
-              r.points_b, alignment::methodName(options.method).c_str());
-  std::snprintf(line, sizeof line, "transform: x %.4f m  y %.4f m  phi %.5f rad (%.3f deg)\n", r.transform.x,
-                r.transform.y, r.transform.phi, r.transform.phi * 180.0 / M_PI);
+  std::printf("scans %ld -> %ld of %s (%d / %d points), method %s\n", ia, ib, log.c_str(), r.points_a, r.points_b,
+              alignment::methodName(options.method).c_str());
+  std::snprintf(line, sizeof line, "transform: x %.4f m  y %.4f m  phi %.5f rad (%.3f deg)\n", r.transform.x, r.transform.y,
+                r.transform.phi, r.transform.phi * 180.0 / M_PI);
   std::cout << line;
   std::cout << "covariance (" << alignment::covarianceMethodName(options.covariance.method) << "; x, y, phi):\n";
   for (int i = 0; i < 3; ++i) {
     std::snprintf(line, sizeof line, "  % .4e % .4e % .4e\n", r.cov(i, 0), r.cov(i, 1), r.cov(i, 2));
     std::cout << line;
   }
-  std::snprintf(line, sizeof line, "std: x %.4f m  y %.4f m  phi %.4f deg\n", std::sqrt(r.cov(0, 0)),
-                std::sqrt(r.cov(1, 1)), std::sqrt(r.cov(2, 2)) * 180.0 / M_PI);
+  std::snprintf(line, sizeof line, "std: x %.4f m  y %.4f m  phi %.4f deg\n", std::sqrt(r.cov(0, 0)), std::sqrt(r.cov(1, 1)),
+                std::sqrt(r.cov(2, 2)) * 180.0 / M_PI);
   std::cout << line;
-  std::printf("iterations %d, time %.2f ms, %d matches, rms residual %.3f m\n", r.iterations, r.time_ms,
-              r.matches, r.rms_residual_m);
+  std::printf("iterations %d, time %.2f ms, %d matches, rms residual %.3f m\n", r.iterations, r.time_ms, r.matches, r.rms_residual_m);
   std::printf("free-space conflict %.3f (share of points where the other scan saw through)\n", conflict);
-  if (r.converged) std::printf("converged\n");
-  else std::printf("NOT converged: %s\n", r.failure_reason.c_str());
+  if (r.converged)
+    std::printf("converged\n");
+  else
+    std::printf("NOT converged: %s\n", r.failure_reason.c_str());
   if (ref_a && ref_b) {
     const common::Pose2 rel = common::between(pose_a, pose_b);
-    std::printf("reference (log's corrected poses): x %.4f m  y %.4f m  phi %.5f rad, free-space conflict %.3f\n", rel.x,
-                rel.y, rel.phi, alignment::mutualFreeSpaceConflict(sa, sb, rel));
+    std::printf("reference (log's corrected poses): x %.4f m  y %.4f m  phi %.5f rad, free-space conflict %.3f\n", rel.x, rel.y, rel.phi,
+                alignment::mutualFreeSpaceConflict(sa, sb, rel));
   }
   return 0;
 }

@@ -12,20 +12,15 @@ namespace urbanslam::cli {
 
 using common::InputError;
 
-ArgParser::ArgParser(std::string usage, std::string summary)
-    : usage_(std::move(usage)), summary_(std::move(summary)) {}
+ArgParser::ArgParser(std::string usage, std::string summary) : usage_(std::move(usage)), summary_(std::move(summary)) {}
 
-void ArgParser::addFlag(const std::string& name, const std::string& help) {
-  opts_.push_back({name, "", help, "", true});
-}
+void ArgParser::addFlag(const std::string& name, const std::string& help) { opts_.push_back({name, "", help, "", true}); }
 
-void ArgParser::addOption(const std::string& name, const std::string& metavar,
-                          const std::string& help, const std::string& default_value) {
+void ArgParser::addOption(const std::string& name, const std::string& metavar, const std::string& help, const std::string& default_value) {
   opts_.push_back({name, metavar, help, default_value, false});
 }
 
-void ArgParser::addPositional(const std::string& name, const std::string& help, bool required,
-                              bool variadic) {
+void ArgParser::addPositional(const std::string& name, const std::string& help, bool required, bool variadic) {
   pos_.push_back({name, help, required, variadic});
 }
 
@@ -79,8 +74,10 @@ bool ArgParser::parse(const std::vector<std::string>& args) {
       if (p.required && pos_values_[p.name].empty()) throw InputError("missing " + p.name + " (see --help)");
       break;
     }
-    if (k < positional.size()) pos_values_[p.name].push_back(positional[k++]);
-    else if (p.required) throw InputError("missing " + p.name + " (see --help)");
+    if (k < positional.size())
+      pos_values_[p.name].push_back(positional[k++]);
+    else if (p.required)
+      throw InputError("missing " + p.name + " (see --help)");
   }
   if (k < positional.size()) throw InputError("unexpected argument '" + positional[k] + "' (see --help)");
   return true;
@@ -115,8 +112,7 @@ long ArgParser::optionInt(const std::string& name) const {
   errno = 0;
   char* end = nullptr;
   const long v = std::strtol(s.c_str(), &end, 10);
-  if (s.empty() || end != s.c_str() + s.size() || errno == ERANGE)
-    throw InputError("--" + name + ": '" + s + "' is not a whole number");
+  if (s.empty() || end != s.c_str() + s.size() || errno == ERANGE) throw InputError("--" + name + ": '" + s + "' is not a whole number");
   return v;
 }
 
@@ -146,8 +142,10 @@ std::string ArgParser::helpText() const {
   all.push_back({"help", "", "show this help and exit", "", true});
   for (const auto& o : all) {
     std::string n = "  --" + o.name + (o.is_flag ? "" : " " + o.metavar);
-    if (n.size() < 26) n.append(26 - n.size(), ' ');
-    else n += "  ";
+    if (n.size() < 26)
+      n.append(26 - n.size(), ' ');
+    else
+      n += "  ";
     os << n << o.help;
     if (!o.is_flag && !o.def.empty()) os << " (default: " << o.def << ")";
     os << "\n";

@@ -13,11 +13,9 @@ class ArgParser {
   ArgParser(std::string usage, std::string summary);
 
   void addFlag(const std::string& name, const std::string& help);
-  void addOption(const std::string& name, const std::string& metavar, const std::string& help,
-                 const std::string& default_value = "");
+  void addOption(const std::string& name, const std::string& metavar, const std::string& help, const std::string& default_value = "");
   // A trailing positional may be variadic (collects the rest); required positionals come first.
-  void addPositional(const std::string& name, const std::string& help, bool required = true,
-                     bool variadic = false);
+  void addPositional(const std::string& name, const std::string& help, bool required = true, bool variadic = false);
   // Free text appended to --help (examples, output description).
   void addEpilog(const std::string& text) { epilog_ = text; }
 

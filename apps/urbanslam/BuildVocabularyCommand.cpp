@@ -19,12 +19,13 @@ namespace urbanslam::cli {
 
 int buildVocabularyCommand(const Argv& args) {
   using namespace vision_loop;
-  ArgParser ap("urbanslam build-vocabulary IMAGES... --out FILE [--descriptor sift|orb] [--k 10] [--levels 6] "
-               "[--max-features 500] [--threads N] [--quiet] [--json]",
-               "Trains a vocabulary tree by hierarchical k-means (k-means++ seeding) on the local features of\n"
-               "IMAGES and writes it in the binary vocabulary format. IMAGES: folders (their image files), image\n"
-               "lists (.txt: one path per line, relative to the list), image files or rawlogs. Use images that\n"
-               "are NOT in the sequences the vocabulary will be evaluated on.");
+  ArgParser ap(
+      "urbanslam build-vocabulary IMAGES... --out FILE [--descriptor sift|orb] [--k 10] [--levels 6] "
+      "[--max-features 500] [--threads N] [--quiet] [--json]",
+      "Trains a vocabulary tree by hierarchical k-means (k-means++ seeding) on the local features of\n"
+      "IMAGES and writes it in the binary vocabulary format. IMAGES: folders (their image files), image\n"
+      "lists (.txt: one path per line, relative to the list), image files or rawlogs. Use images that\n"
+      "are NOT in the sequences the vocabulary will be evaluated on.");
   ap.addPositional("IMAGES", "folders, image lists, images or rawlogs", true, true);
   ap.addOption("out", "FILE", "output vocabulary file");
   ap.addOption("descriptor", "D", "sift (128-D, angle) or orb (256-bit, Hamming)", "sift");
@@ -101,17 +102,16 @@ int buildVocabularyCommand(const Argv& args) {
   for (const auto& d : descriptors) count += d.rows;
   const double feature_s = total.seconds();
   if (show)
-    std::cerr << images << " images, " << descriptors.size() << " with features, " << count << " "
-              << descriptorName(fo.type) << " descriptors (" << feature_s << " s)\n";
+    std::cerr << images << " images, " << descriptors.size() << " with features, " << count << " " << descriptorName(fo.type)
+              << " descriptors (" << feature_s << " s)\n";
 
   // 2. Tree and IDF.
   common::Stopwatch train;
   Vocabulary vocabulary;
   {
     common::ProgressBar bar("k-means", 1000, show);
-    vocabulary = trainVocabulary(descriptors, fo.type, ko, [&](double f, const std::string& s) {
-      bar.update(static_cast<uint64_t>(f * 1000), s);
-    });
+    vocabulary =
+        trainVocabulary(descriptors, fo.type, ko, [&](double f, const std::string& s) { bar.update(static_cast<uint64_t>(f * 1000), s); });
     bar.finish();
   }
   const double train_s = train.seconds();
@@ -130,8 +130,10 @@ int buildVocabularyCommand(const Argv& args) {
   j["feature_seconds"] = feature_s;
   j["training_seconds"] = train_s;
   j["threads"] = threads;
-  if (ap.flag("json")) std::cout << j.dump() << "\n";
-  else std::cout << "wrote " << ap.option("out") << ": " << vocabulary.summary() << " in " << feature_s + train_s << " s\n";
+  if (ap.flag("json"))
+    std::cout << j.dump() << "\n";
+  else
+    std::cout << "wrote " << ap.option("out") << ": " << vocabulary.summary() << " in " << feature_s + train_s << " s\n";
   return 0;
 }
 

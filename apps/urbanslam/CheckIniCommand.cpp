@@ -27,8 +27,10 @@ int checkIniCommand(const Argv& args) {
     common::OptionsSchema schema;
     sim::SimOptions so = sim::loadSimOptions(ap.positional("FILE"), &resolved);
     sim::declareSimOptions(schema, so);
-    if (ap.flag("json")) std::cout << schema.toJson().dump() << "\n";
-    else std::cout << "// " << ap.positional("FILE") << ": OK (simulation). Resolved configuration:\n" << resolved;
+    if (ap.flag("json"))
+      std::cout << schema.toJson().dump() << "\n";
+    else
+      std::cout << "// " << ap.positional("FILE") << ": OK (simulation). Resolved configuration:\n" << resolved;
     return 0;
   }
   const slam::PipelineOptions o = slam::loadPipelineOptions(ap.positional("FILE"), &resolved);

@@ -18,8 +18,7 @@ int convertCommand(const Argv& args) {
                "GPS and reference poses CObservationRobotPose 'GPS_LOCAL' / 'REFERENCE'.");
   ap.addPositional("IN", "input log");
   ap.addPositional("OUT", "output rawlog (gzip-compressed)");
-  ap.addOption("layout", "L", "observations (one observation per entry) or frames (action/sensory-frame pairs)",
-               "observations");
+  ap.addOption("layout", "L", "observations (one observation per entry) or frames (action/sensory-frame pairs)", "observations");
   ap.addFlag("quiet", "no progress bar");
   ap.addFlag("json", "print counts as one JSON object");
   if (!ap.parse(args)) return 0;
@@ -28,16 +27,18 @@ int convertCommand(const Argv& args) {
     throw common::InputError("--layout: '" + layout + "' is not one of observations|frames");
 
   auto source = io::openDataSource(ap.positional("IN"));
-  io::RawlogWriter writer(ap.positional("OUT"),
-                          layout == "frames" ? io::RawlogLayout::SensoryFrames : io::RawlogLayout::Observations);
+  io::RawlogWriter writer(ap.positional("OUT"), layout == "frames" ? io::RawlogLayout::SensoryFrames : io::RawlogLayout::Observations);
   common::ProgressBar bar("convert", 1000, !ap.flag("quiet"));
   io::Measurement m;
   size_t scans = 0, odometry = 0, other = 0;
   while (source->next(m)) {
     writer.write(m);
-    if (std::holds_alternative<io::LaserScan>(m)) ++scans;
-    else if (std::holds_alternative<io::OdometryReading>(m)) ++odometry;
-    else ++other;
+    if (std::holds_alternative<io::LaserScan>(m))
+      ++scans;
+    else if (std::holds_alternative<io::OdometryReading>(m))
+      ++odometry;
+    else
+      ++other;
     bar.update(static_cast<uint64_t>(source->progress() * 1000));
   }
   writer.close();
@@ -51,9 +52,11 @@ int convertCommand(const Argv& args) {
   j["scans"] = scans;
   j["odometry"] = odometry;
   j["other"] = other;
-  if (ap.flag("json")) std::cout << j.dump() << "\n";
-  else std::cout << "wrote " << ap.positional("OUT") << ": " << writer.written() << " measurements (" << scans
-                 << " scans, " << odometry << " odometry, " << other << " other) from " << source->format() << "\n";
+  if (ap.flag("json"))
+    std::cout << j.dump() << "\n";
+  else
+    std::cout << "wrote " << ap.positional("OUT") << ": " << writer.written() << " measurements (" << scans << " scans, " << odometry
+              << " odometry, " << other << " other) from " << source->format() << "\n";
   return 0;
 }
 

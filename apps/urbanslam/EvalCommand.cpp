@@ -81,7 +81,7 @@ void evaluateAgainstSimulation(const fs::path& run, const fs::path& sim, const c
   j["map"] = std::move(m);
   if (fs::exists(run / "loop_closures.csv")) {
     const auto r = evaluation::loopRecall(evaluation::readLoopClosuresCsv((run / "loop_closures.csv").string()),
-                                    evaluation::readTrueLoopsCsv((sim / "loops.csv").string()));
+                                          evaluation::readTrueLoopsCsv((sim / "loops.csv").string()));
     common::Json l = common::Json::object();
     l["revisited_scans"] = r.revisited_scans;
     l["closed_scans"] = r.closed_scans;
@@ -120,9 +120,13 @@ int evalCommand(const Argv& args) {
   ap.addOption("relations", "FILE", "Freiburg relations file (t1 t2 x y z roll pitch yaw)");
   ap.addOption("reference", "FILE", "reference trajectory: TUM file or a log that carries one");
   ap.addOption("truth", "SIM_DIR", "folder written by urbanslam simulate (truth.tum, walls.csv, loops.csv)");
-  ap.addOption("scans", "FILE", "TUM file whose times are the scans the run placed, for the relations' breakdown (default: RUN_DIR/trajectory_scans.tum, else trajectory_keyframes.tum); give another run's to compare two runs on the same classes");
+  ap.addOption("scans", "FILE",
+               "TUM file whose times are the scans the run placed, for the relations' breakdown (default: RUN_DIR/trajectory_scans.tum, "
+               "else trajectory_keyframes.tum); give another run's to compare two runs on the same classes");
   ap.addOption("time-offset", "S", "seconds added to the run's timestamps for --relations (default: found)");
-  ap.addOption("max-gap", "S", "a relation is used only when the trajectory poses around each of its times are at most this far apart [s]; 0: any gap", "0");
+  ap.addOption("max-gap", "S",
+               "a relation is used only when the trajectory poses around each of its times are at most this far apart [s]; 0: any gap",
+               "0");
   ap.addOption("loop-tolerance-m", "M", "a closure is true when its measurement agrees with the reference within this", "0.5");
   ap.addOption("loop-tolerance-deg", "DEG", "... and this", "5");
   ap.addFlag("json", "print the figures as one JSON object");
@@ -149,13 +153,16 @@ int evalCommand(const Argv& args) {
   j["run"] = dir.string();
   bool positions_only = false;
   std::vector<io::StampedPose> reference;
-  if (!reference_path.empty()) reference = loadReference(reference_path, positions_only);
-  else if (fs::exists(dir / "reference.tum")) reference = io::readTum((dir / "reference.tum").string());
+  if (!reference_path.empty())
+    reference = loadReference(reference_path, positions_only);
+  else if (fs::exists(dir / "reference.tum"))
+    reference = io::readTum((dir / "reference.tum").string());
 
   if (ap.has("relations")) {
     const auto rel = evaluation::readRelations(ap.option("relations"));
     double offset = 0;
-    if (ap.has("time-offset")) offset = ap.optionDouble("time-offset");
+    if (ap.has("time-offset"))
+      offset = ap.optionDouble("time-offset");
     else {
       std::vector<double> log_times;  // the log's own timestamps (not estimated values)
       for (const auto& p : estimate) log_times.push_back(p.timestamp);
@@ -177,7 +184,8 @@ int evalCommand(const Argv& args) {
       r["abs_rot_std_deg"] = m.abs_rot_deg.std;
       r["sqr_rot_mean_deg2"] = m.sqr_rot_deg2.mean;
       r["sqr_rot_std_deg2"] = m.sqr_rot_deg2.std;
-      if (m.used == 0) throw common::InputError(ap.option("relations") + ": no relation falls inside the run's time span (wrong dataset or offset?)");
+      if (m.used == 0)
+        throw common::InputError(ap.option("relations") + ": no relation falls inside the run's time span (wrong dataset or offset?)");
       return r;
     };
     j["relations"] = block(nodes, have_nodes ? nodes_path : traj_path);
@@ -209,7 +217,8 @@ int evalCommand(const Argv& args) {
     // carried over the short legs by the odometry-time trajectory (it follows the turns between
     // sparse scans; at the scans it is their poses).
     if (fs::exists(dir / "loop_closures.csv")) {
-      const auto lc = evaluation::checkLoopsWithRelations(evaluation::readLoopClosuresCsv((dir / "loop_closures.csv").string()), estimate, rel, offset);
+      const auto lc =
+          evaluation::checkLoopsWithRelations(evaluation::readLoopClosuresCsv((dir / "loop_closures.csv").string()), estimate, rel, offset);
       common::Json& l = j["relations"]["loops"];
       l["accepted"] = lc.accepted;
       l["checked"] = lc.checked;
@@ -235,9 +244,9 @@ int evalCommand(const Argv& args) {
     j["rpe_trans_rmse_m"] = tm.rpe_trans_rmse_m;
     j["rpe_rot_rmse_deg"] = tm.rpe_rot_rmse_deg;
     if (fs::exists(dir / "loop_closures.csv")) {
-      const auto lm = evaluation::classifyLoopClosures(evaluation::readLoopClosuresCsv((dir / "loop_closures.csv").string()), reference,
-                                                 positions_only, ap.optionDouble("loop-tolerance-m"),
-                                                 ap.optionDouble("loop-tolerance-deg"));
+      const auto lm =
+          evaluation::classifyLoopClosures(evaluation::readLoopClosuresCsv((dir / "loop_closures.csv").string()), reference, positions_only,
+                                           ap.optionDouble("loop-tolerance-m"), ap.optionDouble("loop-tolerance-deg"));
       j["loops_accepted"] = lm.accepted;
       j["loops_true"] = lm.true_positive;
       j["loops_false"] = lm.false_positive;
@@ -255,7 +264,7 @@ int evalCommand(const Argv& args) {
         const auto in_map = [&](long k) { return k >= 0 && static_cast<size_t>(k) < keyframes.size(); };
         if (weigh && in_map(f.from_keyframe) && in_map(f.to_keyframe)) {
           const auto ev = evaluation::weighClosure(keyframes[static_cast<size_t>(f.from_keyframe)].scan,
-                                             keyframes[static_cast<size_t>(f.to_keyframe)].scan, f.measurement, f.reference);
+                                                   keyframes[static_cast<size_t>(f.to_keyframe)].scan, f.measurement, f.reference);
           common::Json s = common::Json::object();
           s["verdict"] = ev.verdict;
           s["from_reference"] = poseJson(ev.from_reference);

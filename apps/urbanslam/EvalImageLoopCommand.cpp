@@ -105,18 +105,17 @@ int evalImageLoopCommand(const Argv& args) {
   writePrCurveCsv(sweep.curve, (out / "pr_curve.csv").string());
   char title[200];
   std::snprintf(title, sizeof title, "%s, %zu frames: recall %.1f %% at 100 %% precision",
-                std::filesystem::path(ap.positional("SEQUENCE")).filename().c_str(), frames.size(),
-                100 * sweep.recall_at_precision_1);
+                std::filesystem::path(ap.positional("SEQUENCE")).filename().c_str(), frames.size(), 100 * sweep.recall_at_precision_1);
   writePrCurvePng(sweep.curve, title, (out / "pr_curve.png").string());
   {
     common::AtomicFile f((out / "detections.csv").string());
     f.stream() << "alpha,query,match,score,normalized_score,inliers,correct\n";
     for (const auto& d : sweep.detections_at_default)
-      f.stream() << lo.min_normalized_score << ',' << d.query << ',' << d.match << ',' << d.score << ','
-                 << d.normalized_score << ',' << d.inliers << ',' << (d.correct ? 1 : 0) << '\n';
+      f.stream() << lo.min_normalized_score << ',' << d.query << ',' << d.match << ',' << d.score << ',' << d.normalized_score << ','
+                 << d.inliers << ',' << (d.correct ? 1 : 0) << '\n';
     for (const auto& d : sweep.detections_at_precision_1)
-      f.stream() << sweep.threshold_at_precision_1 << ',' << d.query << ',' << d.match << ',' << d.score << ','
-                 << d.normalized_score << ',' << d.inliers << ',' << (d.correct ? 1 : 0) << '\n';
+      f.stream() << sweep.threshold_at_precision_1 << ',' << d.query << ',' << d.match << ',' << d.score << ',' << d.normalized_score << ','
+                 << d.inliers << ',' << (d.correct ? 1 : 0) << '\n';
     f.commit();
   }
 
@@ -149,15 +148,14 @@ int evalImageLoopCommand(const Argv& args) {
   if (ap.flag("json")) {
     std::cout << j.dump() << "\n";
   } else {
-    std::printf("%s\n%zu frames (%zu close loops), %.0f features/image\n", vocabulary->summary().c_str(), frames.size(),
-                sweep.positives, features);
-    std::printf("recall at 100%% precision: %.1f %% (alpha %.2f)\n", 100 * sweep.recall_at_precision_1,
-                sweep.threshold_at_precision_1);
+    std::printf("%s\n%zu frames (%zu close loops), %.0f features/image\n", vocabulary->summary().c_str(), frames.size(), sweep.positives,
+                features);
+    std::printf("recall at 100%% precision: %.1f %% (alpha %.2f)\n", 100 * sweep.recall_at_precision_1, sweep.threshold_at_precision_1);
     std::printf("at alpha %.2f: precision %.1f %%, recall %.1f %% (%zu TP, %zu FP)\n", lo.min_normalized_score,
                 100 * sweep.at_default.precision, 100 * sweep.at_default.recall, sweep.at_default.true_positives,
                 sweep.at_default.false_positives);
-    std::printf("per image: %.2f ms (extraction %.2f, quantisation %.2f, query %.3f, verification %.2f)\n", per_image,
-                extraction, quantization, sweep.mean_query_ms, sweep.mean_verification_ms);
+    std::printf("per image: %.2f ms (extraction %.2f, quantisation %.2f, query %.3f, verification %.2f)\n", per_image, extraction,
+                quantization, sweep.mean_query_ms, sweep.mean_verification_ms);
     std::printf("PR curve: %s, %s\n", (out / "pr_curve.csv").c_str(), (out / "pr_curve.png").c_str());
   }
   return 0;

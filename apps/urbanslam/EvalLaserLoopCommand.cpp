@@ -144,8 +144,7 @@ int evalLaserLoopCommand(const Argv& args) {
   j["positives"] = pos.size();
   j["negatives"] = neg.size();
   for (int k = 0; k < 3; ++k) j[std::string("detection_at_fa_") + kFaKeys[k]] = roc.at(kFalseAlarms[k]).detection;
-  for (int k = 0; k < 3; ++k)
-    j[std::string("baseline_detection_at_fa_") + kFaKeys[k]] = broc.at(kFalseAlarms[k]).detection;
+  for (int k = 0; k < 3; ++k) j[std::string("baseline_detection_at_fa_") + kFaKeys[k]] = broc.at(kFalseAlarms[k]).detection;
   j["auc"] = roc.auc();
   j["baseline_auc"] = broc.auc();
   j["factor"] = factor;
@@ -208,23 +207,22 @@ int evalLaserLoopCommand(const Argv& args) {
     std::cout << j.dump() << "\n";
     return 0;
   }
-  std::cout << "pairs: " << pos.size() << " positive, " << neg.size() << " negative (d_pos " << rules.d_pos_m
-            << " m, d_neg " << rules.d_neg_m << " m, min travel " << rules.min_travel_m << " m)\n";
+  std::cout << "pairs: " << pos.size() << " positive, " << neg.size() << " negative (d_pos " << rules.d_pos_m << " m, d_neg "
+            << rules.d_neg_m << " m, min travel " << rules.min_travel_m << " m)\n";
   std::cout << "false alarm   adaboost   nearest-neighbour baseline\n";
   for (int k = 0; k < 3; ++k) {
     char buf[120];
-    std::snprintf(buf, sizeof buf, "%8.1f %%   %7.1f %%   %7.1f %%\n", 100 * kFalseAlarms[k],
-                  100 * roc.at(kFalseAlarms[k]).detection, 100 * broc.at(kFalseAlarms[k]).detection);
+    std::snprintf(buf, sizeof buf, "%8.1f %%   %7.1f %%   %7.1f %%\n", 100 * kFalseAlarms[k], 100 * roc.at(kFalseAlarms[k]).detection,
+                  100 * broc.at(kFalseAlarms[k]).detection);
     std::cout << buf;
   }
   std::cout << "AUC " << roc.auc() << " (baseline " << broc.auc() << ")\n";
-  std::cout << "at factor " << factor << ": detection " << pct(double(at_factor_det) / double(pos.size()))
-            << ", false alarm " << pct(double(at_factor_fa) / double(neg.size())) << "\n";
+  std::cout << "at factor " << factor << ": detection " << pct(double(at_factor_det) / double(pos.size())) << ", false alarm "
+            << pct(double(at_factor_fa) / double(neg.size())) << "\n";
   const auto r = rotation(roc.at(0.01).threshold);
-  std::cout << "rotation (at 1 % FA): heading difference > 90°: " << pct(r.at("detection_heading_gt_90").asNumber())
-            << " of " << static_cast<long>(r.at("pairs_heading_gt_90").asNumber()) << "; < 30°: "
-            << pct(r.at("detection_heading_lt_30").asNumber()) << " of "
-            << static_cast<long>(r.at("pairs_heading_lt_30").asNumber()) << "\n";
+  std::cout << "rotation (at 1 % FA): heading difference > 90°: " << pct(r.at("detection_heading_gt_90").asNumber()) << " of "
+            << static_cast<long>(r.at("pairs_heading_gt_90").asNumber()) << "; < 30°: " << pct(r.at("detection_heading_lt_30").asNumber())
+            << " of " << static_cast<long>(r.at("pairs_heading_lt_30").asNumber()) << "\n";
   return 0;
 }
 

@@ -36,18 +36,18 @@ int graphCommand(const Argv& args) {
   ap.addFlag("json", "print one JSON object on stdout instead of text");
   ap.addFlag("gate", "gate loop closures with the chi2 test (rejected edges still count in chi2)");
   ap.addOption("gate-probability", "P", "chi2 quantile probability of the gate", "0.999");
-  ap.addOption("gate-covariance", "MODE",
-               "exact (refactorise when stale) or conservative (last factorisation + dead reckoning)", "exact");
+  ap.addOption("gate-covariance", "MODE", "exact (refactorise when stale) or conservative (last factorisation + dead reckoning)", "exact");
   ap.addFlag("no-relinearise", "linearise every edge once, as the thesis filter does");
   ap.addOption("full-every", "N", "full recovery after N loop closures", "20");
   ap.addOption("innovation-chi2", "X", "full recovery at once after a closure with innovation chi2 above X", "50");
   ap.addOption("min-gap", "F", "full recoveries at least F * poses apart (amortises their cost)", "0.25");
-  ap.addOption("heading-innovation", "RAD",
-               "full recovery (whatever --min-gap says) before a closure whose heading innovation exceeds RAD", "1.0");
+  ap.addOption("heading-innovation", "RAD", "full recovery (whatever --min-gap says) before a closure whose heading innovation exceeds RAD",
+               "1.0");
   ap.addOption("window", "W", "poses re-solved by the partial recovery after other loop closures", "50");
-  ap.addEpilog("Example:\n  urbanslam graph manhattan.g2o --out manhattan_opt.g2o --json\n"
-               "JSON keys: chi2, poses, edges, time_s (read + filter), read_s, filter_s, step_ms_p50,\n"
-               "step_ms_p99 (per-edge processing time), full_recoveries, partial_recoveries, rejected_edges, ...");
+  ap.addEpilog(
+      "Example:\n  urbanslam graph manhattan.g2o --out manhattan_opt.g2o --json\n"
+      "JSON keys: chi2, poses, edges, time_s (read + filter), read_s, filter_s, step_ms_p50,\n"
+      "step_ms_p99 (per-edge processing time), full_recoveries, partial_recoveries, rejected_edges, ...");
   if (!ap.parse(args)) return 0;
 
   esdf::PoseGraphBackendOptions o;
@@ -56,17 +56,19 @@ int graphCommand(const Argv& args) {
   if (!(o.filter.chi2_gate_probability > 0 && o.filter.chi2_gate_probability < 1))
     throw common::InputError("--gate-probability: must be in (0, 1)");
   const std::string gate_cov = ap.option("gate-covariance");
-  if (gate_cov == "exact") o.filter.gate_covariance = esdf::CovarianceMode::Exact;
-  else if (gate_cov == "conservative") o.filter.gate_covariance = esdf::CovarianceMode::Conservative;
-  else throw common::InputError("--gate-covariance: '" + gate_cov + "' is not one of exact|conservative");
+  if (gate_cov == "exact")
+    o.filter.gate_covariance = esdf::CovarianceMode::Exact;
+  else if (gate_cov == "conservative")
+    o.filter.gate_covariance = esdf::CovarianceMode::Conservative;
+  else
+    throw common::InputError("--gate-covariance: '" + gate_cov + "' is not one of exact|conservative");
   o.filter.relinearise = !ap.flag("no-relinearise");
   o.full_recovery_every_closures = static_cast<int>(ap.optionInt("full-every"));
   o.full_recovery_innovation_chi2 = ap.optionDouble("innovation-chi2");
   o.full_recovery_min_gap_fraction = ap.optionDouble("min-gap");
   o.recent_window_poses = static_cast<int>(ap.optionInt("window"));
   o.full_recovery_heading_innovation_rad = ap.optionDouble("heading-innovation");
-  if (!(o.full_recovery_heading_innovation_rad > 0))
-    throw common::InputError("--heading-innovation: must be > 0");
+  if (!(o.full_recovery_heading_innovation_rad > 0)) throw common::InputError("--heading-innovation: must be > 0");
   if (o.full_recovery_every_closures < 1) throw common::InputError("--full-every: must be >= 1");
   if (o.recent_window_poses < 0) throw common::InputError("--window: must be >= 0");
   if (o.full_recovery_min_gap_fraction < 0) throw common::InputError("--min-gap: must be >= 0");
@@ -122,18 +124,16 @@ int graphCommand(const Argv& args) {
     std::cout << j.dump() << "\n";
   } else {
     std::ostringstream s;
-    s << in << ": " << r.poses.size() << " poses, " << r.edges << " edges (" << r.observation_edges
-      << " observations";
+    s << in << ": " << r.poses.size() << " poses, " << r.edges << " edges (" << r.observation_edges << " observations";
     if (o.gate_loop_closures) s << ", " << r.rejected_edges << " rejected by the gate";
     s << ")\n";
     s.precision(10);
     s << "chi2 " << r.chi2 << "\n";
     s.precision(4);
-    s << "time " << time_s << " s (read " << read_s << " s, filter " << r.time_s << " s, of which full recovery "
-      << r.recovery_s << " s); per edge p50 " << common::percentile(r.step_ms, 50) << " ms, p99 "
-      << common::percentile(r.step_ms, 99) << " ms\n";
-    s << r.full_recoveries << " full / " << r.partial_recoveries << " partial recoveries, "
-      << r.factors_relinearised << " relinearised factors" << (r.converged || !o.filter.relinearise ? "" : " (relinearisation not converged)") << "\n";
+    s << "time " << time_s << " s (read " << read_s << " s, filter " << r.time_s << " s, of which full recovery " << r.recovery_s
+      << " s); per edge p50 " << common::percentile(r.step_ms, 50) << " ms, p99 " << common::percentile(r.step_ms, 99) << " ms\n";
+    s << r.full_recoveries << " full / " << r.partial_recoveries << " partial recoveries, " << r.factors_relinearised
+      << " relinearised factors" << (r.converged || !o.filter.relinearise ? "" : " (relinearisation not converged)") << "\n";
     if (ap.has("out")) s << "wrote " << ap.option("out") << "\n";
     std::cout << s.str();
   }

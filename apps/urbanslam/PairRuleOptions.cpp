@@ -9,8 +9,7 @@ void addPairRuleOptions(ArgParser& ap, const char* max_heading_default_deg, cons
   ap.addOption("d-pos", "M", "positive pair: reference positions within this distance", "1.0");
   ap.addOption("d-neg", "M", "negative pair: reference positions farther apart than this", "3.0");
   ap.addOption("min-travel", "M", "positive pair: at least this much reference trajectory between the scans", "10");
-  ap.addOption("max-heading-diff", "DEG", "positive pair: heading difference at most this (180: any heading)",
-               max_heading_default_deg);
+  ap.addOption("max-heading-diff", "DEG", "positive pair: heading difference at most this (180: any heading)", max_heading_default_deg);
   ap.addOption("max-positives", "N", max_positives_help, max_positives_default);
 }
 

@@ -36,8 +36,9 @@ int runCommand(const Argv& args) {
                "CARMEN log (raw or Freiburg-corrected), GMapping gfs log, Victoria Park (folder or zip) or a\n"
                "folder of camera images (one keyframe per image; image loop proposals need [loop_closure] image_detector).");
   ap.addPositional("LOG", "input log; default: the shipped rawlogs/intel.rawlog", false);
-  ap.addOption("simulate", "CITY_INI", "map a simulated city drive streamed straight from the simulator (no file; see\n"
-                                       "`urbanslam simulate`) instead of a LOG");
+  ap.addOption("simulate", "CITY_INI",
+               "map a simulated city drive streamed straight from the simulator (no file; see\n"
+               "`urbanslam simulate`) instead of a LOG");
   ap.addOption("ini", "FILE", "configuration (see ini/default.ini for every key)", "ini/default.ini");
   ap.addOption("out", "DIR", "output folder (created if needed)", "out");
   ap.addFlag("quiet", "no progress bar and no summary on stderr");
@@ -52,7 +53,7 @@ int runCommand(const Argv& args) {
 
   if (ap.has("simulate") && !ap.positional("LOG").empty())
     throw common::InputError("run: give either a LOG or --simulate CITY_INI, not both");
-  const std::string log = ap.has("simulate")        ? ap.option("simulate")
+  const std::string log = ap.has("simulate")             ? ap.option("simulate")
                           : ap.positional("LOG").empty() ? defaultRawlog()
                                                          : ap.positional("LOG");
   const std::string ini = ap.has("ini") ? ap.option("ini") : defaultIni();
@@ -76,10 +77,9 @@ int runCommand(const Argv& args) {
   if (ap.flag("json")) std::cout << stats.dump() << "\n";
   if (!quiet) {
     const auto& t = stats.at("timing");
-    std::cerr << "urbanslam run: " << pipeline.stats().scans_used << " scans, " << pipeline.keyframes().size()
-              << " keyframes, " << stats.at("counts").at("map_points").asNumber() << " map points in "
-              << t.at("wall_s").asNumber() << " s (" << t.at("real_time_factor").asNumber()
-              << "x real time)\n"
+    std::cerr << "urbanslam run: " << pipeline.stats().scans_used << " scans, " << pipeline.keyframes().size() << " keyframes, "
+              << stats.at("counts").at("map_points").asNumber() << " map points in " << t.at("wall_s").asNumber() << " s ("
+              << t.at("real_time_factor").asNumber() << "x real time)\n"
               << "outputs in " << std::filesystem::absolute(out).string() << "/ (grid.png, map.ply, "
               << "trajectory_keyframes.tum, stats.json, ...)\n";
   }

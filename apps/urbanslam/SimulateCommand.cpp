@@ -20,11 +20,13 @@ int simulateCommand(const Argv& args) {
                "Simulates a drive through a city generated from a seed: 2D laser (walls, trees, parked and\n"
                "moving cars, pedestrians), a camera (textured facades; optional), wheel odometry and optionally\n"
                "GPS, with the ground truth.");
-  ap.addOption("ini", "FILE", "simulation settings ([city], [vehicle], [route], [laser], [camera], [odometry], "
-                              "[gps], [traffic], [loops]); default: built-in defaults");
+  ap.addOption("ini", "FILE",
+               "simulation settings ([city], [vehicle], [route], [laser], [camera], [odometry], "
+               "[gps], [traffic], [loops]); default: built-in defaults");
   ap.addOption("out", "DIR", "output folder (created if needed)");
-  ap.addFlag("no-rawlog", "write only the ground truth (no city.rawlog, no images): to score a run that streamed\n"
-                         "the same ini with `urbanslam run --simulate` (the simulation is deterministic)");
+  ap.addFlag("no-rawlog",
+             "write only the ground truth (no city.rawlog, no images): to score a run that streamed\n"
+             "the same ini with `urbanslam run --simulate` (the simulation is deterministic)");
   ap.addFlag("quiet", "no progress bar and no summary on stderr");
   ap.addFlag("json", "print a summary as one JSON object on stdout");
   ap.addEpilog(
@@ -44,8 +46,7 @@ int simulateCommand(const Argv& args) {
 
   common::ProgressBar bar("simulate", 1000, !quiet);
   const sim::SimulationSummary s = sim::writeSimulation(
-      options, ap.option("out"), resolved, [&](double f) { bar.update(static_cast<uint64_t>(f * 1000)); },
-      !ap.flag("no-rawlog"));
+      options, ap.option("out"), resolved, [&](double f) { bar.update(static_cast<uint64_t>(f * 1000)); }, !ap.flag("no-rawlog"));
   bar.finish();
 
   common::Json j = common::Json::object();
@@ -70,15 +71,14 @@ int simulateCommand(const Argv& args) {
   j["simulated_s_per_wall_s"] = s.simulate_wall_s > 0 ? s.duration_s / s.simulate_wall_s : 0.0;
   if (ap.flag("json")) std::cout << j.dump() << "\n";
   if (!quiet)
-    std::cerr << "urbanslam simulate: " << s.distance_m / 1000 << " km in " << s.duration_s << " s simulated, "
-              << s.scans << " scans, " << s.loop_pairs << " loop pairs, "
+    std::cerr << "urbanslam simulate: " << s.distance_m / 1000 << " km in " << s.duration_s << " s simulated, " << s.scans << " scans, "
+              << s.loop_pairs << " loop pairs, "
               << (s.images > 0 ? std::to_string(s.images) + " images (" +
-                                     std::to_string(static_cast<int>(std::lround(1000 * s.render_wall_s / s.images))) +
-                                     " ms each), " + std::to_string(s.image_loop_pairs) + " image loop pairs, "
+                                     std::to_string(static_cast<int>(std::lround(1000 * s.render_wall_s / s.images))) + " ms each), " +
+                                     std::to_string(s.image_loop_pairs) + " image loop pairs, "
                                : std::string())
-              << s.wall_segments << " wall segments; "
-              << s.duration_s / std::max(1e-9, s.simulate_wall_s) << "x real time (" << s.total_wall_s
-              << " s with outputs)\n";
+              << s.wall_segments << " wall segments; " << s.duration_s / std::max(1e-9, s.simulate_wall_s) << "x real time ("
+              << s.total_wall_s << " s with outputs)\n";
   return 0;
 }
 

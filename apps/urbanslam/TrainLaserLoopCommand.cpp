@@ -33,8 +33,10 @@ int trainLaserLoopCommand(const Argv& args) {
                "--max-heading-diff, after --min-travel of driving; negative beyond --d-neg; balanced), T is\n"
                "chosen by tenfold cross-validation over T = 1..--t-max, and AdaBoost is trained on all pairs\n"
                "with that T.");
-  ap.addPositional("DATA", "logs with a reference trajectory (corrected CARMEN logs, rawlogs with REFERENCE poses, "
-                           "Victoria Park via GPS)", true, true);
+  ap.addPositional("DATA",
+                   "logs with a reference trajectory (corrected CARMEN logs, rawlogs with REFERENCE poses, "
+                   "Victoria Park via GPS)",
+                   true, true);
   ap.addOption("out", "MODEL", "model file to write");
   ap.addOption("plots", "DIR", "write cv.csv and cv.png (Figure 3.5) here");
   // Training positives default to ≤ 30° of heading difference: a 180° scanner sees disjoint
@@ -55,11 +57,10 @@ int trainLaserLoopCommand(const Argv& args) {
   // Off by default: measured on held-out logs (share/laser_loop/README.md) the log scale helps
   // between Freiburg environments (indoor → campus +10 points at 1 % FA) but loses 13–17 points
   // on Victoria Park, so the thesis's plain features stay the default.
-  ap.addOption("log-features", "0|1", "compare features on a log scale, sign(f)·ln(1+|f|) (1) or as in the thesis (0)",
-               "0");
+  ap.addOption("log-features", "0|1", "compare features on a log scale, sign(f)·ln(1+|f|) (1) or as in the thesis (0)", "0");
   // Off by default: measured worse on held-out logs (SubmapScan.h).
-  ap.addOption("submap-window", "M",
-               "features of a virtual 360° scan from the scans of the last M metres of odometry (0: each scan alone)", "0");
+  ap.addOption("submap-window", "M", "features of a virtual 360° scan from the scans of the last M metres of odometry (0: each scan alone)",
+               "0");
   ap.addOption("factor", "F", "strong-classifier factor stored in the model (eq. 3.30)", "0.5");
   ap.addOption("seed", "N", "random seed for pair sampling and fold split", "1");
   ap.addFlag("quiet", "no progress bars");
@@ -111,8 +112,7 @@ int trainLaserLoopCommand(const Argv& args) {
     data_names += (data_names.empty() ? "" : " ") + fileName(path) + "(" + std::to_string(s.scans.size()) + " scans, " +
                   std::to_string(np) + "+" + std::to_string(p.size() - np) + " pairs)";
     if (!quiet && !ap.flag("json"))
-      std::cerr << path << ": " << s.scans.size() << " scans, " << np << " positive and " << p.size() - np
-                << " negative pairs\n";
+      std::cerr << path << ": " << s.scans.size() << " scans, " << np << " positive and " << p.size() - np << " negative pairs\n";
     pairs.insert(pairs.end(), p.begin(), p.end());
   }
   const laser_loop::PairTable table = laser_loop::makePairTable(sets, pairs);
@@ -155,18 +155,15 @@ int trainLaserLoopCommand(const Argv& args) {
   for (const auto& a : args) cmd += " " + a;
   model.comments.push_back("produced by: " + cmd);
   model.provenance.emplace_back("data", data_names);
-  model.provenance.emplace_back("pair_rules", "d_pos_m=" + ap.option("d-pos") + " d_neg_m=" + ap.option("d-neg") +
-                                                  " min_travel_m=" + ap.option("min-travel") +
-                                                  " max_heading_diff_deg=" + ap.option("max-heading-diff") +
-                                                  " max_positives=" + ap.option("max-positives") +
-                                                  " balanced seed=" + ap.option("seed"));
-  model.provenance.emplace_back("pairs", std::to_string(n_pos) + " positive, " + std::to_string(table.size() - n_pos) +
-                                             " negative");
+  model.provenance.emplace_back("pair_rules", "d_pos_m=" + ap.option("d-pos") + " d_neg_m=" + ap.option("d-neg") + " min_travel_m=" +
+                                                  ap.option("min-travel") + " max_heading_diff_deg=" + ap.option("max-heading-diff") +
+                                                  " max_positives=" + ap.option("max-positives") + " balanced seed=" + ap.option("seed"));
+  model.provenance.emplace_back("pairs", std::to_string(n_pos) + " positive, " + std::to_string(table.size() - n_pos) + " negative");
   if (folds >= 2) {
     char buf[200];
     const size_t k = static_cast<size_t>(std::min(T, t_max) - 1);
-    std::snprintf(buf, sizeof buf, "%d-fold over T=1..%d, chosen T=%d; at T=%d FA %.4f MD %.4f total %.4f", folds, t_max,
-                  cv.chosen_T, T, cv.fa_rate[k], cv.md_rate[k], cv.total_rate[k]);
+    std::snprintf(buf, sizeof buf, "%d-fold over T=1..%d, chosen T=%d; at T=%d FA %.4f MD %.4f total %.4f", folds, t_max, cv.chosen_T, T,
+                  cv.fa_rate[k], cv.md_rate[k], cv.total_rate[k]);
     model.provenance.emplace_back("cross_validation", buf);
   }
   model.provenance.emplace_back("rounds", std::to_string(model.classifier.size()) + " of T=" + std::to_string(T) +
@@ -192,12 +189,12 @@ int trainLaserLoopCommand(const Argv& args) {
   if (ap.flag("json")) {
     std::cout << j.dump() << "\n";
   } else {
-    std::cout << "trained " << model.classifier.size() << " stumps on " << n_pos << " positive + "
-              << table.size() - n_pos << " negative pairs";
+    std::cout << "trained " << model.classifier.size() << " stumps on " << n_pos << " positive + " << table.size() - n_pos
+              << " negative pairs";
     if (folds >= 2) {
       const size_t k = static_cast<size_t>(std::min(T, t_max) - 1);
-      std::cout << "; " << folds << "-fold CV chose T=" << cv.chosen_T << " (FA " << cv.fa_rate[k] << ", MD "
-                << cv.md_rate[k] << ", total " << cv.total_rate[k] << " at T=" << T << ")";
+      std::cout << "; " << folds << "-fold CV chose T=" << cv.chosen_T << " (FA " << cv.fa_rate[k] << ", MD " << cv.md_rate[k] << ", total "
+                << cv.total_rate[k] << " at T=" << T << ")";
     }
     std::cout << "\nwrote " << ap.option("out") << "\n";
   }

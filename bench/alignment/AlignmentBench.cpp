@@ -139,8 +139,7 @@ Outcome runMrpt(const ua::PointSet& a, const ua::PointSet& b, const uc::Pose2& g
 }
 
 bool within(const uc::Pose2& est, const uc::Pose2& truth, double m, double deg) {
-  return std::hypot(est.x - truth.x, est.y - truth.y) < m &&
-         std::abs(uc::wrapToPi(est.phi - truth.phi)) * 180.0 / M_PI < deg;
+  return std::hypot(est.x - truth.x, est.y - truth.y) < m && std::abs(uc::wrapToPi(est.phi - truth.phi)) * 180.0 / M_PI < deg;
 }
 
 void score(Outcome& o, const PairCase& pc) {
@@ -161,8 +160,7 @@ void verify(PairCase& pc, const uio::LaserScan& a, const uio::LaserScan& b, cons
   const auto r1 = ua::align(a, b, pc.truth, o);
   o.method = ua::Method::PlIcp;
   const auto r2 = ua::align(a, b, pc.truth, o);
-  pc.verified = r1.converged && r2.converged && within(r1.transform, r2.transform, 0.03, 0.3) &&
-                within(r2.transform, pc.truth, 0.15, 3.0);
+  pc.verified = r1.converged && r2.converged && within(r1.transform, r2.transform, 0.03, 0.3) && within(r2.transform, pc.truth, 0.15, 3.0);
   pc.truth_verified = r2.transform;
 }
 
@@ -187,24 +185,40 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string k = argv[i];
     auto val = [&]() -> std::string {
-      if (i + 1 >= argc) { std::cerr << k << " needs a value\n"; std::exit(2); }
+      if (i + 1 >= argc) {
+        std::cerr << k << " needs a value\n";
+        std::exit(2);
+      }
       return argv[++i];
     };
-    if (k == "--data") args.data = val();
-    else if (k == "--pairs") args.pairs = std::stoi(val());
-    else if (k == "--seed") args.seed = static_cast<unsigned>(std::stoul(val()));
-    else if (k == "--json") args.json = val();
-    else if (k == "--methods") args.methods = val();
-    else if (k == "--no-covariance") args.covariance = false;
-    else if (k == "--verbose") args.verbose = true;
-    else if (k == "--datasets") args.datasets = val();
-    else if (k == "--range-sigma") args.range_sigma = std::stod(val());
-    else if (k == "--gate-initial") args.gate_initial = std::stod(val());
-    else if (k == "--crf") args.crf.push_back(val());
-    else if (k == "--bearing-sigma-deg") args.bearing_sigma_deg = std::stod(val());
+    if (k == "--data")
+      args.data = val();
+    else if (k == "--pairs")
+      args.pairs = std::stoi(val());
+    else if (k == "--seed")
+      args.seed = static_cast<unsigned>(std::stoul(val()));
+    else if (k == "--json")
+      args.json = val();
+    else if (k == "--methods")
+      args.methods = val();
+    else if (k == "--no-covariance")
+      args.covariance = false;
+    else if (k == "--verbose")
+      args.verbose = true;
+    else if (k == "--datasets")
+      args.datasets = val();
+    else if (k == "--range-sigma")
+      args.range_sigma = std::stod(val());
+    else if (k == "--gate-initial")
+      args.gate_initial = std::stod(val());
+    else if (k == "--crf")
+      args.crf.push_back(val());
+    else if (k == "--bearing-sigma-deg")
+      args.bearing_sigma_deg = std::stod(val());
     else {
       std::cerr << "usage: alignment_bench [--data DIR] [--pairs N] [--seed S] [--methods a,b] "
-                   "[--datasets a,b] [--range-sigma M] [--gate-initial M] [--crf name=value ...] [--bearing-sigma-deg D] [--no-covariance] [--verbose] [--json OUT]\n";
+                   "[--datasets a,b] [--range-sigma M] [--gate-initial M] [--crf name=value ...] [--bearing-sigma-deg D] [--no-covariance] "
+                   "[--verbose] [--json OUT]\n";
       return 2;
     }
   }
@@ -232,21 +246,36 @@ int main(int argc, char** argv) {
     const std::string key = kv.substr(0, eq);
     const double v = std::stod(kv.substr(eq + 1));
     auto& c = base.crf;
-    if (key == "target_points") c.subsampling.target_points = static_cast<int>(v);
-    else if (key == "min_segment_points") c.subsampling.min_segment_points = static_cast<int>(v);
-    else if (key == "segment_gap_m") c.subsampling.segment_gap_m = v;
-    else if (key == "feature_sigma_rad") c.feature_sigma_rad = v;
-    else if (key == "pair_sigma_m") c.pair_sigma_m = v;
-    else if (key == "pair_direction_sigma_rad") c.pair_direction_sigma_rad = v;
-    else if (key == "pair_floor") c.pair_floor = v;
-    else if (key == "outlier_local") c.outlier_local = v;
-    else if (key == "outlier_pair") c.outlier_pair = v;
-    else if (key == "bp_iterations") c.bp_iterations = static_cast<int>(v);
-    else if (key == "bp_damping") c.bp_damping = v;
-    else if (key == "candidates_per_point") c.candidates_per_point = static_cast<int>(v);
-    else if (key == "tangent_radius_m") c.tangent_radius_m = v;
-    else if (key == "min_marginal") c.min_marginal = v;
-    else if (key == "guess_sigma_m") c.guess_sigma_m = v;
+    if (key == "target_points")
+      c.subsampling.target_points = static_cast<int>(v);
+    else if (key == "min_segment_points")
+      c.subsampling.min_segment_points = static_cast<int>(v);
+    else if (key == "segment_gap_m")
+      c.subsampling.segment_gap_m = v;
+    else if (key == "feature_sigma_rad")
+      c.feature_sigma_rad = v;
+    else if (key == "pair_sigma_m")
+      c.pair_sigma_m = v;
+    else if (key == "pair_direction_sigma_rad")
+      c.pair_direction_sigma_rad = v;
+    else if (key == "pair_floor")
+      c.pair_floor = v;
+    else if (key == "outlier_local")
+      c.outlier_local = v;
+    else if (key == "outlier_pair")
+      c.outlier_pair = v;
+    else if (key == "bp_iterations")
+      c.bp_iterations = static_cast<int>(v);
+    else if (key == "bp_damping")
+      c.bp_damping = v;
+    else if (key == "candidates_per_point")
+      c.candidates_per_point = static_cast<int>(v);
+    else if (key == "tangent_radius_m")
+      c.tangent_radius_m = v;
+    else if (key == "min_marginal")
+      c.min_marginal = v;
+    else if (key == "guess_sigma_m")
+      c.guess_sigma_m = v;
     else {
       std::cerr << "--crf: unknown key " << key << "\n";
       return 2;
@@ -269,16 +298,21 @@ int main(int argc, char** argv) {
       const std::string mname = n.substr(0, n.find(':'));
       if (n.find(':') != std::string::npos) {
         const std::string kern = n.substr(n.find(':') + 1);
-        if (kern == "none") m.options.icp.kernel = ua::RobustKernel::None;
-        else if (kern == "huber") m.options.icp.kernel = ua::RobustKernel::Huber;
-        else if (kern == "cauchy") m.options.icp.kernel = ua::RobustKernel::Cauchy;
+        if (kern == "none")
+          m.options.icp.kernel = ua::RobustKernel::None;
+        else if (kern == "huber")
+          m.options.icp.kernel = ua::RobustKernel::Huber;
+        else if (kern == "cauchy")
+          m.options.icp.kernel = ua::RobustKernel::Cauchy;
         else {
           std::cerr << "unknown kernel " << kern << "\n";
           return 2;
         }
       }
-      if (mname == "mrpt") m.mrpt = true;
-      else m.options.method = ua::parseMethod(mname);
+      if (mname == "mrpt")
+        m.mrpt = true;
+      else
+        m.options.method = ua::parseMethod(mname);
       m.options.covariance.method = ua::CovarianceMethod::LineVariance;
       methods.push_back(m);
     }
@@ -342,7 +376,8 @@ int main(int argc, char** argv) {
           continue;
         pc.truth = r2.transform;
       }
-      if (ds.reference) verify(pc, samples[a].scan, samples[b].scan, base);
+      if (ds.reference)
+        verify(pc, samples[a].scan, samples[b].scan, base);
       else {
         pc.verified = true;
         pc.truth_verified = pc.truth;
@@ -426,9 +461,8 @@ int main(int argc, char** argv) {
           score(o, pc);
           if (args.verbose)
             std::fprintf(stderr, "%s %d-%d L%zu %-8s conv %d ok %d err %.3f m %.2f deg  truth %.3f %.3f %.2f est %.3f %.3f %.2f  %.2f ms\n",
-                         pc.group.c_str(), pc.a, pc.b, li, m.name.c_str(), o.converged, o.success, o.err_m,
-                         o.err_deg, pc.truth.x, pc.truth.y, pc.truth.phi * 180 / M_PI, o.est.x, o.est.y,
-                         o.est.phi * 180 / M_PI, o.time_ms);
+                         pc.group.c_str(), pc.a, pc.b, li, m.name.c_str(), o.converged, o.success, o.err_m, o.err_deg, pc.truth.x,
+                         pc.truth.y, pc.truth.phi * 180 / M_PI, o.est.x, o.est.y, o.est.phi * 180 / M_PI, o.time_ms);
           char key[200];
           std::snprintf(key, sizeof key, "%s|%.2f m %2.0f deg|%s", pc.group.c_str(), L.m, L.deg, m.name.c_str());
           if (!agg.count(key)) keys_order.push_back(key);
@@ -442,18 +476,14 @@ int main(int argc, char** argv) {
           g.cpu.push_back(o.cpu_ms);
 
           // Covariance NEES on the smallest level, for the default method's successes.
-          if (args.covariance && li == 0 && !m.mrpt && m.options.method == base.method && o.success &&
-              ds.reference && pc.verified) {
-            for (auto cm : {ua::CovarianceMethod::LineVariance, ua::CovarianceMethod::Hessian,
-                            ua::CovarianceMethod::Sampling}) {
+          if (args.covariance && li == 0 && !m.mrpt && m.options.method == base.method && o.success && ds.reference && pc.verified) {
+            for (auto cm : {ua::CovarianceMethod::LineVariance, ua::CovarianceMethod::Hessian, ua::CovarianceMethod::Sampling}) {
               ua::CovarianceOptions co = base.covariance;
               co.method = cm;
               uc::Stopwatch sw;
-              const Eigen::Matrix3d C = ua::alignmentCovariance(pa, pb, o.est, base.icp,
-                                                                base.refine_point_to_line, co);
+              const Eigen::Matrix3d C = ua::alignmentCovariance(pa, pb, o.est, base.icp, base.refine_point_to_line, co);
               cov_time[ua::covarianceMethodName(cm)].push_back(sw.milliseconds());
-              const Eigen::Vector3d e(o.est.x - pc.truth.x, o.est.y - pc.truth.y,
-                                      uc::wrapToPi(o.est.phi - pc.truth.phi));
+              const Eigen::Vector3d e(o.est.x - pc.truth.x, o.est.y - pc.truth.y, uc::wrapToPi(o.est.phi - pc.truth.phi));
               const double v = e.dot(C.ldlt().solve(e));
               nees[ua::covarianceMethodName(cm)].push_back(v);
             }
@@ -510,10 +540,11 @@ int main(int argc, char** argv) {
     }
     std::printf("\n");
   }
-  std::printf("\nver%%: success against the verified reference (pairs where the log's reference is confirmed by\n"
-              "ICP and PL-ICP); ref%%: against the log's reference as is. Success: < 0.1 m and < 1 deg.\n"
-              "Times: CPU milliseconds of the alignment (covariance excluded), median / 95th percentile;\n"
-              "the JSON also has wall-clock times (time_ms_*), which on a shared machine include other jobs.\n");
+  std::printf(
+      "\nver%%: success against the verified reference (pairs where the log's reference is confirmed by\n"
+      "ICP and PL-ICP); ref%%: against the log's reference as is. Success: < 0.1 m and < 1 deg.\n"
+      "Times: CPU milliseconds of the alignment (covariance excluded), median / 95th percentile;\n"
+      "the JSON also has wall-clock times (time_ms_*), which on a shared machine include other jobs.\n");
   std::printf("\nAll Freiburg pairs (near + far):\n");
   uc::Json totals = uc::Json::array();
   for (const auto& L : levels) {
@@ -542,10 +573,11 @@ int main(int argc, char** argv) {
   report["freiburg_totals"] = totals;
 
   if (args.covariance) {
-    std::printf("\nCovariance NEES on real scans (%s; verified pairs, successes at the smallest error level; error against\n"
-                "the log's own reference, whose GMapping error inflates every method's NEES; consistent: mean ~ 3,\n"
-                "95 %% < 7.81)\n",
-                ua::methodName(base.method).c_str());
+    std::printf(
+        "\nCovariance NEES on real scans (%s; verified pairs, successes at the smallest error level; error against\n"
+        "the log's own reference, whose GMapping error inflates every method's NEES; consistent: mean ~ 3,\n"
+        "95 %% < 7.81)\n",
+        ua::methodName(base.method).c_str());
     uc::Json nj = uc::Json::array();
     for (const auto& [name, v] : nees) {
       double mean = 0;
@@ -555,9 +587,8 @@ int main(int argc, char** argv) {
         in95 += x < 7.81;
       }
       mean /= std::max<size_t>(1, v.size());
-      std::printf("  %-10s n=%4zu  mean NEES %10.2f  median %8.2f  within 95%% bound %5.1f %%  time %.2f ms\n",
-                  name.c_str(), v.size(), mean, uc::percentile(v, 50), 100.0 * in95 / std::max<size_t>(1, v.size()),
-                  uc::percentile(cov_time[name], 50));
+      std::printf("  %-10s n=%4zu  mean NEES %10.2f  median %8.2f  within 95%% bound %5.1f %%  time %.2f ms\n", name.c_str(), v.size(),
+                  mean, uc::percentile(v, 50), 100.0 * in95 / std::max<size_t>(1, v.size()), uc::percentile(cov_time[name], 50));
       uc::Json j = uc::Json::object();
       j["method"] = name;
       j["n"] = v.size();
@@ -610,8 +641,8 @@ int main(int argc, char** argv) {
         in95 += x < 7.81;
       }
       mean /= std::max<size_t>(1, v.size());
-      std::printf("  %-10s n=%4zu  mean NEES %10.2f  median %8.2f  within 95%% bound %5.1f %%\n", name.c_str(), v.size(),
-                  mean, uc::percentile(v, 50), 100.0 * in95 / std::max<size_t>(1, v.size()));
+      std::printf("  %-10s n=%4zu  mean NEES %10.2f  median %8.2f  within 95%% bound %5.1f %%\n", name.c_str(), v.size(), mean,
+                  uc::percentile(v, 50), 100.0 * in95 / std::max<size_t>(1, v.size()));
       uc::Json j = uc::Json::object();
       j["method"] = name;
       j["n"] = v.size();

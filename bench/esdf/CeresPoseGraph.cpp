@@ -81,12 +81,18 @@ int main(int argc, char** argv) {
     const std::string arg = argv[a];
     if (arg == "--help" || arg == "-h") return usage(0);
     if ((arg == "--init" || arg == "--max-iterations" || arg == "--out") && a + 1 >= argc) return usage(2);
-    if (arg == "--init") init = argv[++a];
-    else if (arg == "--max-iterations") max_iterations = std::atoi(argv[++a]);
-    else if (arg == "--out") out = argv[++a];
-    else if (!arg.empty() && arg[0] == '-') return usage(2);
-    else if (in.empty()) in = arg;
-    else return usage(2);
+    if (arg == "--init")
+      init = argv[++a];
+    else if (arg == "--max-iterations")
+      max_iterations = std::atoi(argv[++a]);
+    else if (arg == "--out")
+      out = argv[++a];
+    else if (!arg.empty() && arg[0] == '-')
+      return usage(2);
+    else if (in.empty())
+      in = arg;
+    else
+      return usage(2);
   }
   if (in.empty() || (init != "auto" && init != "vertices" && init != "odometry") || max_iterations < 1) return usage(2);
   try {
@@ -142,11 +148,12 @@ int main(int argc, char** argv) {
       r.poses = x;
       esdf::writePoseGraph(esdf::withPoses(g, r), out, esdf::PoseGraphFormat::G2o);
     }
-    std::printf("{\"input\":\"%s\",\"poses\":%zu,\"edges\":%zu,\"init\":\"%s\",\"initial_chi2\":%.10g,\"chi2\":%.10g,"
-                "\"time_s\":%.6f,\"total_s\":%.6f,\"iterations\":%d,\"termination\":\"%s\",\"usable\":%s}\n",
-                in.c_str(), ids.size(), g.edges.size(), from_vertices ? "vertices" : "odometry", initial_chi2, chi2, time_s,
-                total.seconds(), static_cast<int>(summary.iterations.size()) - 1,
-                ceres::TerminationTypeToString(summary.termination_type), summary.IsSolutionUsable() ? "true" : "false");
+    std::printf(
+        "{\"input\":\"%s\",\"poses\":%zu,\"edges\":%zu,\"init\":\"%s\",\"initial_chi2\":%.10g,\"chi2\":%.10g,"
+        "\"time_s\":%.6f,\"total_s\":%.6f,\"iterations\":%d,\"termination\":\"%s\",\"usable\":%s}\n",
+        in.c_str(), ids.size(), g.edges.size(), from_vertices ? "vertices" : "odometry", initial_chi2, chi2, time_s, total.seconds(),
+        static_cast<int>(summary.iterations.size()) - 1, ceres::TerminationTypeToString(summary.termination_type),
+        summary.IsSolutionUsable() ? "true" : "false");
   } catch (const common::InputError& e) {
     std::fprintf(stderr, "ceres_pose_graph: %s\n", e.what());
     return 2;

@@ -198,10 +198,11 @@ int g_incremental_passes = -1;
 double g_heading_recovery = -1;
 
 void runBackend(const std::vector<long>& sizes) {
-  std::printf("\nback end (urbanslam graph's policy: partial recovery after closures, amortised full recoveries,\n"
-              "relinearisation; the last recovery iterates to convergence):\n");
-  std::printf("%9s %8s | %9s %9s %9s | %8s %8s | %9s %9s | %12s %s\n", "poses", "edges", "step_p50", "step_p99", "step_max",
-              "full", "partial", "time_s", "recov_s", "chi2", "");
+  std::printf(
+      "\nback end (urbanslam graph's policy: partial recovery after closures, amortised full recoveries,\n"
+      "relinearisation; the last recovery iterates to convergence):\n");
+  std::printf("%9s %8s | %9s %9s %9s | %8s %8s | %9s %9s | %12s %s\n", "poses", "edges", "step_p50", "step_p99", "step_max", "full",
+              "partial", "time_s", "recov_s", "chi2", "");
   for (long n : sizes) {
     const esdf::PoseGraph graph = cityGraph(n);
     esdf::PoseGraphBackendOptions o;
@@ -210,13 +211,13 @@ void runBackend(const std::vector<long>& sizes) {
     if (g_incremental_passes >= 0) o.incremental_relinearise_passes = g_incremental_passes;
     if (g_heading_recovery >= 0) o.full_recovery_heading_innovation_rad = g_heading_recovery;
     const auto r = esdf::runPoseGraphBackend(graph, o);
-    std::printf("%9ld %8d | %9.4f %9.4f %9.1f | %8d %8d | %9.3f %9.3f | %12.3f %s\n", n, r.edges,
-                common::percentile(r.step_ms, 50), common::percentile(r.step_ms, 99), common::percentile(r.step_ms, 100),
-                r.full_recoveries, r.partial_recoveries, r.time_s, r.recovery_s, r.chi2,
-                r.converged ? "(converged)" : "(not converged)");
-    std::printf("          closures with heading innovation > pi/2 when added: %d (max %.3f rad); "
-                "full recoveries forced by the heading innovation: %d\n",
-                r.large_heading_innovations, r.max_heading_innovation_rad, r.heading_triggered_recoveries);
+    std::printf("%9ld %8d | %9.4f %9.4f %9.1f | %8d %8d | %9.3f %9.3f | %12.3f %s\n", n, r.edges, common::percentile(r.step_ms, 50),
+                common::percentile(r.step_ms, 99), common::percentile(r.step_ms, 100), r.full_recoveries, r.partial_recoveries, r.time_s,
+                r.recovery_s, r.chi2, r.converged ? "(converged)" : "(not converged)");
+    std::printf(
+        "          closures with heading innovation > pi/2 when added: %d (max %.3f rad); "
+        "full recoveries forced by the heading innovation: %d\n",
+        r.large_heading_innovations, r.max_heading_innovation_rad, r.heading_triggered_recoveries);
     std::fflush(stdout);
   }
 }
@@ -227,34 +228,39 @@ int main(int argc, char** argv) {
   std::vector<long> sizes, backend_sizes;
   long no_full_above = 100000000;
   for (int a = 1; a < argc; ++a) {
-    if (!std::strcmp(argv[a], "--no-full-above") && a + 1 < argc) no_full_above = std::atol(argv[++a]);
+    if (!std::strcmp(argv[a], "--no-full-above") && a + 1 < argc)
+      no_full_above = std::atol(argv[++a]);
     else if (!std::strcmp(argv[a], "--write-graph") && a + 2 < argc) {
       writeGraph(std::atol(argv[a + 1]), argv[a + 2]);
       return 0;
-    }
-    else if (!std::strcmp(argv[a], "--backend") && a + 1 < argc) backend_sizes.push_back(std::atol(argv[++a]));
-    else if (!std::strcmp(argv[a], "--final-passes") && a + 1 < argc) g_final_passes = std::atoi(argv[++a]);
-    else if (!std::strcmp(argv[a], "--min-gap") && a + 1 < argc) g_min_gap = std::atof(argv[++a]);
-    else if (!std::strcmp(argv[a], "--incremental-passes") && a + 1 < argc) g_incremental_passes = std::atoi(argv[++a]);
-    else if (!std::strcmp(argv[a], "--heading-recovery") && a + 1 < argc) g_heading_recovery = std::atof(argv[++a]);
+    } else if (!std::strcmp(argv[a], "--backend") && a + 1 < argc)
+      backend_sizes.push_back(std::atol(argv[++a]));
+    else if (!std::strcmp(argv[a], "--final-passes") && a + 1 < argc)
+      g_final_passes = std::atoi(argv[++a]);
+    else if (!std::strcmp(argv[a], "--min-gap") && a + 1 < argc)
+      g_min_gap = std::atof(argv[++a]);
+    else if (!std::strcmp(argv[a], "--incremental-passes") && a + 1 < argc)
+      g_incremental_passes = std::atoi(argv[++a]);
+    else if (!std::strcmp(argv[a], "--heading-recovery") && a + 1 < argc)
+      g_heading_recovery = std::atof(argv[++a]);
     else if (!std::strcmp(argv[a], "--ordering") && a + 1 < argc) {
       const std::string o = argv[++a];
-      g_ordering = o == "metis" ? esdf::FillReducingOrdering::Metis
-                   : o == "auto" ? esdf::FillReducingOrdering::Auto
-                   : o == "natural" ? esdf::FillReducingOrdering::Natural : esdf::FillReducingOrdering::Amd;
-    }
-    else sizes.push_back(std::atol(argv[a]));
+      g_ordering = o == "metis"     ? esdf::FillReducingOrdering::Metis
+                   : o == "auto"    ? esdf::FillReducingOrdering::Auto
+                   : o == "natural" ? esdf::FillReducingOrdering::Natural
+                                    : esdf::FillReducingOrdering::Amd;
+    } else
+      sizes.push_back(std::atol(argv[a]));
   }
   if (sizes.empty() && backend_sizes.empty()) sizes = {1000, 10000, 100000, 1000000};
-  std::printf("%9s %8s | %8s %8s %9s | %8s %8s %9s | %9s | %10s %12s %10s %10s %10s\n", "poses", "closures",
-              "aug_p50", "aug_p99", "aug_max", "upd_p50", "upd_p99", "upd_max", "B/pose", "full_rec_s", "factor_nnz",
-              "part_ms", "cov_ex_ms", "cov_cons_ms");
+  std::printf("%9s %8s | %8s %8s %9s | %8s %8s %9s | %9s | %10s %12s %10s %10s %10s\n", "poses", "closures", "aug_p50", "aug_p99",
+              "aug_max", "upd_p50", "upd_p99", "upd_max", "B/pose", "full_rec_s", "factor_nnz", "part_ms", "cov_ex_ms", "cov_cons_ms");
   std::printf("%9s %8s | %28s | %28s |\n", "", "", "predict+augment (us)", "update (us)");
   for (long n : sizes) {
     const Row r = runSize(n, no_full_above);
-    std::printf("%9ld %8ld | %8.3f %8.3f %9.1f | %8.3f %8.3f %9.1f | %9.0f | %10.3f %12lld %10.3f %10.3f %10.3f\n", r.n,
-                r.closures, r.aug_p50, r.aug_p99, r.aug_max, r.upd_p50, r.upd_p99, r.upd_max, r.bytes_per_pose,
-                r.full_s, r.factor_nnz, r.partial_ms, r.cov_exact_ms, r.cov_cons_ms);
+    std::printf("%9ld %8ld | %8.3f %8.3f %9.1f | %8.3f %8.3f %9.1f | %9.0f | %10.3f %12lld %10.3f %10.3f %10.3f\n", r.n, r.closures,
+                r.aug_p50, r.aug_p99, r.aug_max, r.upd_p50, r.upd_p99, r.upd_max, r.bytes_per_pose, r.full_s, r.factor_nnz, r.partial_ms,
+                r.cov_exact_ms, r.cov_cons_ms);
     std::fflush(stdout);
   }
   if (!backend_sizes.empty()) runBackend(backend_sizes);

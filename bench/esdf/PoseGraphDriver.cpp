@@ -57,28 +57,40 @@ int main(int argc, char** argv) {
       esdf::writePoseGraph(esdf::withPoses(g, r), argv[a + 2], esdf::PoseGraphFormat::G2o);
       return 0;
     }
-    if (!std::strcmp(argv[a], "--every")) o.full_recovery_every_closures = std::atoi(next());
-    else if (!std::strcmp(argv[a], "--innov")) o.full_recovery_innovation_chi2 = std::atof(next());
-    else if (!std::strcmp(argv[a], "--window")) o.recent_window_poses = std::atoi(next());
-    else if (!std::strcmp(argv[a], "--passes")) o.incremental_relinearise_passes = std::atoi(next());
-    else if (!std::strcmp(argv[a], "--no-relin")) o.filter.relinearise = false;
-    else if (!std::strcmp(argv[a], "--gate")) o.gate_loop_closures = true;
-    else if (!std::strcmp(argv[a], "--metis")) o.filter.ordering = esdf::FillReducingOrdering::Metis;
-    else if (!std::strcmp(argv[a], "--auto")) o.filter.ordering = esdf::FillReducingOrdering::Auto;
-    else if (!std::strcmp(argv[a], "--conservative")) o.filter.gate_covariance = esdf::CovarianceMode::Conservative;
-    else if (!std::strcmp(argv[a], "--gap")) o.full_recovery_min_gap_fraction = std::atof(next());
-    else if (!std::strcmp(argv[a], "--heading")) o.full_recovery_heading_innovation_rad = std::atof(next());
+    if (!std::strcmp(argv[a], "--every"))
+      o.full_recovery_every_closures = std::atoi(next());
+    else if (!std::strcmp(argv[a], "--innov"))
+      o.full_recovery_innovation_chi2 = std::atof(next());
+    else if (!std::strcmp(argv[a], "--window"))
+      o.recent_window_poses = std::atoi(next());
+    else if (!std::strcmp(argv[a], "--passes"))
+      o.incremental_relinearise_passes = std::atoi(next());
+    else if (!std::strcmp(argv[a], "--no-relin"))
+      o.filter.relinearise = false;
+    else if (!std::strcmp(argv[a], "--gate"))
+      o.gate_loop_closures = true;
+    else if (!std::strcmp(argv[a], "--metis"))
+      o.filter.ordering = esdf::FillReducingOrdering::Metis;
+    else if (!std::strcmp(argv[a], "--auto"))
+      o.filter.ordering = esdf::FillReducingOrdering::Auto;
+    else if (!std::strcmp(argv[a], "--conservative"))
+      o.filter.gate_covariance = esdf::CovarianceMode::Conservative;
+    else if (!std::strcmp(argv[a], "--gap"))
+      o.full_recovery_min_gap_fraction = std::atof(next());
+    else if (!std::strcmp(argv[a], "--heading"))
+      o.full_recovery_heading_innovation_rad = std::atof(next());
     else {
       try {
         common::Stopwatch sw;
         const esdf::PoseGraph g = esdf::readPoseGraph(argv[a]);
         const double read_s = sw.seconds();
         const auto r = esdf::runPoseGraphBackend(g, o);
-        std::printf("%-60s rejected %d poses %6zu edges %6d chi2 %14.6f time %7.3f s (read %.3f, recovery %.3f) full %5d partial %5d "
-                    "relin %8lld final passes %d%s p50 %.4f p99 %.4f ms\n",
-                    argv[a], r.rejected_edges, r.poses.size(), r.edges, r.chi2, r.time_s, read_s, r.recovery_s, r.full_recoveries,
-                    r.partial_recoveries, r.factors_relinearised, r.final_relinearise_passes, r.converged ? " (converged)" : " (NOT converged)", common::percentile(r.step_ms, 50),
-                    common::percentile(r.step_ms, 99));
+        std::printf(
+            "%-60s rejected %d poses %6zu edges %6d chi2 %14.6f time %7.3f s (read %.3f, recovery %.3f) full %5d partial %5d "
+            "relin %8lld final passes %d%s p50 %.4f p99 %.4f ms\n",
+            argv[a], r.rejected_edges, r.poses.size(), r.edges, r.chi2, r.time_s, read_s, r.recovery_s, r.full_recoveries,
+            r.partial_recoveries, r.factors_relinearised, r.final_relinearise_passes, r.converged ? " (converged)" : " (NOT converged)",
+            common::percentile(r.step_ms, 50), common::percentile(r.step_ms, 99));
       } catch (const std::exception& e) {
         std::fprintf(stderr, "%s: %s\n", argv[a], e.what());
         rc = 1;

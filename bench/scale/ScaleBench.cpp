@@ -49,10 +49,14 @@ int main(int argc, char** argv) {
   std::string city, log, ini = std::string(URBANSLAM_SOURCE_DIR) + "/ini/default.ini", out;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
-    if (a == "--city") city = argv[i + 1];
-    else if (a == "--log") log = argv[i + 1];
-    else if (a == "--ini") ini = argv[i + 1];
-    else if (a == "--out") out = argv[i + 1];
+    if (a == "--city")
+      city = argv[i + 1];
+    else if (a == "--log")
+      log = argv[i + 1];
+    else if (a == "--ini")
+      ini = argv[i + 1];
+    else if (a == "--out")
+      out = argv[i + 1];
   }
   if (out.empty() || city.empty() == log.empty()) {
     std::cerr << "usage: scale_bench (--city CITY_INI | --log LOG) [--ini PIPELINE_INI] --out DIR\n";

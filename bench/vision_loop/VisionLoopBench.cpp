@@ -103,14 +103,18 @@ void BM_Query(benchmark::State& state) {
 // {images, vocabulary words}: the size sweep with a 10^6-word vocabulary, and the shipped
 // 10^4-word size for contrast (inverted files 100x longer: cost grows 100x faster with images).
 BENCHMARK(BM_Query)
-    ->Args({1000, 1000000})->Args({10000, 1000000})->Args({100000, 1000000})->Args({1000000, 1000000})
-    ->Args({1000, 10000})->Args({10000, 10000})->Args({100000, 10000})
+    ->Args({1000, 1000000})
+    ->Args({10000, 1000000})
+    ->Args({100000, 1000000})
+    ->Args({1000000, 1000000})
+    ->Args({1000, 10000})
+    ->Args({10000, 10000})
+    ->Args({100000, 10000})
     ->Unit(benchmark::kMillisecond);
 
 void BM_LoadVocabulary(benchmark::State& state) {
   const auto type = static_cast<DescriptorType>(state.range(0));
-  const auto path = (std::filesystem::temp_directory_path() /
-                     ("urbanslam_bench_" + descriptorName(type) + "_k10_L6.usvoc")).string();
+  const auto path = (std::filesystem::temp_directory_path() / ("urbanslam_bench_" + descriptorName(type) + "_k10_L6.usvoc")).string();
   saveVocabulary(bigVocabulary(type), path);
   for (auto _ : state) benchmark::DoNotOptimize(loadVocabulary(path).wordCount());
   state.counters["MB"] = std::filesystem::file_size(path) / 1e6;
@@ -151,8 +155,8 @@ BENCHMARK(BM_Extract)->Arg(int(DescriptorType::Sift))->Arg(int(DescriptorType::O
 // verification, database insertion; the sequence is replayed so loops occur.
 void BM_Frame(benchmark::State& state) {
   const auto type = static_cast<DescriptorType>(state.range(0));
-  const std::string path = std::string(URBANSLAM_SOURCE_DIR) + "/share/vision_loop/" +
-                           (type == DescriptorType::Sift ? "sift_k10_L4.usvoc" : "orb_k10_L4.usvoc");
+  const std::string path =
+      std::string(URBANSLAM_SOURCE_DIR) + "/share/vision_loop/" + (type == DescriptorType::Sift ? "sift_k10_L4.usvoc" : "orb_k10_L4.usvoc");
   auto vocabulary = std::make_shared<const Vocabulary>(loadVocabulary(path));
   FeatureOptions fo;
   fo.type = type;
@@ -173,8 +177,7 @@ void BM_Frame(benchmark::State& state) {
   state.counters["detections"] = static_cast<double>(detections);
   state.SetLabel(descriptorName(type) + " 640x480, default vocabulary");
 }
-BENCHMARK(BM_Frame)->Arg(int(DescriptorType::Sift))->Arg(int(DescriptorType::Orb))->Unit(benchmark::kMillisecond)
-    ->Iterations(200);
+BENCHMARK(BM_Frame)->Arg(int(DescriptorType::Sift))->Arg(int(DescriptorType::Orb))->Unit(benchmark::kMillisecond)->Iterations(200);
 
 }  // namespace
 

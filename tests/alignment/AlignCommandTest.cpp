@@ -14,8 +14,7 @@ int alignCommand(const Argv& args);
 
 namespace {
 
-const std::string kIntel =
-    std::string(URBANSLAM_SHARED_DATA_DIR) + "/freiburg_slam_benchmark/corrected_logs/intel-corrected.log.gz";
+const std::string kIntel = std::string(URBANSLAM_SHARED_DATA_DIR) + "/freiburg_slam_benchmark/corrected_logs/intel-corrected.log.gz";
 
 std::string capture(const urbanslam::cli::Argv& args, int* code) {
   std::ostringstream out;
@@ -37,8 +36,8 @@ TEST(AlignCommand, JsonOnConsecutiveScansMatchesReference) {
   int code = -1;
   const std::string out = capture({kIntel, "100", "101", "--method", "plicp", "--json"}, &code);
   EXPECT_EQ(code, 0);
-  for (const char* key : {"\"x\":", "\"y\":", "\"phi\":", "\"cov\":[[", "\"iterations\":", "\"time_ms\":",
-                          "\"converged\":true", "\"reference\":"})
+  for (const char* key :
+       {"\"x\":", "\"y\":", "\"phi\":", "\"cov\":[[", "\"iterations\":", "\"time_ms\":", "\"converged\":true", "\"reference\":"})
     EXPECT_NE(out.find(key), std::string::npos) << key << " in " << out;
 }
 

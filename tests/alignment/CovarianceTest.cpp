@@ -40,9 +40,8 @@ TEST(Covariance, CorridorIsUncertainAlongItsAxis) {
     const Eigen::Matrix3d C = ua::alignmentCovariance(s.a, s.b, s.truth, {}, true, o);
     ASSERT_TRUE(positiveDefinite(C)) << ua::covarianceMethodName(m);
     // Along: metres at least (line variance: tens of metres; the Hessian is the less honest one).
-    EXPECT_GT(std::sqrt(C(0, 0)), m == ua::CovarianceMethod::LineVariance ? 10.0 : 1.0)
-        << ua::covarianceMethodName(m);
-    EXPECT_LT(std::sqrt(C(1, 1)), 0.05) << ua::covarianceMethodName(m);    // across: centimetres
+    EXPECT_GT(std::sqrt(C(0, 0)), m == ua::CovarianceMethod::LineVariance ? 10.0 : 1.0) << ua::covarianceMethodName(m);
+    EXPECT_LT(std::sqrt(C(1, 1)), 0.05) << ua::covarianceMethodName(m);  // across: centimetres
     EXPECT_GT(C(0, 0), 1e3 * C(1, 1)) << ua::covarianceMethodName(m);
   }
   EXPECT_LT(ua::translationConstraintRatio(s.a, s.b, s.truth, {}), 1e-3);
@@ -51,8 +50,7 @@ TEST(Covariance, CorridorIsUncertainAlongItsAxis) {
 TEST(Covariance, RoomIsWellConstrainedByAllMethods) {
   const Sets s = make(ua::test::roomWorld(), {-3, 0, 0.2}, {-2.2, 0.4, 0.35});
   EXPECT_GT(ua::translationConstraintRatio(s.a, s.b, s.truth, {}), 0.05);
-  for (auto m : {ua::CovarianceMethod::LineVariance, ua::CovarianceMethod::Hessian,
-                 ua::CovarianceMethod::Sampling}) {
+  for (auto m : {ua::CovarianceMethod::LineVariance, ua::CovarianceMethod::Hessian, ua::CovarianceMethod::Sampling}) {
     ua::CovarianceOptions o;
     o.method = m;
     o.samples = 20;

@@ -28,8 +28,8 @@ double worldConflict(const World& w, const common::Pose2& pose_a, const io::Lase
     double wall = std::numeric_limits<double>::infinity();
     for (int k = -1; k <= 1; ++k) {
       const double ang = pose_a.phi + a.bearing(static_cast<size_t>(beam) + k);
-      const io::LaserScan one = alignment::test::simulateScan(
-          w, {pose_a.x, pose_a.y, ang}, {2, 1e-9, a.max_range_m, 0.0, 1});  // beam 0 along ang
+      const io::LaserScan one =
+          alignment::test::simulateScan(w, {pose_a.x, pose_a.y, ang}, {2, 1e-9, a.max_range_m, 0.0, 1});  // beam 0 along ang
       if (!one.valid[0]) {
         wall = -1;
         break;

@@ -79,7 +79,8 @@ TEST(CorrelativeSearch, BranchAndBoundFindsTheExhaustiveOptimum) {
   std::sort(ranges.begin(), ranges.end());
   const double far = std::max(grid.resolution(), ranges[static_cast<size_t>(0.5 * static_cast<double>(ranges.size() - 1))]);
   const double step = std::acos(1.0 - grid.resolution() * grid.resolution() / (2 * far * far));
-  const int k = static_cast<int>(std::ceil(window.half_angle_rad / step)), w = static_cast<int>(std::ceil(window.half_width_m / grid.resolution()));
+  const int k = static_cast<int>(std::ceil(window.half_angle_rad / step)),
+            w = static_cast<int>(std::ceil(window.half_width_m / grid.resolution()));
   double best = -1e300;
   common::Pose2 best_pose;
   for (int a = -k; a <= k; ++a)
@@ -99,7 +100,8 @@ TEST(CorrelativeSearch, BranchAndBoundFindsTheExhaustiveOptimum) {
 }
 
 // The scan taken at `truth` (in the reference scan's frame), matched from a prior at `odometry`.
-PriorMatchResult matchRoom(const test::World& world, const common::Pose2& truth, const common::Pose2& odometry, const Eigen::Matrix3d& cov) {
+PriorMatchResult matchRoom(const test::World& world, const common::Pose2& truth, const common::Pose2& odometry,
+                           const Eigen::Matrix3d& cov) {
   const PriorMatcherOptions o;
   const MatchReference ref(scanPoints(world, {0, 0, 0}), Eigen::Vector2d::Zero(), o);
   return matchWithPrior(ref, scanPoints(world, truth, 11), odometry, cov, o);
@@ -141,7 +143,7 @@ TEST(PriorScanMatcher, CorridorKeepsTheOdometryAlongItsAxis) {
   EXPECT_NEAR(r.pose.y, truth.y, 0.01);
   EXPECT_NEAR(r.pose.phi, truth.phi, 0.003);
   EXPECT_NEAR(std::sqrt(r.cov(0, 0)), 0.05, 0.005);  // along the axis: the prior's sigma
-  EXPECT_LT(std::sqrt(r.cov(1, 1)), 0.01);          // across: the walls'
+  EXPECT_LT(std::sqrt(r.cov(1, 1)), 0.01);           // across: the walls'
 }
 
 }  // namespace

@@ -24,8 +24,7 @@ struct Log {
 const Log* intel() {
   static Log log;
   static bool loaded = false;
-  const std::string path =
-      std::string(URBANSLAM_SHARED_DATA_DIR) + "/freiburg_slam_benchmark/corrected_logs/intel-corrected.log.gz";
+  const std::string path = std::string(URBANSLAM_SHARED_DATA_DIR) + "/freiburg_slam_benchmark/corrected_logs/intel-corrected.log.gz";
   if (!loaded) {
     loaded = true;
     if (!std::filesystem::exists(path)) return nullptr;
@@ -33,7 +32,8 @@ const Log* intel() {
     uio::Measurement m;
     uc::Pose2 last;
     while (src->next(m)) {
-      if (auto* r = std::get_if<uio::ReferencePose>(&m)) last = r->pose;
+      if (auto* r = std::get_if<uio::ReferencePose>(&m))
+        last = r->pose;
       else if (auto* s = std::get_if<uio::LaserScan>(&m)) {
         log.scans.push_back(*s);
         log.refs.push_back(last);

@@ -36,16 +36,13 @@ Pair roomPair(const uc::Pose2& pa, const uc::Pose2& pb, double noise = 0.01) {
   return p;
 }
 
-void expectNear(const uc::Pose2& est, const uc::Pose2& truth, double tol_m, double tol_rad,
-                const std::string& what) {
+void expectNear(const uc::Pose2& est, const uc::Pose2& truth, double tol_m, double tol_rad, const std::string& what) {
   EXPECT_NEAR(est.x, truth.x, tol_m) << what;
   EXPECT_NEAR(est.y, truth.y, tol_m) << what;
   EXPECT_NEAR(uc::wrapToPi(est.phi - truth.phi), 0.0, tol_rad) << what;
 }
 
-uc::Pose2 perturb(const uc::Pose2& p, double dx, double dy, double dphi) {
-  return {p.x + dx, p.y + dy, uc::wrapToPi(p.phi + dphi)};
-}
+uc::Pose2 perturb(const uc::Pose2& p, double dx, double dy, double dphi) { return {p.x + dx, p.y + dy, uc::wrapToPi(p.phi + dphi)}; }
 
 }  // namespace
 
@@ -81,17 +78,14 @@ TEST_P(MethodTest, RecoversKnownPoseInRoom) {
     // biased by the different sampling of the two scans; point-to-line is the most precise.
     const bool coarse = o.method == ua::Method::Crf;
     const bool p2p = o.method == ua::Method::Icp;
-    expectNear(r.transform, p.truth, coarse ? 0.1 : p2p ? 0.05 : 0.03, coarse ? 0.02 : p2p ? 0.01 : 0.005,
-               ua::methodName(o.method));
+    expectNear(r.transform, p.truth, coarse ? 0.1 : p2p ? 0.05 : 0.03, coarse ? 0.02 : p2p ? 0.01 : 0.005, ua::methodName(o.method));
     EXPECT_TRUE(r.cov.allFinite());
     EXPECT_GT(r.cov.determinant(), 0);
     EXPECT_GT(r.matches, coarse ? 30 : 150);
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(All, MethodTest,
-                         ::testing::Values(ua::Method::Icp, ua::Method::PlIcp, ua::Method::Crf,
-                                           ua::Method::CrfIcp),
+INSTANTIATE_TEST_SUITE_P(All, MethodTest, ::testing::Values(ua::Method::Icp, ua::Method::PlIcp, ua::Method::Crf, ua::Method::CrfIcp),
                          [](const auto& info) {
                            std::string n = ua::methodName(info.param);
                            for (auto& c : n) {
@@ -203,8 +197,7 @@ TEST_P(DegenerateTest, EmptyMaxRangeOnePointAndNaNFailCleanly) {
       const auto r = side == 0 ? ua::align(*bad, good.b, guess, o) : ua::align(good.a, *bad, guess, o);
       EXPECT_FALSE(r.converged);
       EXPECT_FALSE(r.failure_reason.empty());
-      EXPECT_TRUE(std::isfinite(r.transform.x) && std::isfinite(r.transform.y) &&
-                  std::isfinite(r.transform.phi));
+      EXPECT_TRUE(std::isfinite(r.transform.x) && std::isfinite(r.transform.y) && std::isfinite(r.transform.phi));
       EXPECT_TRUE(r.cov.allFinite());
     }
   }
@@ -214,9 +207,7 @@ TEST_P(DegenerateTest, EmptyMaxRangeOnePointAndNaNFailCleanly) {
   EXPECT_TRUE(std::isfinite(r.transform.x));
 }
 
-INSTANTIATE_TEST_SUITE_P(All, DegenerateTest,
-                         ::testing::Values(ua::Method::Icp, ua::Method::PlIcp, ua::Method::Crf,
-                                           ua::Method::CrfIcp),
+INSTANTIATE_TEST_SUITE_P(All, DegenerateTest, ::testing::Values(ua::Method::Icp, ua::Method::PlIcp, ua::Method::Crf, ua::Method::CrfIcp),
                          [](const auto& info) {
                            std::string n = ua::methodName(info.param);
                            for (auto& c : n) {
@@ -226,8 +217,7 @@ INSTANTIATE_TEST_SUITE_P(All, DegenerateTest,
                          });
 
 TEST(Aligner, ParseMethodNames) {
-  for (auto m : {ua::Method::Icp, ua::Method::PlIcp, ua::Method::Crf, ua::Method::CrfIcp})
-    EXPECT_EQ(ua::parseMethod(ua::methodName(m)), m);
+  for (auto m : {ua::Method::Icp, ua::Method::PlIcp, ua::Method::Crf, ua::Method::CrfIcp}) EXPECT_EQ(ua::parseMethod(ua::methodName(m)), m);
   EXPECT_THROW(ua::parseMethod("ndt"), std::invalid_argument);
 }
 
@@ -237,8 +227,7 @@ TEST(Aligner, ParseMethodNames) {
 TEST(Aligner, RandomGarbageNeverCrashes) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(0, 1);
-  const float specials[] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
-                            -1.0f, 0.0f, 1e30f, 80.0f};
+  const float specials[] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(), -1.0f, 0.0f, 1e30f, 80.0f};
   auto randomScan = [&]() {
     urbanslam::io::LaserScan s;
     const int n = static_cast<int>(u(rng) * 400);

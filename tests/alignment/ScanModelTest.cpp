@@ -84,9 +84,9 @@ TEST(Subsampling, ReproducesThesisCounts) {
   };
   for (int k = 0; k < 27; ++k) {
     add(18 + (k < 10 ? 1 : 0), 10.0);  // wall pieces, 8.7 cm spacing: one segment each
-    add(4, 5.0);                        // a small cluster 5 m nearer: too small a segment
+    add(4, 5.0);                       // a small cluster 5 m nearer: too small a segment
   }
-  add(118, 100.0);                      // no-returns beyond r_max
+  add(118, 100.0);  // no-returns beyond r_max
   ASSERT_EQ(ranges.size(), 722u);
   ua::ScanModelOptions so;
   so.max_range_m = 1000;  // let the subsampling do step 1 itself, as in the thesis

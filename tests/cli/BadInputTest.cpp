@@ -50,8 +50,7 @@ TEST(BadInput, TruncatedRawlogAndCarmen) {
   expectBadInput("run" + out + writeFile(d / "cut.log", "ODOM 0 0 0 0 0 0 1.0 h 1.0\nFLASER 180 1.0 2.0\n"),
                  "cut.log:2: truncated laser line");
   expectBadInput("run" + out + writeFile(d / "nan.log", "FLASER 3 1.0 nan 2.0 0 0 0 0 0 0 5.0 h 5.0\n"), "nan.log:1");
-  expectBadInput("run" + out + writeFile(d / "neg.log", "FLASER 3 1.0 -2.0 2.0 0 0 0 0 0 0 5.0 h 5.0\n"),
-                 "neg.log:1: negative range");
+  expectBadInput("run" + out + writeFile(d / "neg.log", "FLASER 3 1.0 -2.0 2.0 0 0 0 0 0 0 5.0 h 5.0\n"), "neg.log:1: negative range");
 }
 
 TEST(BadInput, EmptyAndNanScansInARawlog) {

@@ -66,8 +66,8 @@ TEST(Cli, RunOnTheShippedRawlogWritesEveryOutput) {
   EXPECT_EQ(r.out.front(), '{');
   EXPECT_EQ(r.out.find('\n'), r.out.size() - 1);
   EXPECT_NE(r.out.find("\"keyframes\":"), std::string::npos);
-  for (const char* f : {"trajectory_keyframes.tum", "trajectory_odometry.tum", "trajectory_scans.tum", "reference.tum", "map.ply", "map.pcd",
-                        "map.simplemap", "grid.png", "grid.yaml", "config.ini", "stats.json"})
+  for (const char* f : {"trajectory_keyframes.tum", "trajectory_odometry.tum", "trajectory_scans.tum", "reference.tum", "map.ply",
+                        "map.pcd", "map.simplemap", "grid.png", "grid.yaml", "config.ini", "stats.json"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
   // No temporary files left behind.
   for (const auto& e : fs::directory_iterator(out))
@@ -111,7 +111,9 @@ TEST(Cli, ConvertWritesARawlogThatRunsTheSame) {
   // and nearest-neighbour associations can turn a 1e-8 input difference into millimetres.
   const std::string ini = (d / "odometry.ini").string();
   std::ofstream(ini) << "[local]\nscan_matching = false\n";
-  ASSERT_EQ(runCli("run --quiet --ini " + ini + " --out " + (d / "a").string() + " " + repoPath("rawlogs/intel-corrected-excerpt.log.gz")).code, 0);
+  ASSERT_EQ(
+      runCli("run --quiet --ini " + ini + " --out " + (d / "a").string() + " " + repoPath("rawlogs/intel-corrected-excerpt.log.gz")).code,
+      0);
   ASSERT_EQ(runCli("run --quiet --ini " + ini + " --out " + (d / "b").string() + " " + rawlog).code, 0);
   // MRPT stores the sensor pose as a 3D pose (yaw through a rotation matrix): equal to ~1e-8.
   std::ifstream a(d / "a" / "trajectory_keyframes.tum"), b(d / "b" / "trajectory_keyframes.tum");
@@ -138,8 +140,10 @@ TEST(Cli, RawlogEditReadsConvertedRawlogs) {
   const fs::path d = scratchDir("cli_rawlog_edit");
   for (const char* layout : {"observations", "frames"}) {
     const std::string rawlog = (d / (std::string(layout) + ".rawlog")).string();
-    ASSERT_EQ(runCli(std::string("convert --quiet --layout ") + layout + " " +
-                     repoPath("rawlogs/intel-corrected-excerpt.log.gz") + " " + rawlog).code, 0);
+    ASSERT_EQ(
+        runCli(std::string("convert --quiet --layout ") + layout + " " + repoPath("rawlogs/intel-corrected-excerpt.log.gz") + " " + rawlog)
+            .code,
+        0);
     const std::string info = (d / "info.txt").string();
     const int rc = std::system(("rawlog-edit --info -i " + rawlog + " > " + info + " 2>&1").c_str());
     const std::string text = slurp(info);

@@ -44,8 +44,7 @@ TEST(AtomicFile, AbandonedWriteLeavesNoFile) {
   }
   EXPECT_FALSE(fs::exists(target));
   EXPECT_EQ(std::distance(fs::directory_iterator(d), fs::directory_iterator{}), 0);
-  EXPECT_THROW(writeAtomically(target, [](const std::string&) { throw std::runtime_error("boom"); }),
-               std::runtime_error);
+  EXPECT_THROW(writeAtomically(target, [](const std::string&) { throw std::runtime_error("boom"); }), std::runtime_error);
   EXPECT_FALSE(fs::exists(target));
   EXPECT_THROW(AtomicFile((d / "no_such_dir" / "x.txt").string()), InputError);
 }

@@ -28,8 +28,8 @@ TEST(IniFile, RejectsMalformedLinesWithFileAndLine) {
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("bad.ini:2"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(IniFile::parse("x = 1\n", "t.ini"), ConfigError);            // outside a section
-  EXPECT_THROW(IniFile::parse("[a]\nx=1\nx=2\n", "t.ini"), ConfigError);   // duplicate key
-  EXPECT_THROW(IniFile::parse("[a\nx=1\n", "t.ini"), ConfigError);          // broken header
+  EXPECT_THROW(IniFile::parse("x = 1\n", "t.ini"), ConfigError);          // outside a section
+  EXPECT_THROW(IniFile::parse("[a]\nx=1\nx=2\n", "t.ini"), ConfigError);  // duplicate key
+  EXPECT_THROW(IniFile::parse("[a\nx=1\n", "t.ini"), ConfigError);        // broken header
   EXPECT_THROW(IniFile::load("/nonexistent/file.ini"), ConfigError);
 }

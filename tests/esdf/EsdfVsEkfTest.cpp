@@ -36,7 +36,7 @@ void runScenario(unsigned seed, bool with_predict_without_augmentation) {
 
   for (int step = 0; step < 40; ++step) {
     const int kind = step % 3;
-    std::shared_ptr<const MotionModel> model = kind == 0 ? std::shared_ptr<const MotionModel>(steering)
+    std::shared_ptr<const MotionModel> model = kind == 0   ? std::shared_ptr<const MotionModel>(steering)
                                                : kind == 1 ? std::shared_ptr<const MotionModel>(turn)
                                                            : std::shared_ptr<const MotionModel>(odo);
     VecU u;

@@ -21,8 +21,7 @@ void checkModel(const MotionModel& m, const VecU& u, double dt, std::mt19937& rn
     const Vec3 y = m.predict(x, u, dt, &fx, &fu);
     EXPECT_LT((y - m.predict(x, u, dt, nullptr, nullptr)).norm(), 1e-15);
     const auto nx = test::numericalJacobian([&](const V& p) -> V { return m.predict(p, u, dt, nullptr, nullptr); }, x);
-    const auto nu = test::numericalJacobian(
-        [&](const V& q) -> V { return m.predict(x, VecU(q), dt, nullptr, nullptr); }, V(u));
+    const auto nu = test::numericalJacobian([&](const V& q) -> V { return m.predict(x, VecU(q), dt, nullptr, nullptr); }, V(u));
     EXPECT_LT((fx - nx).norm(), 1e-6) << "F_x\n" << fx << "\nvs\n" << nx;
     EXPECT_LT((fu - nu).norm(), 1e-6) << "F_u\n" << fu << "\nvs\n" << nu;
   }

@@ -30,15 +30,12 @@ PoseGraph cityGraph(unsigned seed, int poses, double heading_sigma, std::vector<
     if (std::abs(next.x()) > 20 || std::abs(next.y()) > 20) next = compose(truth.back(), Vec3(1, 0, M_PI));
     const Vec3 z = between(truth.back(), next);
     truth.push_back(next);
-    g.edges.push_back({k - 1, k,
-                       z + Vec3(test::gauss(rng, 0.1), test::gauss(rng, 0.1), test::gauss(rng, heading_sigma)),
-                       odo_info});
+    g.edges.push_back({k - 1, k, z + Vec3(test::gauss(rng, 0.1), test::gauss(rng, 0.1), test::gauss(rng, heading_sigma)), odo_info});
     // Loop closures to earlier visits of the same spot.
     for (int j = 0; j + 10 < k; j += 1) {
       if ((truth[j].head<2>() - next.head<2>()).norm() < 0.5 && coin(rng) == 0) {
         const Vec3 zl = between(truth[j], next);
-        g.edges.push_back({j, k, zl + Vec3(test::gauss(rng, 0.1), test::gauss(rng, 0.1), test::gauss(rng, 0.03)),
-                           loop_info});
+        g.edges.push_back({j, k, zl + Vec3(test::gauss(rng, 0.1), test::gauss(rng, 0.1), test::gauss(rng, 0.03)), loop_info});
         break;
       }
     }
@@ -129,8 +126,7 @@ TEST(PoseGraphBackend, RelinearisationBeatsSingleLinearisationAfterLargeLoops) {
   const auto r_once = runPoseGraphBackend(g, once);
   const auto r_relin = runPoseGraphBackend(g);
   const double opt = batchOptimumChi2(g, odometryChain(g, 300));
-  std::printf("chi2: single linearisation %.3f, relinearised %.3f, batch optimum %.3f\n", r_once.chi2, r_relin.chi2,
-              opt);
+  std::printf("chi2: single linearisation %.3f, relinearised %.3f, batch optimum %.3f\n", r_once.chi2, r_relin.chi2, opt);
   EXPECT_NEAR(r_relin.chi2, opt, 1e-4 * opt);
   EXPECT_GT(r_once.chi2, 1.01 * r_relin.chi2);
 }
@@ -148,8 +144,8 @@ TEST(PoseGraphBackend, FullRecoveriesForcedByLargeHeadingInnovationsKeepTheBatch
   o.full_recovery_min_gap_fraction = 1e9;
   const auto r = runPoseGraphBackend(g, o);
   const double opt = batchOptimumChi2(g, truth);
-  std::printf("chi2 %.3f (%d forced full recoveries, %d full in all), batch optimum %.3f\n", r.chi2,
-              r.heading_triggered_recoveries, r.full_recoveries, opt);
+  std::printf("chi2 %.3f (%d forced full recoveries, %d full in all), batch optimum %.3f\n", r.chi2, r.heading_triggered_recoveries,
+              r.full_recoveries, opt);
   EXPECT_GT(r.heading_triggered_recoveries, 0);
   EXPECT_EQ(r.full_recoveries, r.heading_triggered_recoveries + 1);  // + the final one
   EXPECT_NEAR(r.chi2, opt, 1e-6 * opt);

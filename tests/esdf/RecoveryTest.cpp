@@ -21,8 +21,7 @@ void buildGraph(Esdf& f, std::mt19937& rng, int poses, int closures) {
   f.initialise(Vec3(0, 0, 0), Mat3::Identity() * 1e-6);
   for (int k = 1; k < poses; ++k) {
     const double turn = (k % 10 == 0) ? M_PI / 2 : 0.0;
-    f.augmentRelative(k - 1, Vec3(1.0 + test::gauss(rng, 0.05), test::gauss(rng, 0.05), turn + test::gauss(rng, 0.01)),
-                      kOdoInfo);
+    f.augmentRelative(k - 1, Vec3(1.0 + test::gauss(rng, 0.05), test::gauss(rng, 0.05), turn + test::gauss(rng, 0.01)), kOdoInfo);
   }
   std::uniform_int_distribution<int> pick(0, poses - 1);
   for (int c = 0; c < closures; ++c) {
@@ -195,7 +194,10 @@ TEST(Relinearisation, MotionAndObservationFactorsConvergeToAStationaryPoint) {
     f.predictAugment(odo, VecU(u), qv, 0);
   }
   const Mat3 om = Vec3(100.0, 100.0, 1000.0).asDiagonal();
-  struct Obs { int i, j; Vec3 z; };
+  struct Obs {
+    int i, j;
+    Vec3 z;
+  };
   std::vector<Obs> obs;
   for (auto [i, j] : {std::pair{0, 40}, std::pair{5, 35}, std::pair{12, 28}})
     obs.push_back({i, j, between(truth[i], truth[j]) + Vec3(test::gauss(rng, 0.1), test::gauss(rng, 0.1), test::gauss(rng, 0.03))});
@@ -252,8 +254,7 @@ TEST(Relinearisation, BacktrackingNeverIncreasesTheCostOnAnInconsistentGraph) {
   std::mt19937 rng(35);
   Esdf f;
   f.initialise(Vec3::Zero(), Mat3::Identity() * 1e-6);
-  for (int k = 1; k <= 40; ++k)
-    f.augmentRelative(k - 1, Vec3(1.0, 0.0, k % 10 == 0 ? M_PI / 2 : 0.0), Vec3(1.0, 1.0, 1.0).asDiagonal());
+  for (int k = 1; k <= 40; ++k) f.augmentRelative(k - 1, Vec3(1.0, 0.0, k % 10 == 0 ? M_PI / 2 : 0.0), Vec3(1.0, 1.0, 1.0).asDiagonal());
   double previous = f.cost();
   const Mat3 om = Mat3::Identity();
   for (auto [i, j, z] : {std::tuple{0, 40, Vec3(0, 0, 0)}, std::tuple{5, 35, Vec3(0, -5, -M_PI / 2)},

@@ -7,8 +7,8 @@
 namespace urbanslam::esdf::test {
 
 // d f / d x by central differences (f: R^n -> R^m), step h.
-inline Eigen::MatrixXd numericalJacobian(const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& f,
-                                         const Eigen::VectorXd& x, double h = 1e-6) {
+inline Eigen::MatrixXd numericalJacobian(const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& f, const Eigen::VectorXd& x,
+                                         double h = 1e-6) {
   const Eigen::VectorXd f0 = f(x);
   Eigen::MatrixXd j(f0.size(), x.size());
   for (int k = 0; k < x.size(); ++k) {

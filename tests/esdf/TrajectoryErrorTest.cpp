@@ -15,8 +15,8 @@ namespace urbanslam::esdf {
 namespace {
 
 // RMSE and mean heading error at rotation theta with the best translation for that theta.
-void errorsAt(const std::vector<PoseGraphVertex>& est, const std::vector<PoseGraphVertex>& ref, double theta,
-              double* rmse, double* heading) {
+void errorsAt(const std::vector<PoseGraphVertex>& est, const std::vector<PoseGraphVertex>& ref, double theta, double* rmse,
+              double* heading) {
   const double c = std::cos(theta), s = std::sin(theta);
   double mx = 0, my = 0;
   for (size_t k = 0; k < est.size(); ++k) {
@@ -74,8 +74,8 @@ TEST(TrajectoryError, MatchesBruteForceAlignment) {
 TEST(TrajectoryError, MatchesByIdAndNeedsTwoCommonIds) {
   const std::vector<PoseGraphVertex> ref{{0, Vec3(0, 0, 0)}, {1, Vec3(1, 0, 0)}, {2, Vec3(2, 0, 0)}};
   // Estimate in another order, with an id the reference does not have.
-  const std::vector<PoseGraphVertex> est{{2, Vec3(0, 2, M_PI / 2)}, {7, Vec3(5, 5, 0)}, {0, Vec3(0, 0, M_PI / 2)},
-                                         {1, Vec3(0, 1, M_PI / 2)}};
+  const std::vector<PoseGraphVertex> est{
+      {2, Vec3(0, 2, M_PI / 2)}, {7, Vec3(5, 5, 0)}, {0, Vec3(0, 0, M_PI / 2)}, {1, Vec3(0, 1, M_PI / 2)}};
   const TrajectoryError e = trajectoryError(est, ref);
   EXPECT_EQ(e.matched, 3u);
   EXPECT_NEAR(e.ate_rmse_m, 0.0, 1e-12);

@@ -71,7 +71,8 @@ TEST(Evaluation, RelationsAreSplitByWhereTheyFallAmongTheScans) {
   for (size_t i = 0; i < traj.size(); i += 20) scans.push_back(traj[i].timestamp);
   std::vector<evaluation::Relation> rel;
   const auto add = [&](size_t i, size_t j, double d) {
-    rel.push_back({base + traj[i].timestamp, base + traj[j].timestamp, common::compose({d, 0, 0}, common::between(traj[i].pose, traj[j].pose))});
+    rel.push_back(
+        {base + traj[i].timestamp, base + traj[j].timestamp, common::compose({d, 0, 0}, common::between(traj[i].pose, traj[j].pose))});
   };
   add(20, 40, 0.1);    // scans at 2 s and 4 s
   add(60, 100, 0.1);   // 6 s and 10 s, scans in between do not matter
@@ -220,7 +221,7 @@ TEST(Evaluation, LoopsCheckedAgainstRelations) {
   good.to_time = bad.to_time = 75.0;
   good.measurement = common::between(truth(11.0), truth(75.0));
   bad.measurement = common::compose(good.measurement, {0.8, 0.0, 0.0});  // 0.8 m along the path
-  far.from_time = 40.0;  // no relation near these times
+  far.from_time = 40.0;                                                  // no relation near these times
   far.to_time = 100.0;
   const auto c = evaluation::checkLoopsWithRelations({good, bad, far}, nodes, rel, 0.0);
   EXPECT_EQ(c.accepted, 3u);

@@ -20,10 +20,18 @@ TEST(MapAccuracy, DistancesToKnownWalls) {
   for (int i = 0; i < 400; ++i) {
     const double a = along(rng), d = off(rng);
     switch (i % 4) {
-      case 0: pts.push_back({static_cast<float>(a), static_cast<float>(d), 0}); break;
-      case 1: pts.push_back({static_cast<float>(10 - d), static_cast<float>(a), 0}); break;
-      case 2: pts.push_back({static_cast<float>(a), static_cast<float>(10 + d), 0}); break;
-      default: pts.push_back({static_cast<float>(-d), static_cast<float>(a), 0}); break;
+      case 0:
+        pts.push_back({static_cast<float>(a), static_cast<float>(d), 0});
+        break;
+      case 1:
+        pts.push_back({static_cast<float>(10 - d), static_cast<float>(a), 0});
+        break;
+      case 2:
+        pts.push_back({static_cast<float>(a), static_cast<float>(10 + d), 0});
+        break;
+      default:
+        pts.push_back({static_cast<float>(-d), static_cast<float>(a), 0});
+        break;
     }
     expected.push_back(d);
   }

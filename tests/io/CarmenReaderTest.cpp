@@ -87,7 +87,7 @@ TEST(CarmenReader, CorrectedLogGivesScansReferenceAndTimestamps) {
   EXPECT_EQ(r.scans[0].ranges.size(), 180u);
   EXPECT_NEAR(r.scans[0].timestamp, 32.9068, 1e-9);
   EXPECT_NEAR(r.scans[0].angle_increment_rad, M_PI / 180, 1e-12);
-  EXPECT_NEAR(r.scans[0].sensor_pose.phi + r.scans[0].bearing(0), -M_PI / 2, 1e-12);   // first beam to the right
+  EXPECT_NEAR(r.scans[0].sensor_pose.phi + r.scans[0].bearing(0), -M_PI / 2, 1e-12);  // first beam to the right
   EXPECT_NEAR(r.scans[0].sensor_pose.phi + r.scans[0].bearing(179), 89 * M_PI / 180, 1e-12);
   EXPECT_NEAR(r.reference[0].pose.x, 0.600266, 1e-9);
   EXPECT_NEAR(r.reference[0].pose.phi, -0.354665, 1e-9);
@@ -208,7 +208,8 @@ TEST(CarmenReader, FrontAndRearLasersByLabel) {
 // orders the log instead.
 TEST(CarmenReader, RepeatedTimestampsFallBackToTheScanIndex) {
   std::string text;
-  for (int i = 0; i < 10; ++i) text += "ODOM " + std::to_string(0.1 * i) + " 0 0 0 0 0 1.13486e+09 h 1.13486e+09\n" + flaser(3, "1.0", 1.13486e+09);
+  for (int i = 0; i < 10; ++i)
+    text += "ODOM " + std::to_string(0.1 * i) + " 0 0 0 0 0 1.13486e+09 h 1.13486e+09\n" + flaser(3, "1.0", 1.13486e+09);
   io::CarmenReader reader(writeText("repeated", text));
   EXPECT_FALSE(reader.info().has_timestamps);
   const ReadBack r = readAll(reader);
@@ -224,8 +225,8 @@ TEST(CarmenReader, ReadingsSharingAPrintedTimeAreSpreadOverItsStep) {
   const auto odom = [](double x, const std::string& t) { return "ODOM " + std::to_string(x) + " 0 0 0 0 0 " + t + " h " + t + "\n"; };
   std::string rear = flaser(3, "1.0", 2670.16);
   rear.replace(0, 6, "RLASER");
-  const std::string text = odom(0.0, "2670.15") + odom(0.1, "2670.16") + odom(0.2, "2670.16") + flaser(3, "1.0", 2670.16) +
-                           rear + odom(0.3, "2670.16") + odom(0.4, "2670.17") + odom(0.5, "2670.2") + odom(0.6, "2670.2");
+  const std::string text = odom(0.0, "2670.15") + odom(0.1, "2670.16") + odom(0.2, "2670.16") + flaser(3, "1.0", 2670.16) + rear +
+                           odom(0.3, "2670.16") + odom(0.4, "2670.17") + odom(0.5, "2670.2") + odom(0.6, "2670.2");
   io::CarmenReader reader(writeText("burst", text));
   ASSERT_TRUE(reader.info().has_timestamps);
   const ReadBack r = readAll(reader);
@@ -250,8 +251,7 @@ TEST(CarmenReader, ReadingsSharingAPrintedTimeAreSpreadOverItsStep) {
 // digits the number has: "5.25" stands for [5.245, 5.255), not for 5.25 to 6 digits.
 TEST(CarmenReader, FixedPointTimesKeepTheirOwnStep) {
   const auto odom = [](double x, const std::string& t) { return "ODOM " + std::to_string(x) + " 0 0 0 0 0 " + t + " h " + t + "\n"; };
-  const std::string text = odom(0.0, "5.20") + odom(0.1, "5.25") + odom(0.2, "5.25") + odom(0.3, "2670.16") +
-                           flaser(3, "1.0", 2670.16);
+  const std::string text = odom(0.0, "5.20") + odom(0.1, "5.25") + odom(0.2, "5.25") + odom(0.3, "2670.16") + flaser(3, "1.0", 2670.16);
   io::CarmenReader reader(writeText("fixed", text));
   ASSERT_TRUE(reader.info().has_timestamps);
   const ReadBack r = readAll(reader);

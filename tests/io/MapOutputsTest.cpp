@@ -104,9 +104,12 @@ TEST(MapOutputs, PcdAndXyzHaveOneLinePerPoint) {
   size_t declared = 0, data = 0;
   bool in_data = false;
   while (std::getline(pcd, line)) {
-    if (in_data) ++data;
-    else if (line.rfind("POINTS ", 0) == 0) declared = std::stoul(line.substr(7));
-    else if (line == "DATA ascii") in_data = true;
+    if (in_data)
+      ++data;
+    else if (line.rfind("POINTS ", 0) == 0)
+      declared = std::stoul(line.substr(7));
+    else if (line == "DATA ascii")
+      in_data = true;
   }
   EXPECT_EQ(declared, pts.size());
   EXPECT_EQ(data, pts.size());

@@ -34,8 +34,10 @@ TEST(RawlogReader, SensoryFrameRawlogKeepsTheLeadingFrame) {
     }
     if (auto* o = std::get_if<io::OdometryReading>(&m)) {
       ++odo;
-      if (have) path += std::hypot(o->pose.x - last.x, o->pose.y - last.y);
-      else path += std::hypot(o->pose.x, o->pose.y);  // first increment from the origin
+      if (have)
+        path += std::hypot(o->pose.x - last.x, o->pose.y - last.y);
+      else
+        path += std::hypot(o->pose.x, o->pose.y);  // first increment from the origin
       last = o->pose;
       have = true;
     }

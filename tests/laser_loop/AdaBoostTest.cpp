@@ -57,7 +57,7 @@ TEST(WeakClassifier, StumpMinimisesWeightedError) {
   const StumpFit fit = fitStump(t, 0, order, w);
   EXPECT_EQ(fit.stump.polarity, 1);
   EXPECT_DOUBLE_EQ(fit.stump.threshold, 0.4);  // midway between 0.3 and 0.5
-  EXPECT_DOUBLE_EQ(fit.error, 0.125);           // only the positive at 0.9 is missed
+  EXPECT_DOUBLE_EQ(fit.error, 0.125);          // only the positive at 0.9 is missed
 }
 
 // Algorithm 1 on the set above, two rounds by hand:

@@ -74,10 +74,8 @@ TEST(ClassifierModel, SaveLoadRoundTripIsExact) {
 TEST(ClassifierModel, ModelWithoutLogFeaturesKeyUsesPlainFeatures) {
   EXPECT_FALSE(parseModel(modelWith("log_features 1\n", ""), "m.model").params.log_features);
   EXPECT_EQ(parseModel(modelWith("submap_window_m 7.5\n", ""), "m.model").submap_window_m, 0.0);
-  EXPECT_NE(errorOf(modelWith("submap_window_m 7.5", "submap_window_m -1")).find("submap_window_m must be >= 0"),
-            std::string::npos);
-  EXPECT_NE(errorOf(modelWith("log_features 1", "log_features yes")).find("log_features must be 0 or 1"),
-            std::string::npos);
+  EXPECT_NE(errorOf(modelWith("submap_window_m 7.5", "submap_window_m -1")).find("submap_window_m must be >= 0"), std::string::npos);
+  EXPECT_NE(errorOf(modelWith("log_features 1", "log_features yes")).find("log_features must be 0 or 1"), std::string::npos);
 }
 
 TEST(ClassifierModel, MalformedFilesGiveClearErrors) {
@@ -86,8 +84,7 @@ TEST(ClassifierModel, MalformedFilesGiveClearErrors) {
   EXPECT_NE(errorOf(modelWith("urbanslam-laser-loop-model 1", "urbanslam-laser-loop-model 7")).find("version 7 is not supported"),
             std::string::npos);
   EXPECT_NE(errorOf(modelWith("end\n", "")).find("truncated"), std::string::npos);
-  EXPECT_NE(errorOf(modelWith("r_max_m 27.5", "r_max_m abc")).find("r_max_m: 'abc' is not a finite number"),
-            std::string::npos);
+  EXPECT_NE(errorOf(modelWith("r_max_m 27.5", "r_max_m abc")).find("r_max_m: 'abc' is not a finite number"), std::string::npos);
   EXPECT_NE(errorOf(modelWith("r_max_m 27.5\n", "")).find("missing required key(s): r_max_m"), std::string::npos);
   EXPECT_NE(errorOf(modelWith("factor", "fudge")).find("unknown key 'fudge'"), std::string::npos);
   EXPECT_NE(errorOf(modelWith("stumps 2", "stumps 3")).find("'stumps 3' declared but 2 stump lines"), std::string::npos);

@@ -206,6 +206,6 @@ TEST(TrainingPairs, FrontAndRearScansOfOneInstantAreMerged) {
     GTEST_SKIP() << "the CARMEN reader does not take this minimal front+rear log: " << e.what();
   }
   if (set.scans.empty()) GTEST_SKIP() << "no reference poses read from the minimal log";
-  EXPECT_EQ(set.scans.size(), 2u);  // one per instant, not one per laser
+  EXPECT_EQ(set.scans.size(), 2u);                                       // one per instant, not one per laser
   EXPECT_EQ(set.scans[0].features[static_cast<int>(Feature::Size)], 8);  // 4 front + 4 rear beams
 }

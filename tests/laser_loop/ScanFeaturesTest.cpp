@@ -44,9 +44,9 @@ io::LaserScan roomScan360() {
     const double tx = std::fabs(std::cos(a)) > 1e-9 ? hx / std::fabs(std::cos(a)) : 1e9;
     const double ty = std::fabs(std::sin(a)) > 1e-9 ? hy / std::fabs(std::sin(a)) : 1e9;
     double d = std::min(tx, ty);
-    if (i >= 40 && i < 48) d = 1.2 + 0.01 * (i - 40);        // pillar
-    if (i >= 100 && i < 112) d = 0;                          // door: no return
-    if (i >= 200 && i < 204) d = 45.0;                       // window: beyond r_max
+    if (i >= 40 && i < 48) d = 1.2 + 0.01 * (i - 40);  // pillar
+    if (i >= 100 && i < 112) d = 0;                    // door: no return
+    if (i >= 200 && i < 204) d = 45.0;                 // window: beyond r_max
     r.push_back(d > 0 ? d + noise(rng) : 0);
   }
   return makeScan(r, -M_PI, kDeg);
@@ -61,8 +61,7 @@ FeatureParams params(double r_max, double gate, int min_size) {
 }
 
 void expectSame(const FeatureVector& a, const FeatureVector& b, const std::string& what) {
-  for (int i = 0; i < kFeatureCount; ++i)
-    EXPECT_NEAR(a[i], b[i], 1e-9 * std::max(1.0, std::fabs(a[i]))) << what << ": " << featureName(i);
+  for (int i = 0; i < kFeatureCount; ++i) EXPECT_NEAR(a[i], b[i], 1e-9 * std::max(1.0, std::fabs(a[i]))) << what << ": " << featureName(i);
 }
 
 }  // namespace
@@ -135,8 +134,8 @@ TEST(ScanFeatures, LogFeaturesAreTheLogOfThePlainFeatures) {
 // Closed 360° scan of four unit-range beams: the square (1,0),(0,1),(−1,0),(0,−1).
 TEST(ScanFeatures, HandComputedClosedSquare) {
   const auto f = computeFeatures(makeScan({1, 1, 1, 1}, 0, 90 * kDeg), params(10, 2.0, 2));
-  EXPECT_NEAR(get(f, Feature::Area), 2.0, 1e-12);            // four triangles of ½
-  EXPECT_NEAR(get(f, Feature::CloseArea), 2.0, 1e-12);       // ½ · 4 · sin 90°
+  EXPECT_NEAR(get(f, Feature::Area), 2.0, 1e-12);       // four triangles of ½
+  EXPECT_NEAR(get(f, Feature::CloseArea), 2.0, 1e-12);  // ½ · 4 · sin 90°
   EXPECT_NEAR(get(f, Feature::AverageRange), 1.0, 1e-12);
   EXPECT_NEAR(get(f, Feature::MeanCentroid), 0.0, 1e-12);
   EXPECT_NEAR(get(f, Feature::ClampedCentroid), 0.0, 1e-12);
@@ -250,9 +249,9 @@ TEST(ScanFeatures, SetFeaturesInvariantUnderBeamPermutation) {
     shuffled.valid[i] = polar.valid[idx[i]];
   }
   const auto f1 = computeFeatures(shuffled, p);
-  for (Feature k : {Feature::AverageRange, Feature::MeanCentroid, Feature::ClampedCentroid, Feature::CloseArea,
-                    Feature::CircularityResidual, Feature::CircularityRadius, Feature::MaxRangeCount,
-                    Feature::MeanDeviation, Feature::Size, Feature::StdRange})
+  for (Feature k :
+       {Feature::AverageRange, Feature::MeanCentroid, Feature::ClampedCentroid, Feature::CloseArea, Feature::CircularityResidual,
+        Feature::CircularityRadius, Feature::MaxRangeCount, Feature::MeanDeviation, Feature::Size, Feature::StdRange})
     EXPECT_NEAR(get(f0, k), get(f1, k), 1e-9 * std::max(1.0, std::fabs(get(f0, k)))) << featureName(k);
 }
 

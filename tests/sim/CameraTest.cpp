@@ -48,9 +48,7 @@ CameraOptions clean() {
 
 uint8_t at(const io::CameraImage& im, int x, int y) { return (*im.pixels)[static_cast<size_t>(y) * im.width + x]; }
 
-cv::Mat toMat(const io::CameraImage& im) {
-  return cv::Mat(im.height, im.width, CV_8U, const_cast<uint8_t*>(im.pixels->data())).clone();
-}
+cv::Mat toMat(const io::CameraImage& im) { return cv::Mat(im.height, im.width, CV_8U, const_cast<uint8_t*>(im.pixels->data())).clone(); }
 
 // A look id whose featureless wall is darker than anything else in the image (sky > 160, ground
 // at least 88 within 10 m), so wall pixels can be told apart by a threshold.
@@ -83,7 +81,7 @@ common::Pose2 streetView(const StreetGrid& grid, double t, double forward_m = 0)
 }  // namespace
 
 TEST(CameraRenderer, AWallAtDistanceDHasTheAnalyticPixelHeightAndEdges) {
-  for (double d : {10.0, 14.0, 22.5}) {  // from 10 m, the wall's top is inside the image
+  for (double d : {10.0, 14.0, 22.5}) {                   // from 10 m, the wall's top is inside the image
     const double wall_h = 9.0, left = 4.0, right = -3.0;  // wall from y = -3 (right) to y = 4 (left)
     KnownWalls w;
     w.segments.push_back({{d, right}, {d, left}, darkWall(wall_h), 0.f});
@@ -200,10 +198,10 @@ TEST(CameraRenderer, RepeatedDesignsLookTheSameAndOtherDesignsDiffer) {
       if (norm(list[k].a - s0.a) < 50) continue;
       const double d = difference(view(s0), view(list[k]), s0.look.height_m);
       ASSERT_GE(d, 0);
-      std::printf("[ info ] design %08x: copies at (%.1f, %.1f) and (%.1f, %.1f), mean |difference| %.2f\n",
-                  std::get<0>(key), s0.a.x, s0.a.y, list[k].a.x, list[k].a.y, d);
-      EXPECT_LT(d, 1.0) << "design " << std::get<0>(key) << " at " << s0.a.x << "," << s0.a.y << " and "
-                        << list[k].a.x << "," << list[k].a.y;
+      std::printf("[ info ] design %08x: copies at (%.1f, %.1f) and (%.1f, %.1f), mean |difference| %.2f\n", std::get<0>(key), s0.a.x,
+                  s0.a.y, list[k].a.x, list[k].a.y, d);
+      EXPECT_LT(d, 1.0) << "design " << std::get<0>(key) << " at " << s0.a.x << "," << s0.a.y << " and " << list[k].a.x << ","
+                        << list[k].a.y;
       ++pairs;
       if (designs.empty() || designs.back().first.look.id != s0.look.id) designs.emplace_back(s0, view(s0));
       break;
@@ -214,8 +212,7 @@ TEST(CameraRenderer, RepeatedDesignsLookTheSameAndOtherDesignsDiffer) {
   for (size_t i = 1; i < designs.size(); ++i) {
     const double top = std::min(designs[0].first.look.height_m, designs[i].first.look.height_m);
     const double d = difference(designs[0].second, designs[i].second, top);
-    std::printf("[ info ] designs %08x and %08x: mean |difference| %.1f\n", designs[0].first.look.id,
-                designs[i].first.look.id, d);
+    std::printf("[ info ] designs %08x and %08x: mean |difference| %.1f\n", designs[0].first.look.id, designs[i].first.look.id, d);
     EXPECT_GT(d, 10.0);
   }
 }
@@ -250,8 +247,8 @@ TEST(CameraRenderer, SiftFindsAndMatchesFeaturesOnStreetViews) {
     const int inliers = cv::countNonZero(inlier);
     EXPECT_GE(inliers, 50) << "t " << t << ": " << k0.size() << " keypoints, " << p0.size() << " ratio-test matches";
     ++views;
-    std::printf("[ info ] t %.0f s: %zu / %zu SIFT keypoints, %zu ratio-test matches, %d F-RANSAC inliers\n", t,
-                k0.size(), k1.size(), p0.size(), inliers);
+    std::printf("[ info ] t %.0f s: %zu / %zu SIFT keypoints, %zu ratio-test matches, %d F-RANSAC inliers\n", t, k0.size(), k1.size(),
+                p0.size(), inliers);
   }
   EXPECT_EQ(views, 3);
 }

@@ -32,10 +32,9 @@ double bruteForce(const std::vector<Segment>& segs, Vec2 o, Vec2 d, double max_r
 TEST(RaySegment, HitsAWallAtTheAnalyticRange) {
   // A wall x = 10, |y| <= 5: a beam at angle a from the origin meets it at 10 / cos(a).
   const Segment wall{{10, -5}, {10, 5}};
-  for (double a = -0.4; a <= 0.4; a += 0.05)
-    EXPECT_NEAR(raySegment({0, 0}, {std::cos(a), std::sin(a)}, wall), 10 / std::cos(a), 1e-9) << a;
+  for (double a = -0.4; a <= 0.4; a += 0.05) EXPECT_NEAR(raySegment({0, 0}, {std::cos(a), std::sin(a)}, wall), 10 / std::cos(a), 1e-9) << a;
   EXPECT_EQ(raySegment({0, 0}, {std::cos(0.6), std::sin(0.6)}, wall), kNoHit);  // passes above its end
-  EXPECT_EQ(raySegment({0, 0}, {-1, 0}, wall), kNoHit);                          // behind the sensor
+  EXPECT_EQ(raySegment({0, 0}, {-1, 0}, wall), kNoHit);                         // behind the sensor
 }
 
 TEST(CityModel, RaycastEqualsBruteForceOverAllNearbyWalls) {

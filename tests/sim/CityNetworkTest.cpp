@@ -41,9 +41,7 @@ bool isBuilding(const Segment& s) {
 }
 
 struct NodeLess {
-  bool operator()(const NodeId& a, const NodeId& b) const {
-    return std::tie(a.kind, a.i, a.j) < std::tie(b.kind, b.i, b.j);
-  }
+  bool operator()(const NodeId& a, const NodeId& b) const { return std::tie(a.kind, a.i, a.j) < std::tie(b.kind, b.i, b.j); }
 };
 
 // Every intersection reachable from the city's centre.
@@ -87,8 +85,7 @@ TEST(StreetNetwork, AvenuePiecesLieInTheirCorridorAndTheGraphIsSymmetric) {
       // The driving lane along the piece stays inside one avenue's carriageway: nearest avenue of
       // the midpoint, then every point of the lane checked against it.
       const Vec2 mid = 0.5 * (a + b);
-      const int av = static_cast<int>(std::lround((dot(mid, g.avenueNormal()) - g.avenueOffset(0)) /
-                                                  g.options().avenue_spacing_m));
+      const int av = static_cast<int>(std::lround((dot(mid, g.avenueNormal()) - g.avenueOffset(0)) / g.options().avenue_spacing_m));
       avenues.insert(av);
       const Vec2 d = (1.0 / norm(b - a)) * (b - a);
       // Parallel to the avenue.
@@ -240,8 +237,7 @@ TEST(Driver, StaysClearOfEveryWallOnAvenuesAndDrivesRoundaboutsCounterClockwise)
   // Counter-clockwise round the island: the position's angle about the centre grows. (The
   // heading's net change is the exit's direction: negative when the car leaves to the right.)
   for (const Pass& p : passes) EXPECT_GT(p.sweep, 0.3) << "roundabout at " << p.centre.x << "," << p.centre.y;
-  std::cout << "closest wall " << worst << " m, " << on_avenue_m << " m on avenues, " << passes.size()
-            << " roundabout passes\n";
+  std::cout << "closest wall " << worst << " m, " << on_avenue_m << " m on avenues, " << passes.size() << " roundabout passes\n";
 }
 
 TEST(CityModel, TilesWithAvenuesAndRoundaboutsAreIdenticalInAnyBuildOrder) {

@@ -124,7 +124,8 @@ TEST(LocalMatching, ScanMatchBeatsAFalseOdometryTurn) {
   const std::string log = test::sharedDataPath("freiburg_slam_benchmark/corrected_logs/freiburg-campus-corrected.log.gz");
   if (log.empty()) GTEST_SKIP() << "../shared/data (Freiburg corrected logs) not present";
   const slam::PipelineOptions o = slam::loadPipelineOptions(test::repoPath("ini/freiburg-campus.ini"));
-  const auto e = worstHeadingWithAndWithout(log, o, [](slam::PipelineOptions& w) { w.local.scan_matching = false; }, 238, 240);
+  const auto e = worstHeadingWithAndWithout(
+      log, o, [](slam::PipelineOptions& w) { w.local.scan_matching = false; }, 238, 240);
   EXPECT_GT(e.without, 15);
   EXPECT_LT(e.with, 5);
 }
@@ -153,7 +154,8 @@ TEST(LocalMatching, ScansBetweenKeyframesFollowTheirSubmapMatch) {
 TEST(LocalMatching, ClutteredStepsStayNearTheCorrectedLog) {
   const std::string log = test::repoPath("rawlogs/intel.rawlog");
   const slam::PipelineOptions o = slam::loadPipelineOptions(test::repoPath("ini/intel.ini"));
-  const auto e = worstHeadingWithAndWithout(log, o, [](slam::PipelineOptions& w) { w.local.scan_matching = false; }, 100, 165);
+  const auto e = worstHeadingWithAndWithout(
+      log, o, [](slam::PipelineOptions& w) { w.local.scan_matching = false; }, 100, 165);
   EXPECT_GT(e.without, 4.5);
   EXPECT_LT(e.with, 2.5);
 }

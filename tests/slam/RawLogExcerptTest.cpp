@@ -26,7 +26,8 @@ ExcerptRun runExcerpt(const slam::PipelineOptions& o) {
   std::vector<evaluation::LoopRow> rows;
   for (const auto& c : p.loopClosures())
     rows.push_back({static_cast<long>(c.from), static_cast<long>(c.to), c.from_time, c.to_time, c.accepted, c.measurement});
-  return {evaluation::relationMetrics(p.scanTrajectory(), rel, 0.0, 1e9), evaluation::checkLoopsWithRelations(rows, p.odometryTrajectory(), rel, 0.0)};
+  return {evaluation::relationMetrics(p.scanTrajectory(), rel, 0.0, 1e9),
+          evaluation::checkLoopsWithRelations(rows, p.odometryTrajectory(), rel, 0.0)};
 }
 
 }  // namespace

@@ -161,8 +161,7 @@ TEST(LoopDetector, CandidateRestrictionOnlyReturnsCandidates) {
     if (i >= 16 && r.status != LoopStatus::NoFeatures && r.status != LoopStatus::NoCandidates && r.status != LoopStatus::DatabaseTooSmall &&
         r.status != LoopStatus::LowPriorScore) {
       ++restricted_results;
-      EXPECT_TRUE(r.match >= 10 && r.match <= 15)
-          << frames[i].name << " -> " << r.match << " (" << loopStatusName(r.status) << ")";
+      EXPECT_TRUE(r.match >= 10 && r.match <= 15) << frames[i].name << " -> " << r.match << " (" << loopStatusName(r.status) << ")";
     }
   }
   EXPECT_GT(restricted_results, 0u);
@@ -200,12 +199,11 @@ TEST(ImageLoopOptions, IniKeysReachTheDetector) {
   ImageLoopOptions o;
   schema.section("image_loop", "Tree of Words");
   declareImageLoopOptions(schema, o);
-  schema.load(urbanslam::common::IniFile::parse(
-      "[image_loop]\nmin_normalized_score = 0.5\nmin_inliers = 15\nmax_features = 300\n", "test.ini"));
+  schema.load(
+      urbanslam::common::IniFile::parse("[image_loop]\nmin_normalized_score = 0.5\nmin_inliers = 15\nmax_features = 300\n", "test.ini"));
   const LoopDetectorOptions d = detectorOptions(o);
   EXPECT_FLOAT_EQ(d.min_normalized_score, 0.5f);
   EXPECT_EQ(d.verification.min_inliers, 15);
   EXPECT_EQ(featureOptions(o, DescriptorType::Orb).max_features, 300);
-  EXPECT_THROW(schema.load(urbanslam::common::IniFile::parse("[image_loop]\nmin_inlier = 3\n", "bad.ini")),
-               urbanslam::common::ConfigError);
+  EXPECT_THROW(schema.load(urbanslam::common::IniFile::parse("[image_loop]\nmin_inlier = 3\n", "bad.ini")), urbanslam::common::ConfigError);
 }

@@ -44,8 +44,8 @@ CameraView cameraView(const MapSnapshot& s, std::optional<size_t> selected) {
   // The proposal to show: for a clicked keyframe, its own latest one (as either side); for the
   // running view, the newest proposal while it is recent.
   for (auto it = s.image_matches.rbegin(); it != s.image_matches.rend(); ++it) {
-    const bool mine = selected ? (it->current == *left || it->matched == *left)
-                               : it->current <= *left && *left - it->current <= kMatchHoldKeyframes;
+    const bool mine =
+        selected ? (it->current == *left || it->matched == *left) : it->current <= *left && *left - it->current <= kMatchHoldKeyframes;
     if (mine) {
       v.match = *it;
       break;
@@ -59,8 +59,7 @@ CameraView cameraView(const MapSnapshot& s, std::optional<size_t> selected) {
   if (!selected && m.current != *left) v.current = keyframeFrame(s, m.current, "proposal");
   v.matched = keyframeFrame(s, other, "matched");
   char buf[200];
-  std::snprintf(buf, sizeof buf, "Tree of Words: keyframe %zu matches %zu\nscore %.2f, %s", m.current, m.matched, m.score,
-                m.fate.c_str());
+  std::snprintf(buf, sizeof buf, "Tree of Words: keyframe %zu matches %zu\nscore %.2f, %s", m.current, m.matched, m.score, m.fate.c_str());
   v.match_caption = buf;
   return v;
 }

@@ -76,8 +76,8 @@ DrawList buildDrawList(const MapSnapshot& s, const Layers& layers) {
     const double cs = std::cos(k.pose.phi), sn = std::sin(k.pose.phi);
     if (k.points)
       for (const auto& p : *k.points)
-        d.selected_scan.push_back({static_cast<float>(k.pose.x + cs * p.x - sn * p.y),
-                                   static_cast<float>(k.pose.y + sn * p.x + cs * p.y), 0.07f, palette::kSelected});
+        d.selected_scan.push_back({static_cast<float>(k.pose.x + cs * p.x - sn * p.y), static_cast<float>(k.pose.y + sn * p.x + cs * p.y),
+                                   0.07f, palette::kSelected});
   }
   for (const auto& c : s.closures) {
     if (c.from_keyframe >= n || c.to_keyframe >= n) continue;

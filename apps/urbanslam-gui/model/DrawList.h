@@ -73,7 +73,7 @@ struct DrawList {
   std::optional<Ellipse> uncertainty;
   std::vector<Segment> closures_accepted, closures_rejected;
   std::vector<common::Pose2> candidates;
-  Bounds bounds;             // of everything drawn, for fit-to-map
+  Bounds bounds;  // of everything drawn, for fit-to-map
   size_t keyframes_drawn = 0;
 };
 

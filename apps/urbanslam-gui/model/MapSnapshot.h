@@ -30,13 +30,13 @@ struct ImageMatchView {
   size_t current = 0, matched = 0;  // keyframe indices
   double score = 0;                 // normalised score
   bool accepted = false;
-  std::string fate;                 // accepted | pending | alignment | gating | unconfirmed | no_scans | ...
+  std::string fate;  // accepted | pending | alignment | gating | unconfirmed | no_scans | ...
 };
 
 struct RunStats {
   size_t scans = 0, keyframes = 0, closures_accepted = 0, closures_rejected = 0;
-  double log_time_s = 0;      // log time covered so far
-  double processing_s = 0;    // time spent in the pipeline
+  double log_time_s = 0;    // log time covered so far
+  double processing_s = 0;  // time spent in the pipeline
   double progress = 0;
   std::vector<double> step_ms;  // recent per-scan processing times (bounded)
 };
@@ -46,7 +46,7 @@ struct MapSnapshot {
   std::vector<KeyframeView> keyframes;
   std::array<double, 9> current_covariance{};
   std::vector<slam::LoopClosureEvent> closures;
-  std::vector<size_t> candidates;  // of the current keyframe
+  std::vector<size_t> candidates;                     // of the current keyframe
   std::shared_ptr<const io::CameraImage> last_image;  // the latest camera frame of the log
   std::vector<ImageMatchView> image_matches;          // in the order proposed
   RunStats stats;

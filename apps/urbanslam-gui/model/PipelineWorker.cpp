@@ -6,8 +6,8 @@
 
 namespace urbanslam::gui {
 
-PipelineWorker::PipelineWorker(const std::string& log_path, const std::string& ini_path,
-                               const std::string& default_laser_model, const std::string& default_vocabulary)
+PipelineWorker::PipelineWorker(const std::string& log_path, const std::string& ini_path, const std::string& default_laser_model,
+                               const std::string& default_vocabulary)
     : log_path_(log_path), ini_path_(ini_path), default_laser_model_(default_laser_model) {
   slam::PipelineOptions options = slam::loadPipelineOptions(ini_path, &resolved_ini_);
   if (options.loop_closure.laser_model.empty()) options.loop_closure.laser_model = default_laser_model_;

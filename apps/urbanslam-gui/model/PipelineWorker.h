@@ -51,7 +51,7 @@ class PipelineWorker {
   std::unique_ptr<slam::Pipeline> pipeline_;
   SnapshotCollector collector_;
 
-  mutable std::mutex mutex_;         // guards the pipeline and the control flags below
+  mutable std::mutex mutex_;  // guards the pipeline and the control flags below
   std::condition_variable wake_;
   std::atomic<bool> running_{false}, finished_{false}, stop_{false};
   bool step_request_ = false;

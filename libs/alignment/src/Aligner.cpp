@@ -11,8 +11,7 @@ namespace urbanslam::alignment {
 
 using common::Pose2;
 
-AlignmentResult align(const io::LaserScan& a, const io::LaserScan& b, const Pose2& guess,
-                      const AlignerOptions& options) {
+AlignmentResult align(const io::LaserScan& a, const io::LaserScan& b, const Pose2& guess, const AlignerOptions& options) {
   common::Stopwatch sw;
   const PointSet pa = pointSetFromScan(a, options.scan, options.in_vehicle_frame);
   const PointSet pb = pointSetFromScan(b, options.scan, options.in_vehicle_frame);
@@ -45,8 +44,7 @@ AlignmentResult alignWithPrior(const MatchReference& reference, const PointSet& 
 
 }  // namespace
 
-AlignmentResult alignPointSets(const PointSet& a, const PointSet& b, const Pose2& guess,
-                               const AlignerOptions& options) {
+AlignmentResult alignPointSets(const PointSet& a, const PointSet& b, const Pose2& guess, const AlignerOptions& options) {
   common::Stopwatch sw;
   // (The prior method builds its kd-tree with its grid: no IndexedReference first.)
   AlignmentResult r = options.method == Method::Prior && std::isfinite(guess.x) && std::isfinite(guess.y) && std::isfinite(guess.phi)
@@ -56,19 +54,17 @@ AlignmentResult alignPointSets(const PointSet& a, const PointSet& b, const Pose2
   return r;
 }
 
-AlignmentResult alignPointSets(const IndexedReference& indexed, const PointSet& b, const Pose2& guess,
-                               const AlignerOptions& options) {
+AlignmentResult alignPointSets(const IndexedReference& indexed, const PointSet& b, const Pose2& guess, const AlignerOptions& options) {
   common::Stopwatch sw;
   const PointSet& a = indexed.points();
   AlignmentResult out;
   out.transform = guess;
   out.points_a = static_cast<int>(a.size());
   out.points_b = static_cast<int>(b.size());
-  const Eigen::Matrix3d large =
-      Eigen::Vector3d(options.covariance.max_std_m * options.covariance.max_std_m,
-                      options.covariance.max_std_m * options.covariance.max_std_m,
-                      options.covariance.max_std_rad * options.covariance.max_std_rad)
-          .asDiagonal();
+  const Eigen::Matrix3d large = Eigen::Vector3d(options.covariance.max_std_m * options.covariance.max_std_m,
+                                                options.covariance.max_std_m * options.covariance.max_std_m,
+                                                options.covariance.max_std_rad * options.covariance.max_std_rad)
+                                    .asDiagonal();
   out.cov = large;
   if (!std::isfinite(guess.x) || !std::isfinite(guess.y) || !std::isfinite(guess.phi)) {
     out.transform = Pose2{};
@@ -88,13 +84,18 @@ AlignmentResult alignPointSets(const IndexedReference& indexed, const PointSet& 
   RegistrationResult reg;
   bool point_to_line = false;
   switch (options.method) {
-    case Method::Prior: break;  // above
-    case Method::Icp: reg = icpWithIndex(a, indexed.index(), {}, b, guess, options.icp); break;
+    case Method::Prior:
+      break;  // above
+    case Method::Icp:
+      reg = icpWithIndex(a, indexed.index(), {}, b, guess, options.icp);
+      break;
     case Method::PlIcp:
       point_to_line = true;
       reg = icpWithIndex(a, indexed.index(), indexed.normals(options.icp.normals), b, guess, options.icp);
       break;
-    case Method::Crf: reg = crfMatch(a, b, guess, options.crf); break;
+    case Method::Crf:
+      reg = crfMatch(a, b, guess, options.crf);
+      break;
     case Method::CrfIcp: {
       // CRF-match proposes, ICP verifies: ICP runs from the CRF transform, from the CRF's other
       // consensus hypotheses and from the caller's guess; the refinement that explains most
@@ -130,8 +131,7 @@ AlignmentResult alignPointSets(const IndexedReference& indexed, const PointSet& 
         const auto dist = [&](const Pose2& p) {
           return std::hypot(p.x - guess.x, p.y - guess.y) + 2.0 * std::abs(common::wrapToPi(p.phi - guess.phi));
         };
-        const bool better = !have || count > best_count * 1.02 ||
-                            (count >= best_count * 0.98 && dist(r.transform) < dist(reg.transform));
+        const bool better = !have || count > best_count * 1.02 || (count >= best_count * 0.98 && dist(r.transform) < dist(reg.transform));
         if (better) {
           reg = r;
           best_count = std::max(best_count, count);
@@ -139,8 +139,7 @@ AlignmentResult alignPointSets(const IndexedReference& indexed, const PointSet& 
         }
       }
       reg.iterations = total_iterations;
-      if (!have && !coarse.converged)
-        reg.failure_reason = "CRF-match: " + coarse.failure_reason + "; ICP: " + reg.failure_reason;
+      if (!have && !coarse.converged) reg.failure_reason = "CRF-match: " + coarse.failure_reason + "; ICP: " + reg.failure_reason;
       break;
     }
   }
@@ -187,11 +186,16 @@ Method parseMethod(const std::string& name) {
 
 std::string methodName(Method method) {
   switch (method) {
-    case Method::Prior: return "prior";
-    case Method::Icp: return "icp";
-    case Method::PlIcp: return "plicp";
-    case Method::Crf: return "crf";
-    case Method::CrfIcp: return "crf+icp";
+    case Method::Prior:
+      return "prior";
+    case Method::Icp:
+      return "icp";
+    case Method::PlIcp:
+      return "plicp";
+    case Method::Crf:
+      return "crf";
+    case Method::CrfIcp:
+      return "crf+icp";
   }
   return "?";
 }

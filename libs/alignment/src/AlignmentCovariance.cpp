@@ -21,8 +21,7 @@ struct Pair {
   Eigen::Vector2d dm;  // d m / d phi
 };
 
-std::vector<Pair> associations(const IndexedReference& reference, const PointSet& moving,
-                               const Pose2& transform, double gate) {
+std::vector<Pair> associations(const IndexedReference& reference, const PointSet& moving, const Pose2& transform, double gate) {
   const NearestNeighbours& index = reference.index();
   const Rigid2 T = Rigid2::fromPose(transform);
   const double c = std::cos(transform.phi), s = std::sin(transform.phi);
@@ -60,8 +59,8 @@ double sweepSpacing(const PointSet& ref, int j) {
 
 }  // namespace
 
-Eigen::Matrix3d lineVarianceCovariance(const IndexedReference& indexed, const PointSet& moving,
-                                       const Pose2& transform, const CovarianceOptions& options) {
+Eigen::Matrix3d lineVarianceCovariance(const IndexedReference& indexed, const PointSet& moving, const Pose2& transform,
+                                       const CovarianceOptions& options) {
   const auto pairs = associations(indexed, moving, transform, options.association_gate_m);
   if (pairs.size() < 3) return largeCovariance(options);
   const PointSet& reference = indexed.points();
@@ -99,8 +98,8 @@ Eigen::Matrix3d lineVarianceCovariance(const IndexedReference& indexed, const Po
   return symmetric(cov);
 }
 
-Eigen::Matrix3d hessianCovariance(const IndexedReference& indexed, const PointSet& moving,
-                                  const Pose2& transform, const CovarianceOptions& options) {
+Eigen::Matrix3d hessianCovariance(const IndexedReference& indexed, const PointSet& moving, const Pose2& transform,
+                                  const CovarianceOptions& options) {
   const auto pairs = associations(indexed, moving, transform, options.association_gate_m);
   if (pairs.size() < 3) return largeCovariance(options);
   const PointSet& reference = indexed.points();
@@ -132,9 +131,8 @@ Eigen::Matrix3d hessianCovariance(const IndexedReference& indexed, const PointSe
   return symmetric(info.inverse());
 }
 
-Eigen::Matrix3d samplingCovariance(const IndexedReference& indexed, const PointSet& moving,
-                                   const Pose2& transform, const IcpOptions& icp, bool point_to_line,
-                                   const CovarianceOptions& options) {
+Eigen::Matrix3d samplingCovariance(const IndexedReference& indexed, const PointSet& moving, const Pose2& transform, const IcpOptions& icp,
+                                   bool point_to_line, const CovarianceOptions& options) {
   const PointSet& reference = indexed.points();
   const NearestNeighbours& index = indexed.index();
   const std::vector<LineNormal> none;
@@ -143,13 +141,11 @@ Eigen::Matrix3d samplingCovariance(const IndexedReference& indexed, const PointS
   std::normal_distribution<double> nd(0.0, 1.0);
   std::vector<Eigen::Vector3d> results;
   for (int k = 0; k < options.samples; ++k) {
-    const Pose2 guess{transform.x + options.sample_sigma_m * nd(rng),
-                      transform.y + options.sample_sigma_m * nd(rng),
+    const Pose2 guess{transform.x + options.sample_sigma_m * nd(rng), transform.y + options.sample_sigma_m * nd(rng),
                       common::wrapToPi(transform.phi + options.sample_sigma_rad * nd(rng))};
     const auto r = icpWithIndex(reference, index, normals, moving, guess, icp);
     if (!r.converged) continue;
-    results.emplace_back(r.transform.x, r.transform.y,
-                         transform.phi + common::wrapToPi(r.transform.phi - transform.phi));
+    results.emplace_back(r.transform.x, r.transform.y, transform.phi + common::wrapToPi(r.transform.phi - transform.phi));
   }
   if (results.size() < 3) return largeCovariance(options);
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
@@ -163,31 +159,31 @@ Eigen::Matrix3d samplingCovariance(const IndexedReference& indexed, const PointS
   return symmetric(C + Eigen::Matrix3d::Identity() * 1e-12);
 }
 
-Eigen::Matrix3d alignmentCovariance(const PointSet& reference, const PointSet& moving,
-                                    const Pose2& transform, const IcpOptions& icp, bool point_to_line,
-                                    const CovarianceOptions& options) {
+Eigen::Matrix3d alignmentCovariance(const PointSet& reference, const PointSet& moving, const Pose2& transform, const IcpOptions& icp,
+                                    bool point_to_line, const CovarianceOptions& options) {
   return alignmentCovariance(IndexedReference(reference), moving, transform, icp, point_to_line, options);
 }
 
-Eigen::Matrix3d alignmentCovariance(const IndexedReference& reference, const PointSet& moving,
-                                    const Pose2& transform, const IcpOptions& icp, bool point_to_line,
-                                    const CovarianceOptions& options) {
+Eigen::Matrix3d alignmentCovariance(const IndexedReference& reference, const PointSet& moving, const Pose2& transform,
+                                    const IcpOptions& icp, bool point_to_line, const CovarianceOptions& options) {
   switch (options.method) {
-    case CovarianceMethod::LineVariance: return lineVarianceCovariance(reference, moving, transform, options);
-    case CovarianceMethod::Hessian: return hessianCovariance(reference, moving, transform, options);
+    case CovarianceMethod::LineVariance:
+      return lineVarianceCovariance(reference, moving, transform, options);
+    case CovarianceMethod::Hessian:
+      return hessianCovariance(reference, moving, transform, options);
     case CovarianceMethod::Sampling:
       return samplingCovariance(reference, moving, transform, icp, point_to_line, options);
   }
   return largeCovariance(options);
 }
 
-double translationConstraintRatio(const PointSet& reference, const PointSet& moving,
-                                  const Pose2& transform, const CovarianceOptions& options) {
+double translationConstraintRatio(const PointSet& reference, const PointSet& moving, const Pose2& transform,
+                                  const CovarianceOptions& options) {
   return translationConstraintRatio(IndexedReference(reference), moving, transform, options);
 }
 
-double translationConstraintRatio(const IndexedReference& reference, const PointSet& moving,
-                                  const Pose2& transform, const CovarianceOptions& options) {
+double translationConstraintRatio(const IndexedReference& reference, const PointSet& moving, const Pose2& transform,
+                                  const CovarianceOptions& options) {
   const auto pairs = associations(reference, moving, transform, options.association_gate_m);
   if (pairs.size() < 3) return 0.0;
   const auto& normals = reference.normals(options.normals);
@@ -219,9 +215,12 @@ CovarianceMethod parseCovarianceMethod(const std::string& name) {
 
 std::string covarianceMethodName(CovarianceMethod method) {
   switch (method) {
-    case CovarianceMethod::LineVariance: return "line";
-    case CovarianceMethod::Hessian: return "hessian";
-    case CovarianceMethod::Sampling: return "sampling";
+    case CovarianceMethod::LineVariance:
+      return "line";
+    case CovarianceMethod::Hessian:
+      return "hessian";
+    case CovarianceMethod::Sampling:
+      return "sampling";
   }
   return "?";
 }

@@ -61,7 +61,8 @@ class Search {
         for (int oy = -half_cells_; oy <= half_cells_; oy += s) roots.push_back({a, ox, oy, score(top, a, ox, oy)});
     branch(std::move(roots), top);
     CorrelativeResult out;
-    out.pose = {prior_.mean().x + best_.ox * r_, prior_.mean().y + best_.oy * r_, common::wrapToPi(prior_.mean().phi + dphi_[static_cast<size_t>(best_.angle)])};
+    out.pose = {prior_.mean().x + best_.ox * r_, prior_.mean().y + best_.oy * r_,
+                common::wrapToPi(prior_.mean().phi + dphi_[static_cast<size_t>(best_.angle)])};
     out.score = best_.score;
     out.scan_score = best_.score - prior_.logDensity(out.pose);
     out.nodes = nodes_;
@@ -117,8 +118,10 @@ class Search {
     for (int k = 0; k < count; ++k) {
       const Node& c = children[static_cast<size_t>(k)];
       if (c.score <= best_.score) return;
-      if (level - 1 == 0) best_ = c;
-      else branchChildren(c, level - 1);
+      if (level - 1 == 0)
+        best_ = c;
+      else
+        branchChildren(c, level - 1);
     }
   }
 

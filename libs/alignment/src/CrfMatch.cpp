@@ -14,8 +14,7 @@ namespace urbanslam::alignment {
 
 using common::Pose2;
 
-std::vector<std::vector<double>> crfShapeFeatures(const SubsamplingResult& s,
-                                                  const std::vector<double>& radii_m) {
+std::vector<std::vector<double>> crfShapeFeatures(const SubsamplingResult& s, const std::vector<double>& radii_m) {
   const int n = static_cast<int>(s.segmented.size());
   const double nan = std::numeric_limits<double>::quiet_NaN();
   std::vector<std::vector<double>> f(n, std::vector<double>(radii_m.size(), nan));
@@ -68,16 +67,16 @@ std::vector<double> sweepTangents(const SubsamplingResult& s, double radius) {
 // Sparse pairwise table of one edge: for each state j of the first node, the states k of the
 // second node with a non-negligible distance-consistency term g(j, k) (CSR layout).
 struct EdgeTable {
-  int a = 0, b = 0;                 // node indices
-  std::vector<int> row;             // size M + 1
+  int a = 0, b = 0;      // node indices
+  std::vector<int> row;  // size M + 1
   std::vector<int> col;
   std::vector<double> val;
 };
 
 }  // namespace
 
-RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, const Pose2& guess,
-                            const CrfOptions& options, CrfDiagnostics* diagnostics) {
+RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, const Pose2& guess, const CrfOptions& options,
+                            CrfDiagnostics* diagnostics) {
   RegistrationResult result;
   result.transform = guess;
   CrfDiagnostics diag;
@@ -91,8 +90,7 @@ RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, c
   const int min_assoc = std::max(3, options.min_associations);
   if (M < min_assoc || N < min_assoc) {
     std::ostringstream os;
-    os << "too few points after subsampling (reference " << M << ", moving " << N << "; need "
-       << min_assoc << ")";
+    os << "too few points after subsampling (reference " << M << ", moving " << N << "; need " << min_assoc << ")";
     result.failure_reason = os.str();
     if (diagnostics) *diagnostics = diag;
     return result;
@@ -122,8 +120,7 @@ RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, c
         }
       }
       if (options.guess_sigma_m > 0)
-        cost += (G * mov.points[i].p - ref.points[j].p).squaredNorm() /
-                (2 * options.guess_sigma_m * options.guess_sigma_m);
+        cost += (G * mov.points[i].p - ref.points[j].p).squaredNorm() / (2 * options.guess_sigma_m * options.guess_sigma_m);
       phi[static_cast<size_t>(i) * S + j] = std::exp(-cost);
     }
     phi[static_cast<size_t>(i) * S + OUT] = options.outlier_local;
@@ -150,9 +147,8 @@ RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, c
   }
   const double ps = options.pair_sigma_m;
   const double cut = 3.0 * ps;
-  const double inv_s2_dir = options.pair_direction_sigma_rad > 0
-                                ? 1.0 / (options.pair_direction_sigma_rad * options.pair_direction_sigma_rad)
-                                : 0.0;
+  const double inv_s2_dir =
+      options.pair_direction_sigma_rad > 0 ? 1.0 / (options.pair_direction_sigma_rad * options.pair_direction_sigma_rad) : 0.0;
   const double keep = 1e-3;  // table entries below this (times the peak) fall to the floor
   const double max_q = -std::log(keep);
   std::vector<EdgeTable> edges;
@@ -214,7 +210,8 @@ RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, c
         const double* m = &msg[(2 * static_cast<size_t>(e) + dir) * S];
         double z = 0;
         for (int j = 0; j < S; ++j) z += (bl[j] *= m[j]);
-        if (z > 0) for (int j = 0; j < S; ++j) bl[j] /= z;  // keep the products in range
+        if (z > 0)
+          for (int j = 0; j < S; ++j) bl[j] /= z;  // keep the products in range
       }
     }
   };
@@ -285,8 +282,7 @@ RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, c
     const double* bl = &belief[static_cast<size_t>(i) * S];
     for (int j = 0; j < M; ++j) order[j] = j;
     const int K = std::min(M, std::max(1, options.candidates_per_point));
-    std::partial_sort(order.begin(), order.begin() + K, order.end(),
-                      [&](int x, int y) { return bl[x] > bl[y]; });
+    std::partial_sort(order.begin(), order.begin() + K, order.end(), [&](int x, int y) { return bl[x] > bl[y]; });
     for (int k = 0; k < K; ++k)
       if (bl[order[k]] >= options.min_marginal && bl[order[k]] > bl[OUT]) cand.push_back({i, order[k], bl[order[k]]});
   }
@@ -407,8 +403,7 @@ RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, c
   result.rms_residual_m = result.matches.empty() ? 0 : std::sqrt(sse / result.matches.size());
   if (diag.inliers < min_assoc) {
     std::ostringstream os;
-    os << "only " << diag.inliers << " of " << diag.associations
-       << " associations agree on one transform (need " << min_assoc << ")";
+    os << "only " << diag.inliers << " of " << diag.associations << " associations agree on one transform (need " << min_assoc << ")";
     result.failure_reason = os.str();
   } else {
     result.converged = true;

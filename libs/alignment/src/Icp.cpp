@@ -17,29 +17,28 @@ namespace {
 
 double kernelWeight(RobustKernel kernel, double e, double k) {
   switch (kernel) {
-    case RobustKernel::None: return 1.0;
-    case RobustKernel::Huber: return e <= k ? 1.0 : k / e;
-    case RobustKernel::Cauchy: return 1.0 / (1.0 + (e / k) * (e / k));
+    case RobustKernel::None:
+      return 1.0;
+    case RobustKernel::Huber:
+      return e <= k ? 1.0 : k / e;
+    case RobustKernel::Cauchy:
+      return 1.0 / (1.0 + (e / k) * (e / k));
   }
   return 1.0;
 }
 
-bool finitePose(const Pose2& p) {
-  return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.phi);
-}
+bool finitePose(const Pose2& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.phi); }
 
 }  // namespace
 
-RegistrationResult icpWithIndex(const PointSet& reference, const NearestNeighbours& index,
-                                const std::vector<LineNormal>& normals, const PointSet& moving,
-                                const Pose2& guess, const IcpOptions& options) {
+RegistrationResult icpWithIndex(const PointSet& reference, const NearestNeighbours& index, const std::vector<LineNormal>& normals,
+                                const PointSet& moving, const Pose2& guess, const IcpOptions& options) {
   RegistrationResult result;
   result.transform = guess;
   const int min_matches = std::max(3, options.min_matches);
   if (static_cast<int>(reference.size()) < min_matches || static_cast<int>(moving.size()) < min_matches) {
     std::ostringstream os;
-    os << "too few points (reference " << reference.size() << ", moving " << moving.size()
-       << "; need " << min_matches << ")";
+    os << "too few points (reference " << reference.size() << ", moving " << moving.size() << "; need " << min_matches << ")";
     result.failure_reason = os.str();
     return result;
   }
@@ -99,8 +98,7 @@ RegistrationResult icpWithIndex(const PointSet& reference, const NearestNeighbou
     associate(pose, gate);
     if (static_cast<int>(src.size()) < min_matches) {
       std::ostringstream os;
-      os << "only " << src.size() << " associations within the " << gate << " m gate (need "
-         << min_matches << ")";
+      os << "only " << src.size() << " associations within the " << gate << " m gate (need " << min_matches << ")";
       result.failure_reason = os.str();
       result.iterations = it;
       result.transform = pose;
@@ -174,8 +172,8 @@ RegistrationResult icpWithIndex(const PointSet& reference, const NearestNeighbou
     result.failure_reason = os.str();
   } else if (static_cast<int>(src.size()) < min_matches || overlap < options.min_overlap) {
     std::ostringstream os;
-    os << "only " << src.size() << " of " << moving.size() << " points ("
-       << static_cast<int>(100 * overlap) << " %) match within " << gate_final << " m";
+    os << "only " << src.size() << " of " << moving.size() << " points (" << static_cast<int>(100 * overlap) << " %) match within "
+       << gate_final << " m";
     result.failure_reason = os.str();
   } else {
     result.converged = true;
@@ -183,14 +181,12 @@ RegistrationResult icpWithIndex(const PointSet& reference, const NearestNeighbou
   return result;
 }
 
-RegistrationResult icp(const PointSet& reference, const PointSet& moving, const Pose2& guess,
-                       const IcpOptions& options) {
+RegistrationResult icp(const PointSet& reference, const PointSet& moving, const Pose2& guess, const IcpOptions& options) {
   const IndexedReference ref(reference);
   return icpWithIndex(ref.points(), ref.index(), {}, moving, guess, options);
 }
 
-RegistrationResult plIcp(const PointSet& reference, const PointSet& moving, const Pose2& guess,
-                         const IcpOptions& options) {
+RegistrationResult plIcp(const PointSet& reference, const PointSet& moving, const Pose2& guess, const IcpOptions& options) {
   const IndexedReference ref(reference);
   return icpWithIndex(ref.points(), ref.index(), ref.normals(options.normals), moving, guess, options);
 }

@@ -12,9 +12,8 @@ std::vector<Eigen::Vector2d> positions(const PointSet& s) {
 }
 
 bool sameOptions(const LineNormalOptions& a, const LineNormalOptions& b) {
-  return a.line_tolerance_m == b.line_tolerance_m && a.max_gap_m == b.max_gap_m &&
-         a.max_gap_range_fraction == b.max_gap_range_fraction && a.min_points == b.min_points &&
-         a.min_length_m == b.min_length_m;
+  return a.line_tolerance_m == b.line_tolerance_m && a.max_gap_m == b.max_gap_m && a.max_gap_range_fraction == b.max_gap_range_fraction &&
+         a.min_points == b.min_points && a.min_length_m == b.min_length_m;
 }
 
 }  // namespace

@@ -37,8 +37,7 @@ struct LineSums {
 bool adjacent(const ScanPoint& a, const ScanPoint& b, const LineNormalOptions& o) {
   const double d = (a.p - b.p).norm();
   if (d < o.max_gap_m) return true;
-  return std::abs(a.beam - b.beam) == 1 &&
-         d < o.max_gap_range_fraction * std::max(a.range_m, b.range_m);
+  return std::abs(a.beam - b.beam) == 1 && d < o.max_gap_range_fraction * std::max(a.range_m, b.range_m);
 }
 
 }  // namespace

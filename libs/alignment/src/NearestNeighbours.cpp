@@ -13,10 +13,11 @@ struct Cloud {
   size_t kdtree_get_point_count() const { return pts.size(); }
   double kdtree_get_pt(size_t i, size_t dim) const { return pts[i][static_cast<int>(dim)]; }
   template <class BBox>
-  bool kdtree_get_bbox(BBox&) const { return false; }
+  bool kdtree_get_bbox(BBox&) const {
+    return false;
+  }
 };
-using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>, Cloud, 2,
-                                                 uint32_t>;
+using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>, Cloud, 2, uint32_t>;
 }  // namespace
 
 struct NearestNeighbours::Impl {
@@ -26,8 +27,7 @@ struct NearestNeighbours::Impl {
 
 NearestNeighbours::NearestNeighbours(std::vector<Eigen::Vector2d> points) : impl_(new Impl) {
   impl_->cloud.pts = std::move(points);
-  if (!impl_->cloud.pts.empty())
-    impl_->tree = std::make_unique<Tree>(2, impl_->cloud, nanoflann::KDTreeSingleIndexAdaptorParams(8));
+  if (!impl_->cloud.pts.empty()) impl_->tree = std::make_unique<Tree>(2, impl_->cloud, nanoflann::KDTreeSingleIndexAdaptorParams(8));
 }
 
 NearestNeighbours::~NearestNeighbours() = default;
@@ -45,8 +45,7 @@ bool NearestNeighbours::nearest(const Eigen::Vector2d& query, int* index, double
   return true;
 }
 
-bool NearestNeighbours::nearestWithin(const Eigen::Vector2d& query, double max_distance_sq, int* index,
-                                      double* distance_sq) const {
+bool NearestNeighbours::nearestWithin(const Eigen::Vector2d& query, double max_distance_sq, int* index, double* distance_sq) const {
   if (!impl_->tree) return false;
   uint32_t idx = 0;
   double d2 = 0;
@@ -63,8 +62,7 @@ bool NearestNeighbours::nearestWithin(const Eigen::Vector2d& query, double max_d
   return true;
 }
 
-size_t NearestNeighbours::knn(const Eigen::Vector2d& query, size_t k, std::vector<int>* indices,
-                              std::vector<double>* distances_sq) const {
+size_t NearestNeighbours::knn(const Eigen::Vector2d& query, size_t k, std::vector<int>* indices, std::vector<double>* distances_sq) const {
   indices->clear();
   distances_sq->clear();
   if (!impl_->tree || k == 0) return 0;

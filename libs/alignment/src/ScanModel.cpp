@@ -5,16 +5,14 @@
 
 namespace urbanslam::alignment {
 
-Eigen::Matrix2d rangeBearingCovariance(double range_m, double max_range_m,
-                                       const ScanModelOptions& options) {
+Eigen::Matrix2d rangeBearingCovariance(double range_m, double max_range_m, const ScanModelOptions& options) {
   const double sr = options.range_sigma_m * (1.0 + range_m / max_range_m);
   Eigen::Matrix2d R;
   R << sr * sr, 0, 0, options.bearing_sigma_rad * options.bearing_sigma_rad;
   return R;
 }
 
-Eigen::Matrix2d cartesianCovariance(double range_m, double bearing_rad, double max_range_m,
-                                    const ScanModelOptions& options) {
+Eigen::Matrix2d cartesianCovariance(double range_m, double bearing_rad, double max_range_m, const ScanModelOptions& options) {
   const double c = std::cos(bearing_rad), s = std::sin(bearing_rad);
   Eigen::Matrix2d J;
   J << c, -range_m * s, s, range_m * c;
@@ -23,8 +21,8 @@ Eigen::Matrix2d cartesianCovariance(double range_m, double bearing_rad, double m
 
 namespace {
 
-PointSet build(size_t n, const std::vector<double>& ranges, const std::vector<double>& bearings,
-               double r_max, const ScanModelOptions& options, const std::vector<uint8_t>& valid) {
+PointSet build(size_t n, const std::vector<double>& ranges, const std::vector<double>& bearings, double r_max,
+               const ScanModelOptions& options, const std::vector<uint8_t>& valid) {
   PointSet out;
   out.reserve(n);
   for (size_t i = 0; i < n; ++i) {
@@ -45,15 +43,14 @@ PointSet build(size_t n, const std::vector<double>& ranges, const std::vector<do
 
 }  // namespace
 
-PointSet makePointSet(const std::vector<double>& ranges_m, const std::vector<double>& bearings_rad,
-                      const ScanModelOptions& options, const std::vector<uint8_t>& valid) {
+PointSet makePointSet(const std::vector<double>& ranges_m, const std::vector<double>& bearings_rad, const ScanModelOptions& options,
+                      const std::vector<uint8_t>& valid) {
   if (ranges_m.size() != bearings_rad.size() || (!valid.empty() && valid.size() != ranges_m.size()))
     throw std::invalid_argument("makePointSet: ranges, bearings and valid differ in length");
   return build(ranges_m.size(), ranges_m, bearings_rad, options.max_range_m, options, valid);
 }
 
-PointSet pointSetFromScan(const io::LaserScan& scan, const ScanModelOptions& options,
-                          bool in_vehicle_frame) {
+PointSet pointSetFromScan(const io::LaserScan& scan, const ScanModelOptions& options, bool in_vehicle_frame) {
   double r_max = options.max_range_m;
   if (scan.max_range_m > 0 && scan.max_range_m < r_max) r_max = scan.max_range_m;
   std::vector<double> ranges(scan.size()), bearings(scan.size());

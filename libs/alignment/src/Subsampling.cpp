@@ -39,8 +39,7 @@ SubsamplingResult subsample(const PointSet& points, int raw_count, const Subsamp
       if (static_cast<int>(e - b) >= m) kept += e - b;
     return kept;
   };
-  while (min_size > 2 && static_cast<double>(keptWith(min_size)) <
-                             options.min_kept_fraction * static_cast<double>(in_range.size()))
+  while (min_size > 2 && static_cast<double>(keptWith(min_size)) < options.min_kept_fraction * static_cast<double>(in_range.size()))
     --min_size;
   out.min_segment_points_used = min_size;
   int id = 0;

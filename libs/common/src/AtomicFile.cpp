@@ -14,15 +14,12 @@ namespace fs = std::filesystem;
 std::string temporaryPathFor(const std::string& path) {
   const fs::path p(path);
   // ".name.partial-PID.ext": hidden, obviously incomplete, but keeps the extension.
-  const std::string name = "." + p.stem().string() + ".partial-" + std::to_string(::getpid()) +
-                           p.extension().string();
+  const std::string name = "." + p.stem().string() + ".partial-" + std::to_string(::getpid()) + p.extension().string();
   return (p.parent_path() / name).string();
 }
 
-AtomicFile::AtomicFile(std::string path, bool binary)
-    : path_(std::move(path)), temp_(temporaryPathFor(path_)) {
-  out_.open(temp_, binary ? std::ios::out | std::ios::binary | std::ios::trunc
-                          : std::ios::out | std::ios::trunc);
+AtomicFile::AtomicFile(std::string path, bool binary) : path_(std::move(path)), temp_(temporaryPathFor(path_)) {
+  out_.open(temp_, binary ? std::ios::out | std::ios::binary | std::ios::trunc : std::ios::out | std::ios::trunc);
   if (!out_) throw InputError(path_ + ": cannot write (is the folder writable?)");
 }
 
@@ -37,13 +34,11 @@ void AtomicFile::commit() {
   out_.flush();
   if (!out_) throw InputError(path_ + ": write failed (disk full?)");
   out_.close();
-  if (std::rename(temp_.c_str(), path_.c_str()) != 0)
-    throw InputError(path_ + ": cannot rename the finished file into place");
+  if (std::rename(temp_.c_str(), path_.c_str()) != 0) throw InputError(path_ + ": cannot rename the finished file into place");
   committed_ = true;
 }
 
-void writeAtomically(const std::string& path,
-                     const std::function<void(const std::string& tmp)>& write) {
+void writeAtomically(const std::string& path, const std::function<void(const std::string& tmp)>& write) {
   const std::string tmp = temporaryPathFor(path);
   try {
     write(tmp);

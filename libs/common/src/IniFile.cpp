@@ -66,8 +66,7 @@ IniFile IniFile::parse(const std::string& text, const std::string& name) {
     if (e.key.empty()) throw ConfigError(where + "empty key");
     for (const auto& other : ini.entries_)
       if (other.section == e.section && other.key == e.key)
-        throw ConfigError(where + "[" + section + "] " + e.key + " is set twice (first on line " +
-                          std::to_string(other.line) + ")");
+        throw ConfigError(where + "[" + section + "] " + e.key + " is set twice (first on line " + std::to_string(other.line) + ")");
     ini.entries_.push_back(std::move(e));
   }
   return ini;

@@ -46,11 +46,21 @@ std::string jsonEscape(const std::string& s) {
   out.reserve(s.size() + 2);
   for (unsigned char c : s) {
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\r': out += "\\r"; break;
-      case '\t': out += "\\t"; break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
       default:
         if (c < 0x20) {
           char buf[8];
@@ -77,17 +87,28 @@ void Json::dumpTo(std::string& out, int indent, int depth) const {
     out.append(static_cast<size_t>(indent * d), ' ');
   };
   switch (type_) {
-    case Type::Null: out += "null"; break;
-    case Type::Bool: out += bool_ ? "true" : "false"; break;
-    case Type::Integer: out += std::to_string(integer_); break;
+    case Type::Null:
+      out += "null";
+      break;
+    case Type::Bool:
+      out += bool_ ? "true" : "false";
+      break;
+    case Type::Integer:
+      out += std::to_string(integer_);
+      break;
     case Type::Number: {
-      if (!std::isfinite(number_)) { out += "null"; break; }
+      if (!std::isfinite(number_)) {
+        out += "null";
+        break;
+      }
       char buf[32];
       std::snprintf(buf, sizeof buf, "%.15g", number_);
       out += buf;
       break;
     }
-    case Type::String: out += '"' + jsonEscape(string_) + '"'; break;
+    case Type::String:
+      out += '"' + jsonEscape(string_) + '"';
+      break;
     case Type::Array:
     case Type::Object: {
       const bool obj = type_ == Type::Object;

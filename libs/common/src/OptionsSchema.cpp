@@ -32,20 +32,16 @@ long parseInt(const std::string& s, const std::string& where) {
   errno = 0;
   char* end = nullptr;
   const long v = std::strtol(s.c_str(), &end, 10);
-  if (s.empty() || end != s.c_str() + s.size() || errno == ERANGE)
-    throw ConfigError(where + "'" + s + "' is not a whole number");
+  if (s.empty() || end != s.c_str() + s.size() || errno == ERANGE) throw ConfigError(where + "'" + s + "' is not a whole number");
   return v;
 }
 
 }  // namespace
 
-void OptionsSchema::section(const std::string& name, const std::string& doc) {
-  sections_.push_back({name, doc});
-}
+void OptionsSchema::section(const std::string& name, const std::string& doc) { sections_.push_back({name, doc}); }
 
-OptionsSchema::Option& OptionsSchema::push(const std::string& key, const std::string& unit,
-                                           const std::string& range, const std::string& doc,
-                                           bool required) {
+OptionsSchema::Option& OptionsSchema::push(const std::string& key, const std::string& unit, const std::string& range,
+                                           const std::string& doc, bool required) {
   if (sections_.empty()) throw std::logic_error("OptionsSchema: add() before section()");
   Option o;
   o.section = sections_.back().name;
@@ -58,27 +54,23 @@ OptionsSchema::Option& OptionsSchema::push(const std::string& key, const std::st
   return options_.back();
 }
 
-void OptionsSchema::add(const std::string& key, double& value, double min, double max,
-                        const std::string& unit, const std::string& doc, bool required) {
+void OptionsSchema::add(const std::string& key, double& value, double min, double max, const std::string& unit, const std::string& doc,
+                        bool required) {
   Option& o = push(key, unit, "[" + formatDouble(min) + ", " + formatDouble(max) + "]", doc, required);
   o.set = [&value, min, max](const std::string& s, const std::string& where) {
     const double v = parseDouble(s, where);
-    if (v < min || v > max)
-      throw ConfigError(where + s + " is out of range [" + formatDouble(min) + ", " +
-                        formatDouble(max) + "]");
+    if (v < min || v > max) throw ConfigError(where + s + " is out of range [" + formatDouble(min) + ", " + formatDouble(max) + "]");
     value = v;
   };
   o.get = [&value] { return formatDouble(value); };
 }
 
-void OptionsSchema::add(const std::string& key, int& value, int min, int max,
-                        const std::string& unit, const std::string& doc, bool required) {
+void OptionsSchema::add(const std::string& key, int& value, int min, int max, const std::string& unit, const std::string& doc,
+                        bool required) {
   Option& o = push(key, unit, "[" + std::to_string(min) + ", " + std::to_string(max) + "]", doc, required);
   o.set = [&value, min, max](const std::string& s, const std::string& where) {
     const long v = parseInt(s, where);
-    if (v < min || v > max)
-      throw ConfigError(where + s + " is out of range [" + std::to_string(min) + ", " +
-                        std::to_string(max) + "]");
+    if (v < min || v > max) throw ConfigError(where + s + " is out of range [" + std::to_string(min) + ", " + std::to_string(max) + "]");
     value = static_cast<int>(v);
   };
   o.get = [&value] { return std::to_string(value); };
@@ -87,15 +79,17 @@ void OptionsSchema::add(const std::string& key, int& value, int min, int max,
 void OptionsSchema::add(const std::string& key, bool& value, const std::string& doc, bool required) {
   Option& o = push(key, "", "true|false", doc, required);
   o.set = [&value](const std::string& s, const std::string& where) {
-    if (s == "1" || s == "true" || s == "yes" || s == "on") value = true;
-    else if (s == "0" || s == "false" || s == "no" || s == "off") value = false;
-    else throw ConfigError(where + "'" + s + "' is not a boolean (true/false/1/0)");
+    if (s == "1" || s == "true" || s == "yes" || s == "on")
+      value = true;
+    else if (s == "0" || s == "false" || s == "no" || s == "off")
+      value = false;
+    else
+      throw ConfigError(where + "'" + s + "' is not a boolean (true/false/1/0)");
   };
   o.get = [&value] { return std::string(value ? "true" : "false"); };
 }
 
-void OptionsSchema::add(const std::string& key, std::string& value,
-                        const std::vector<std::string>& choices, const std::string& doc,
+void OptionsSchema::add(const std::string& key, std::string& value, const std::vector<std::string>& choices, const std::string& doc,
                         bool required) {
   std::string range;
   for (const auto& c : choices) range += (range.empty() ? "" : "|") + c;

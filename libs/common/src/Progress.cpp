@@ -9,8 +9,11 @@ namespace urbanslam::common {
 bool ProgressBar::stderrIsTerminal() { return ::isatty(STDERR_FILENO) == 1; }
 
 ProgressBar::ProgressBar(std::string label, uint64_t total, bool enabled)
-    : label_(std::move(label)), total_(total), enabled_(enabled && stderrIsTerminal()),
-      start_(std::chrono::steady_clock::now()), last_draw_(start_ - std::chrono::seconds(1)) {}
+    : label_(std::move(label)),
+      total_(total),
+      enabled_(enabled && stderrIsTerminal()),
+      start_(std::chrono::steady_clock::now()),
+      last_draw_(start_ - std::chrono::seconds(1)) {}
 
 ProgressBar::~ProgressBar() { finish(); }
 
@@ -30,11 +33,9 @@ void ProgressBar::draw(uint64_t done, const std::string& status) {
     const int filled = static_cast<int>(f * kWidth);
     std::string bar(static_cast<size_t>(filled), '#');
     bar.append(static_cast<size_t>(kWidth - filled), '.');
-    std::fprintf(stderr, "\r%s [%s] %3.0f%% %.1fs %s\033[K", label_.c_str(), bar.c_str(), 100 * f,
-                 elapsed, status.c_str());
+    std::fprintf(stderr, "\r%s [%s] %3.0f%% %.1fs %s\033[K", label_.c_str(), bar.c_str(), 100 * f, elapsed, status.c_str());
   } else {
-    std::fprintf(stderr, "\r%s %llu %.1fs %s\033[K", label_.c_str(),
-                 static_cast<unsigned long long>(done), elapsed, status.c_str());
+    std::fprintf(stderr, "\r%s %llu %.1fs %s\033[K", label_.c_str(), static_cast<unsigned long long>(done), elapsed, status.c_str());
   }
   std::fflush(stderr);
 }

@@ -21,9 +21,9 @@ InformationForm informationFromCovariance(const Eigen::MatrixXd& p, const Eigen:
   const Eigen::MatrixXd pvt = p.bottomLeftCorner(nv, nt), pvv = p.bottomRightCorner(nv, nv);
   const Eigen::LDLT<Eigen::MatrixXd> ptt_f(ptt);
   const Eigen::MatrixXd ptt_inv = ptt_f.solve(Eigen::MatrixXd::Identity(nt, nt));
-  const Eigen::MatrixXd delta = pvv - pvt * ptt_inv * ptv;                 // eq. 2.8
+  const Eigen::MatrixXd delta = pvv - pvt * ptt_inv * ptv;  // eq. 2.8
   const Eigen::MatrixXd di = delta.ldlt().solve(Eigen::MatrixXd::Identity(nv, nv));
-  const Eigen::MatrixXd g = ptt_inv * ptv * di;                            // P_tt^-1 P_tv Delta^-1
+  const Eigen::MatrixXd g = ptt_inv * ptv * di;  // P_tt^-1 P_tv Delta^-1
   // eq. 2.7
   out.lambda.topLeftCorner(nt, nt) = ptt_inv + g * pvt * ptt_inv;
   out.lambda.topRightCorner(nt, nv) = -g;

@@ -9,8 +9,7 @@
 
 namespace urbanslam::esdf {
 
-Esdf::Esdf(EsdfOptions options)
-    : options_(options), full_factor_(options.ordering) {}
+Esdf::Esdf(EsdfOptions options) : options_(options), full_factor_(options.ordering) {}
 Esdf::~Esdf() = default;
 
 void Esdf::reserve(int poses) {
@@ -196,8 +195,7 @@ void Esdf::predict(std::shared_ptr<const MotionModel> model, const VecU& u, cons
 }
 
 ObservationResult Esdf::observeRelative(int i, int j, const Vec3& z, const Mat3& omega, bool gate) {
-  if (i < 0 || j < 0 || i >= size() || j >= size() || i == j)
-    throw std::out_of_range("observeRelative: bad pose indices");
+  if (i < 0 || j < 0 || i >= size() || j >= size() || i == j) throw std::out_of_range("observeRelative: bad pose indices");
   Factor f{Factor::Kind::Relative, i, j, z, omega, 0, nullptr, state_.mean(i), state_.mean(j)};
   const Linearisation l = linearise(f, f.lin_a, f.lin_b);
   ObservationResult r;
@@ -384,9 +382,8 @@ Mat3 Esdf::marginalCovariance(int i, CovarianceMode mode) { return jointCovarian
 
 Mat6 Esdf::jointCovariance(int i, int j, CovarianceMode mode) {
   if (i < 0 || j < 0 || i >= size() || j >= size()) throw std::out_of_range("jointCovariance: bad pose");
-  if (mode == CovarianceMode::Conservative && full_factor_.valid() && chain_valid_ &&
-      full_factor_.last() == chain_base_ && chain_base_ > 0 && full_factor_.first() == 0 &&
-      static_cast<int>(chain_phi_.size()) == size() - chain_base_)
+  if (mode == CovarianceMode::Conservative && full_factor_.valid() && chain_valid_ && full_factor_.last() == chain_base_ &&
+      chain_base_ > 0 && full_factor_.first() == 0 && static_cast<int>(chain_phi_.size()) == size() - chain_base_)
     return conservativeJoint(i, j);
   ensureFactor();
   const int n = size();
@@ -439,8 +436,7 @@ Mat6 Esdf::conservativeJoint(int i, int j) {
 }
 
 size_t Esdf::memoryBytes() const {
-  return state_.memoryBytes() + factors_.capacity() * sizeof(Factor) +
-         first_factor_of_pose_.capacity() * sizeof(int) +
+  return state_.memoryBytes() + factors_.capacity() * sizeof(Factor) + first_factor_of_pose_.capacity() * sizeof(int) +
          (chain_phi_.capacity() + chain_cov_.capacity()) * sizeof(Mat3);
 }
 

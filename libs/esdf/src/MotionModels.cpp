@@ -12,15 +12,11 @@ Vec3 SteeringModel::predict(const Vec3& x, const VecU& u, double dt, Mat3* f_x, 
   const double v = u(0), steer = u(1), wb = opt_.wheelbase_m;
   const double ca = std::cos(x.z() + steer), sa = std::sin(x.z() + steer);
   if (f_x) {
-    *f_x << 1, 0, -dt * v * sa,
-            0, 1, dt * v * ca,
-            0, 0, 1;
+    *f_x << 1, 0, -dt * v * sa, 0, 1, dt * v * ca, 0, 0, 1;
   }
   if (f_u) {
     f_u->resize(3, 2);
-    *f_u << dt * ca, -dt * v * sa,
-            dt * sa, dt * v * ca,
-            dt * std::sin(steer) / wb, dt * v * std::cos(steer) / wb;
+    *f_u << dt * ca, -dt * v * sa, dt * sa, dt * v * ca, dt * std::sin(steer) / wb, dt * v * std::cos(steer) / wb;
   }
   return {x.x() + dt * v * ca, x.y() + dt * v * sa, x.z() + dt * v * std::sin(steer) / wb};
 }
@@ -33,15 +29,11 @@ Vec3 TurnRateModel::predict(const Vec3& x, const VecU& u, double dt, Mat3* f_x, 
   // Eq. 2.13a: the input matrix G(phi) with x(k+1) = x(k) + Ts G u.
   const double g12 = -h * c - t1, g22 = -h * s + t2;
   if (f_x) {
-    *f_x << 1, 0, dt * (-s * v + (h * s - t2) * w),
-            0, 1, dt * (c * v - (h * c + t1) * w),
-            0, 0, 1;
+    *f_x << 1, 0, dt * (-s * v + (h * s - t2) * w), 0, 1, dt * (c * v - (h * c + t1) * w), 0, 0, 1;
   }
   if (f_u) {
     f_u->resize(3, 2);
-    *f_u << dt * c, dt * g12,
-            dt * s, dt * g22,
-            0, dt;
+    *f_u << dt * c, dt * g12, dt * s, dt * g22, 0, dt;
   }
   return {x.x() + dt * (c * v + g12 * w), x.y() + dt * (s * v + g22 * w), x.z() + dt * w};
 }
@@ -66,8 +58,8 @@ Mat3 processCovariance(const MatU& f_u, const MatQ& q_v, const Vec3& q_s) {
 Mat3 processInformation(const MatU& f_u, const MatQ& q_v, const Vec3& q_s) {
   if ((q_s.array() > 0).all()) {
     const Vec3 qs_inv = q_s.cwiseInverse();
-    const MatU qsi_fu = qs_inv.asDiagonal() * f_u;                  // Q_s^-1 F_u
-    MatQ inner = q_v.inverse() + f_u.transpose() * qsi_fu;          // 2x2 (or 3x3)
+    const MatU qsi_fu = qs_inv.asDiagonal() * f_u;          // Q_s^-1 F_u
+    MatQ inner = q_v.inverse() + f_u.transpose() * qsi_fu;  // 2x2 (or 3x3)
     Mat3 info = -qsi_fu * inner.ldlt().solve(qsi_fu.transpose());
     info.diagonal() += qs_inv;
     return 0.5 * (info + info.transpose());

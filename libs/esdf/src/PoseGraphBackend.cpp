@@ -86,8 +86,7 @@ PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBa
       if (aug < 0) aug = q;
     }
     if (aug < 0)
-      throw common::InputError("pose graph: vertex " + std::to_string(ids[k]) +
-                               " has no edge to an earlier vertex (disconnected graph)");
+      throw common::InputError("pose graph: vertex " + std::to_string(ids[k]) + " has no edge to an earlier vertex (disconnected graph)");
     double max_chi2 = 0;
     int closures = 0;
     // The augmenting edge first (the new pose must exist before it is observed).

@@ -85,9 +85,7 @@ PoseGraph parsePoseGraph(const std::string& text, const std::string& name) {
   bool seen_g2o = false, seen_toro = false;
   std::string_view rest(text);
   long lineno = 0;
-  auto fail = [&](const std::string& what) {
-    throw common::InputError(name + ":" + std::to_string(lineno) + ": " + what);
-  };
+  auto fail = [&](const std::string& what) { throw common::InputError(name + ":" + std::to_string(lineno) + ": " + what); };
   while (!rest.empty()) {
     ++lineno;
     const size_t eol = std::min(rest.find('\n'), rest.size());
@@ -117,9 +115,19 @@ PoseGraph parsePoseGraph(const std::string& text, const std::string& name) {
       // g2o: upper triangle row-major, i11 i12 i13 i22 i23 i33. TORO: ff fs ss rr fr sr.
       double xx, xy, xt, yy, yt, tt;
       if (toro) {
-        xx = p[3]; xy = p[4]; yy = p[5]; tt = p[6]; xt = p[7]; yt = p[8];
+        xx = p[3];
+        xy = p[4];
+        yy = p[5];
+        tt = p[6];
+        xt = p[7];
+        yt = p[8];
       } else {
-        xx = p[3]; xy = p[4]; xt = p[5]; yy = p[6]; yt = p[7]; tt = p[8];
+        xx = p[3];
+        xy = p[4];
+        xt = p[5];
+        yy = p[6];
+        yt = p[7];
+        tt = p[8];
       }
       e.information << xx, xy, xt, xy, yy, yt, xt, yt, tt;
       // A singular or indefinite information matrix would make Lambda singular far from here.
@@ -143,20 +151,17 @@ std::string formatPoseGraph(const PoseGraph& g, PoseGraphFormat format) {
   char buf[512];
   const bool toro = format == PoseGraphFormat::Toro;
   for (const auto& v : g.vertices) {
-    std::snprintf(buf, sizeof buf, "%s %ld %.17g %.17g %.17g\n", toro ? "VERTEX2" : "VERTEX_SE2", v.id,
-                  v.pose.x(), v.pose.y(), v.pose.z());
+    std::snprintf(buf, sizeof buf, "%s %ld %.17g %.17g %.17g\n", toro ? "VERTEX2" : "VERTEX_SE2", v.id, v.pose.x(), v.pose.y(), v.pose.z());
     out += buf;
   }
   for (const auto& e : g.edges) {
     const Mat3& i = e.information;
     if (toro)
-      std::snprintf(buf, sizeof buf, "EDGE2 %ld %ld %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", e.from,
-                    e.to, e.measurement.x(), e.measurement.y(), e.measurement.z(), i(0, 0), i(0, 1), i(1, 1), i(2, 2),
-                    i(0, 2), i(1, 2));
+      std::snprintf(buf, sizeof buf, "EDGE2 %ld %ld %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", e.from, e.to,
+                    e.measurement.x(), e.measurement.y(), e.measurement.z(), i(0, 0), i(0, 1), i(1, 1), i(2, 2), i(0, 2), i(1, 2));
     else
-      std::snprintf(buf, sizeof buf, "EDGE_SE2 %ld %ld %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n",
-                    e.from, e.to, e.measurement.x(), e.measurement.y(), e.measurement.z(), i(0, 0), i(0, 1), i(0, 2),
-                    i(1, 1), i(1, 2), i(2, 2));
+      std::snprintf(buf, sizeof buf, "EDGE_SE2 %ld %ld %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", e.from, e.to,
+                    e.measurement.x(), e.measurement.y(), e.measurement.z(), i(0, 0), i(0, 1), i(0, 2), i(1, 1), i(1, 2), i(2, 2));
     out += buf;
   }
   return out;

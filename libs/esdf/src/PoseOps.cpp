@@ -13,14 +13,10 @@ void composeJacobians(const Vec3& a, const Vec3& b, Mat3* j1, Mat3* j2) {
   const double c = std::cos(a.z()), s = std::sin(a.z());
   if (j1) {
     // Rows: x, y, phi of the result; d/dphi_a rotates b by 90 degrees.
-    *j1 << 1, 0, -s * b.x() - c * b.y(),
-           0, 1, c * b.x() - s * b.y(),
-           0, 0, 1;
+    *j1 << 1, 0, -s * b.x() - c * b.y(), 0, 1, c * b.x() - s * b.y(), 0, 0, 1;
   }
   if (j2) {
-    *j2 << c, -s, 0,
-           s, c, 0,
-           0, 0, 1;
+    *j2 << c, -s, 0, s, c, 0, 0, 0, 1;
   }
 }
 
@@ -32,9 +28,7 @@ Vec3 inverse(const Vec3& a) {
 Mat3 inverseJacobian(const Vec3& a) {
   const double c = std::cos(a.z()), s = std::sin(a.z());
   Mat3 j;
-  j << -c, -s, s * a.x() - c * a.y(),
-        s, -c, c * a.x() + s * a.y(),
-        0, 0, -1;
+  j << -c, -s, s * a.x() - c * a.y(), s, -c, c * a.x() + s * a.y(), 0, 0, -1;
   return j;
 }
 
@@ -49,14 +43,10 @@ void betweenJacobians(const Vec3& a, const Vec3& b, Mat3* ja, Mat3* jb) {
   const double c = std::cos(a.z()), s = std::sin(a.z());
   const double dx = b.x() - a.x(), dy = b.y() - a.y();
   if (ja) {
-    *ja << -c, -s, -s * dx + c * dy,
-            s, -c, -c * dx - s * dy,
-            0, 0, -1;
+    *ja << -c, -s, -s * dx + c * dy, s, -c, -c * dx - s * dy, 0, 0, -1;
   }
   if (jb) {
-    *jb << c, s, 0,
-          -s, c, 0,
-           0, 0, 1;
+    *jb << c, s, 0, -s, c, 0, 0, 0, 1;
   }
 }
 
@@ -76,21 +66,15 @@ Vec3 relativePoseError(const Vec3& a, const Vec3& b, const Vec3& z, Mat3* ja, Ma
     const double c = cz * ca - sz * sa, s = sz * ca + cz * sa;
     const double gx = -sa * dx + ca * dy, gy = -ca * dx - sa * dy;
     if (ja) {
-      *ja << -c, -s, cz * gx + sz * gy,
-              s, -c, -sz * gx + cz * gy,
-              0, 0, -1;
+      *ja << -c, -s, cz * gx + sz * gy, s, -c, -sz * gx + cz * gy, 0, 0, -1;
     }
     if (jb) {
-      *jb << c, s, 0,
-            -s, c, 0,
-             0, 0, 1;
+      *jb << c, s, 0, -s, c, 0, 0, 0, 1;
     }
   }
   return e;
 }
 
-void relativePoseErrorJacobians(const Vec3& a, const Vec3& b, const Vec3& z, Mat3* ja, Mat3* jb) {
-  relativePoseError(a, b, z, ja, jb);
-}
+void relativePoseErrorJacobians(const Vec3& a, const Vec3& b, const Vec3& z, Mat3* ja, Mat3* jb) { relativePoseError(a, b, z, ja, jb); }
 
 }  // namespace urbanslam::esdf

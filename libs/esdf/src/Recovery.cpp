@@ -37,10 +37,20 @@ struct SparseCholesky::Impl {
   explicit Impl(FillReducingOrdering o) : ordering(o) {
     cholmod_start(&common);
     switch (o) {
-      case FillReducingOrdering::Amd: common.nmethods = 1; common.method[0].ordering = CHOLMOD_AMD; break;
-      case FillReducingOrdering::Metis: common.nmethods = 1; common.method[0].ordering = CHOLMOD_METIS; break;
-      case FillReducingOrdering::Natural: common.nmethods = 1; common.method[0].ordering = CHOLMOD_NATURAL; break;
-      case FillReducingOrdering::Auto: break;  // cholmod_start's defaults
+      case FillReducingOrdering::Amd:
+        common.nmethods = 1;
+        common.method[0].ordering = CHOLMOD_AMD;
+        break;
+      case FillReducingOrdering::Metis:
+        common.nmethods = 1;
+        common.method[0].ordering = CHOLMOD_METIS;
+        break;
+      case FillReducingOrdering::Natural:
+        common.nmethods = 1;
+        common.method[0].ordering = CHOLMOD_NATURAL;
+        break;
+      case FillReducingOrdering::Auto:
+        break;  // cholmod_start's defaults
     }
     common.postorder = 1;
     common.print = 0;
@@ -118,8 +128,7 @@ void SparseCholesky::factorize(const InformationState& s, int first, int last) {
   if (cm->status != CHOLMOD_OK || impl_->factor->minor < n) {
     cholmod_free_factor(&impl_->factor, cm);
     impl_->last_p.clear();
-    throw std::runtime_error("information matrix is not positive definite (CHOLMOD status " +
-                             std::to_string(cm->status) + ")");
+    throw std::runtime_error("information matrix is not positive definite (CHOLMOD status " + std::to_string(cm->status) + ")");
   }
   first_ = first;
   last_ = last;

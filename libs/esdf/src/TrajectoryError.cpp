@@ -76,8 +76,10 @@ std::vector<PoseGraphVertex> readReferencePoses(const std::string& path) {
     if (v.empty() && line.find_first_not_of(" \t\r") == std::string::npos) continue;
     if (!ls.eof() || (v.size() != 3 && v.size() != 4))
       throw common::InputError(path + ":" + std::to_string(lineno) + ": want 'id x y theta' or 'x y theta'");
-    if (v.size() == 4) out.push_back({static_cast<long>(v[0]), Vec3(v[1], v[2], v[3])});
-    else out.push_back({static_cast<long>(out.size()), Vec3(v[0], v[1], v[2])});
+    if (v.size() == 4)
+      out.push_back({static_cast<long>(v[0]), Vec3(v[1], v[2], v[3])});
+    else
+      out.push_back({static_cast<long>(out.size()), Vec3(v[0], v[1], v[2])});
   }
   if (out.empty()) throw common::InputError(path + ": no poses");
   return out;

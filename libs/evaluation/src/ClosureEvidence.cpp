@@ -16,8 +16,7 @@ bool samePose(const common::Pose2& p, const common::Pose2& q) {
 
 }  // namespace
 
-ClosureEvidence weighClosure(const io::LaserScan& a, const io::LaserScan& b, const common::Pose2& run,
-                             const common::Pose2& reference) {
+ClosureEvidence weighClosure(const io::LaserScan& a, const io::LaserScan& b, const common::Pose2& run, const common::Pose2& reference) {
   ClosureEvidence e;
   if (a.validCount() == 0 || b.validCount() == 0) {
     e.verdict = "no_scans";
@@ -30,10 +29,14 @@ ClosureEvidence weighClosure(const io::LaserScan& a, const io::LaserScan& b, con
   const auto r = alignment::align(a, b, reference, o);
   e.from_reference = r.transform;
   e.matched_fraction = r.matchedFraction();
-  if (!r.converged) e.verdict = "neither";
-  else if (samePose(r.transform, run)) e.verdict = "run";
-  else if (samePose(r.transform, reference)) e.verdict = "reference";
-  else e.verdict = "neither";
+  if (!r.converged)
+    e.verdict = "neither";
+  else if (samePose(r.transform, run))
+    e.verdict = "run";
+  else if (samePose(r.transform, reference))
+    e.verdict = "reference";
+  else
+    e.verdict = "neither";
   return e;
 }
 

@@ -88,8 +88,8 @@ bool relationError(const std::vector<io::StampedPose>& t, const Relation& r, dou
 
 }  // namespace
 
-RelationMetrics relationMetrics(const std::vector<io::StampedPose>& traj, const std::vector<Relation>& rel,
-                                double time_offset_s, double max_gap_s) {
+RelationMetrics relationMetrics(const std::vector<io::StampedPose>& traj, const std::vector<Relation>& rel, double time_offset_s,
+                                double max_gap_s) {
   const auto t = shifted(traj, time_offset_s);
   std::vector<double> tr, tr2, rot, rot2;
   RelationMetrics m;
@@ -114,9 +114,8 @@ RelationMetrics relationMetrics(const std::vector<io::StampedPose>& traj, const 
   return m;
 }
 
-RelationsByScans relationsByScans(const std::vector<io::StampedPose>& traj, const std::vector<Relation>& rel,
-                                  double time_offset_s, const std::vector<double>& scan_times, double max_gap_s,
-                                  double at_scan_s) {
+RelationsByScans relationsByScans(const std::vector<io::StampedPose>& traj, const std::vector<Relation>& rel, double time_offset_s,
+                                  const std::vector<double>& scan_times, double max_gap_s, double at_scan_s) {
   const auto t = shifted(traj, time_offset_s);
   std::vector<double> s = scan_times;
   for (double& x : s) x += time_offset_s;
@@ -128,8 +127,8 @@ RelationsByScans relationsByScans(const std::vector<io::StampedPose>& traj, cons
   const auto oneInterval = [&](double a, double b) {
     if (a > b) std::swap(a, b);
     const auto first_after = std::upper_bound(s.begin(), s.end(), a + at_scan_s);  // no scan within at_scan_s of a ...
-    return first_after != s.begin() && first_after != s.end() && *(first_after - 1) < a - at_scan_s &&
-           *first_after > b + at_scan_s;  // ... none up to b either, and one on each side
+    return first_after != s.begin() && first_after != s.end() &&
+           *(first_after - 1)<a - at_scan_s&& * first_after> b + at_scan_s;  // ... none up to b either, and one on each side
   };
   RelationsByScans out;
   size_t used = 0;
@@ -284,7 +283,11 @@ std::vector<LoopRow> readLoopClosuresCsv(const std::string& path) {
     while (std::getline(ss, cell, ',')) f.push_back(cell);
     if (f.size() < 11) throw common::InputError(path + ":" + std::to_string(n) + ": expected 14 columns");
     try {
-      out.push_back({std::stol(f[0]), std::stol(f[1]), std::stod(f[2]), std::stod(f[3]), f[6] == "1",
+      out.push_back({std::stol(f[0]),
+                     std::stol(f[1]),
+                     std::stod(f[2]),
+                     std::stod(f[3]),
+                     f[6] == "1",
                      {std::stod(f[8]), std::stod(f[9]), std::stod(f[10])}});
     } catch (const std::exception&) {
       throw common::InputError(path + ":" + std::to_string(n) + ": malformed number");
@@ -293,8 +296,8 @@ std::vector<LoopRow> readLoopClosuresCsv(const std::string& path) {
   return out;
 }
 
-LoopMetrics classifyLoopClosures(const std::vector<LoopRow>& loops, const std::vector<io::StampedPose>& reference,
-                                 bool positions_only, double tol_m, double tol_deg) {
+LoopMetrics classifyLoopClosures(const std::vector<LoopRow>& loops, const std::vector<io::StampedPose>& reference, bool positions_only,
+                                 double tol_m, double tol_deg) {
   LoopMetrics m;
   const auto ref = shifted(reference, 0);
   for (const auto& l : loops) {

@@ -108,8 +108,7 @@ MapAccuracyMetrics mapAccuracy(const std::vector<io::MapPoint>& points, const co
   const double c = std::cos(to_truth.phi), s = std::sin(to_truth.phi);
   std::vector<double> d;
   d.reserve(points.size());
-  for (const auto& p : points)
-    d.push_back(index.nearest(to_truth.x + c * p.x - s * p.y, to_truth.y + s * p.x + c * p.y, cap_m));
+  for (const auto& p : points) d.push_back(index.nearest(to_truth.x + c * p.x - s * p.y, to_truth.y + s * p.x + c * p.y, cap_m));
   m.points = d.size();
   double sum = 0;
   size_t near = 0, far = 0;

@@ -21,8 +21,7 @@ using detail::setBeamGeometry;
 namespace {
 
 bool samePose(const Pose2& a, const Pose2& b) {
-  return std::abs(a.x - b.x) < 1e-9 && std::abs(a.y - b.y) < 1e-9 &&
-         std::abs(common::wrapToPi(a.phi - b.phi)) < 1e-9;
+  return std::abs(a.x - b.x) < 1e-9 && std::abs(a.y - b.y) < 1e-9 && std::abs(common::wrapToPi(a.phi - b.phi)) < 1e-9;
 }
 
 // The step of a number as printed: "2670.16" -> 0.01, "1.13487e+09" -> 1e4, "42" -> 1.
@@ -90,8 +89,7 @@ void CarmenReader::prescan() {
       any_odom_lines_ = true;
       const Pose2 p{parseNumber(f[1], where, "x"), parseNumber(f[2], where, "y"), parseNumber(f[3], where, "theta")};
       // An anchor that differs from the odometry just before it is a corrected pose.
-      if (after_scan && samePose(p, scan_pose) && have_prev_odom && !samePose(p, prev_odom))
-        info_.corrected = true;
+      if (after_scan && samePose(p, scan_pose) && have_prev_odom && !samePose(p, prev_odom)) info_.corrected = true;
       prev_odom = p;
       have_prev_odom = true;
       if (f.size() >= 8) noteStampFormat(f[7]);
@@ -101,8 +99,7 @@ void CarmenReader::prescan() {
       const long n = parseInteger(f[1], where, "beam count");
       if (n >= 0 && f.size() >= static_cast<size_t>(n) + 9) {
         any_scan = true;
-        scan_pose = {parseNumber(f[static_cast<size_t>(n) + 2], where, "x"),
-                     parseNumber(f[static_cast<size_t>(n) + 3], where, "y"),
+        scan_pose = {parseNumber(f[static_cast<size_t>(n) + 2], where, "x"), parseNumber(f[static_cast<size_t>(n) + 3], where, "y"),
                      parseNumber(f[static_cast<size_t>(n) + 4], where, "theta")};
         after_scan = f[0] == "FLASER";
         const std::string& token = f[static_cast<size_t>(n) + 8];
@@ -129,10 +126,14 @@ void CarmenReader::handleParam(const std::vector<std::string>& f) {
     const double v = std::strtod(f[2].c_str(), &end);
     if (end != f[2].c_str() && std::isfinite(v)) dst = v;
   };
-  if (f[1] == "robot_front_laser_max") num(info_.front_max_range_m);
-  else if (f[1] == "robot_rear_laser_max") num(info_.rear_max_range_m);
-  else if (f[1] == "robot_frontlaser_offset") num(info_.front_offset_m);
-  else if (f[1] == "robot_rearlaser_offset") num(info_.rear_offset_m);
+  if (f[1] == "robot_front_laser_max")
+    num(info_.front_max_range_m);
+  else if (f[1] == "robot_rear_laser_max")
+    num(info_.rear_max_range_m);
+  else if (f[1] == "robot_frontlaser_offset")
+    num(info_.front_offset_m);
+  else if (f[1] == "robot_rearlaser_offset")
+    num(info_.rear_offset_m);
 }
 
 double CarmenReader::progress() const { return text_ ? text_->progress() : 0.0; }
@@ -222,11 +223,16 @@ bool CarmenReader::parseLine(const std::string& line) {
   if (fields_.empty() || fields_[0][0] == '#') return false;
   const std::string where = path_ + ":" + std::to_string(text_->lineNumber());
   const std::string& tag = fields_[0];
-  if (tag == "ODOM") handleOdom(fields_, where);
-  else if (tag == "FLASER") handleLaser(fields_, where, false);
-  else if (tag == "RLASER") handleLaser(fields_, where, true);
-  else if (tag == "ROBOTLASER1") handleRobotLaser(fields_, where);
-  else if (tag == "PARAM" && fields_.size() >= 3) handleParam(fields_);
+  if (tag == "ODOM")
+    handleOdom(fields_, where);
+  else if (tag == "FLASER")
+    handleLaser(fields_, where, false);
+  else if (tag == "RLASER")
+    handleLaser(fields_, where, true);
+  else if (tag == "ROBOTLASER1")
+    handleRobotLaser(fields_, where);
+  else if (tag == "PARAM" && fields_.size() >= 3)
+    handleParam(fields_);
   // NEFF, SYNC, TRUEPOS, RAWLASER*, SONAR, ...: not used.
   // Only the ODOM line right after a scan can be an anchor (handlers set/clear the flag).
   if (tag != "ODOM" && tag != "FLASER" && tag != "RLASER" && tag != "ROBOTLASER1") last_was_scan_ = false;
@@ -236,8 +242,7 @@ bool CarmenReader::parseLine(const std::string& line) {
 void CarmenReader::handleOdom(const std::vector<std::string>& f, const std::string& where) {
   // ODOM x y theta tv rv accel timestamp hostname logger_timestamp
   if (f.size() < 8) throw InputError(where + ": truncated ODOM line (" + std::to_string(f.size()) + " fields, need 8)");
-  const Pose2 p{parseNumber(f[1], where, "x"), parseNumber(f[2], where, "y"),
-                common::wrapToPi(parseNumber(f[3], where, "theta"))};
+  const Pose2 p{parseNumber(f[1], where, "x"), parseNumber(f[2], where, "y"), common::wrapToPi(parseNumber(f[3], where, "theta"))};
   const double ts = lineStamp(f[7], where, false);
   const bool anchor = last_was_scan_ && samePose(p, last_scan_pose_);
   last_was_scan_ = false;
@@ -274,8 +279,7 @@ void CarmenReader::handleLaser(const std::vector<std::string>& f, const std::str
   if (n <= 0 || n > 100000) throw InputError(where + ": invalid beam count " + f[1]);
   const size_t nn = static_cast<size_t>(n);
   if (f.size() < nn + 9)
-    throw InputError(where + ": truncated laser line (" + std::to_string(f.size()) + " fields, need " +
-                     std::to_string(nn + 9) + ")");
+    throw InputError(where + ": truncated laser line (" + std::to_string(f.size()) + " fields, need " + std::to_string(nn + 9) + ")");
   LaserScan scan;
   scan.label = rear ? "RLASER" : "FLASER";
   scan.max_range_m = rear ? info_.rear_max_range_m : info_.front_max_range_m;
@@ -303,8 +307,7 @@ void CarmenReader::handleRobotLaser(const std::vector<std::string>& f, const std
   const size_t nn = static_cast<size_t>(n);
   if (f.size() < 9 + nn + 1) throw InputError(where + ": truncated ROBOTLASER1 line");
   const long m = parseInteger(f[9 + nn], where, "remission count");
-  if (m < 0 || f.size() < 10 + nn + static_cast<size_t>(m) + 13)
-    throw InputError(where + ": truncated ROBOTLASER1 line");
+  if (m < 0 || f.size() < 10 + nn + static_cast<size_t>(m) + 13) throw InputError(where + ": truncated ROBOTLASER1 line");
   const size_t k = 10 + nn + static_cast<size_t>(m);
   LaserScan scan;
   scan.label = "ROBOTLASER1";
@@ -316,8 +319,7 @@ void CarmenReader::handleRobotLaser(const std::vector<std::string>& f, const std
                     common::wrapToPi(parseNumber(f[k + 5], where, "robot_theta"))};
   ++scans_;
   scan.timestamp = lineStamp(f[k + 12], where, true);
-  setBeamGeometry(scan, parseNumber(f[2], where, "start_angle"), parseNumber(f[4], where, "resolution"),
-              common::between(robot, laser));
+  setBeamGeometry(scan, parseNumber(f[2], where, "start_angle"), parseNumber(f[4], where, "resolution"), common::between(robot, laser));
   emitScan(std::move(scan), robot, robot);
   last_was_scan_ = true;
   last_scan_pose_ = robot;

@@ -42,14 +42,22 @@ LogFormat detectLogFormat(const std::string& path) {
 
 std::unique_ptr<DataSource> openDataSource(const std::string& path) {
   switch (detectLogFormat(path)) {
-    case LogFormat::MrptRawlog: return std::make_unique<RawlogReader>(path);
-    case LogFormat::Carmen: return std::make_unique<CarmenReader>(path);
-    case LogFormat::Gfs: return std::make_unique<GfsReader>(path);
-    case LogFormat::VictoriaPark: return std::make_unique<VictoriaParkReader>(path);
-    case LogFormat::ImageFolder: return std::make_unique<ImageFolderSource>(path);
-    case LogFormat::Unknown: break;
+    case LogFormat::MrptRawlog:
+      return std::make_unique<RawlogReader>(path);
+    case LogFormat::Carmen:
+      return std::make_unique<CarmenReader>(path);
+    case LogFormat::Gfs:
+      return std::make_unique<GfsReader>(path);
+    case LogFormat::VictoriaPark:
+      return std::make_unique<VictoriaParkReader>(path);
+    case LogFormat::ImageFolder:
+      return std::make_unique<ImageFolderSource>(path);
+    case LogFormat::Unknown:
+      break;
   }
-  throw InputError(path + ": unrecognised format (expected an MRPT rawlog, a CARMEN log, a GMapping gfs log, a Victoria Park folder/zip or a folder of images)");
+  throw InputError(path +
+                   ": unrecognised format (expected an MRPT rawlog, a CARMEN log, a GMapping gfs log, a Victoria Park folder/zip or a "
+                   "folder of images)");
 }
 
 }  // namespace urbanslam::io

@@ -51,12 +51,13 @@ bool GfsReader::parseLine(const std::string& line) {
     if (r > 0) max_range_m_ = r;
   } else if (f[0] == "ODOM") {
     if (f.size() < 5) throw InputError(where + ": truncated ODOM line (" + std::to_string(f.size()) + " fields, need 5)");
-    const Pose2 p{parseNumber(f[1], where, "x"), parseNumber(f[2], where, "y"),
-                  common::wrapToPi(parseNumber(f[3], where, "theta"))};
+    const Pose2 p{parseNumber(f[1], where, "x"), parseNumber(f[2], where, "y"), common::wrapToPi(parseNumber(f[3], where, "theta"))};
     const double t = parseNumber(f[4], where, "timestamp");
     // This line's pose was measured at the previous line's time.
-    if (!any_odometry_) emitOdometry(t, p);  // GMapping starts from the first reading's own pose
-    else if (have_held_) emitOdometry(held_time_, p);
+    if (!any_odometry_)
+      emitOdometry(t, p);  // GMapping starts from the first reading's own pose
+    else if (have_held_)
+      emitOdometry(held_time_, p);
     have_held_ = true;
     held_time_ = t;
   } else if (f[0] == "LASER_READING") {
@@ -65,8 +66,8 @@ bool GfsReader::parseLine(const std::string& line) {
     if (n <= 0 || n > 100000) throw InputError(where + ": invalid beam count " + f[1]);
     const size_t nn = static_cast<size_t>(n);
     if (f.size() < nn + 6)
-      throw InputError(where + ": truncated LASER_READING line (" + std::to_string(f.size()) + " fields, need " +
-                       std::to_string(nn + 6) + ")");
+      throw InputError(where + ": truncated LASER_READING line (" + std::to_string(f.size()) + " fields, need " + std::to_string(nn + 6) +
+                       ")");
     LaserScan scan;
     scan.label = "FLASER";
     scan.max_range_m = max_range_m_;

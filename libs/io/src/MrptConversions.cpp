@@ -50,8 +50,7 @@ LaserScan fromMrptScan(const mrpt::obs::CObservation2DRangeScan& o, const std::s
     const float r = o.getScanRange(i);
     const bool ok = o.getScanRangeValidity(i);
     if (ok && (!std::isfinite(r) || r < 0))
-      throw InputError(where + ": laser beam " + std::to_string(i) + " has an invalid range (" +
-                       std::to_string(r) + ")");
+      throw InputError(where + ": laser beam " + std::to_string(i) + " has an invalid range (" + std::to_string(r) + ")");
     s.ranges[i] = std::isfinite(r) ? r : 0.f;
     s.valid[i] = ok && r > 0 && r < o.maxRange ? 1 : 0;
   }
@@ -89,8 +88,8 @@ struct ToMrpt {
     o->sensorLabel = m.label;
     o->image = mrpt::img::CImage(m.width, m.height, mrpt::img::CH_GRAY);
     for (int r = 0; r < m.height; ++r)
-      std::copy_n(m.pixels->data() + static_cast<size_t>(r) * static_cast<size_t>(m.width),
-                  static_cast<size_t>(m.width), o->image.ptrLine<uint8_t>(static_cast<unsigned>(r)));
+      std::copy_n(m.pixels->data() + static_cast<size_t>(r) * static_cast<size_t>(m.width), static_cast<size_t>(m.width),
+                  o->image.ptrLine<uint8_t>(static_cast<unsigned>(r)));
     return o;
   }
   mrpt::obs::CObservation::Ptr operator()(const GpsFix& m) const {

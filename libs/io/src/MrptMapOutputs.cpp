@@ -48,8 +48,7 @@ std::vector<KeyframeScan> readSimpleMap(const std::string& path) {
     }
     const auto obs = sf ? sf->getObservationByClass<mrpt::obs::CObservation2DRangeScan>() : nullptr;
     // A keyframe without returns was written as an empty scan: keep it empty, not an error.
-    if (obs && obs->getScanSize() > 0)
-      out[i].scan = detail::fromMrptScan(*obs, path + ": entry " + std::to_string(i));
+    if (obs && obs->getScanSize() > 0) out[i].scan = detail::fromMrptScan(*obs, path + ": entry " + std::to_string(i));
   }
   return out;
 }
@@ -60,18 +59,25 @@ std::pair<int, int> writeOccupancyGrid(const std::string& prefix, const std::vec
   double x0 = 0, x1 = 0, y0 = 0, y1 = 0;
   bool first = true;
   for (const auto& p : mapPoints(scans)) {
-    if (first) { x0 = x1 = p.x; y0 = y1 = p.y; first = false; }
-    x0 = std::min<double>(x0, p.x); x1 = std::max<double>(x1, p.x);
-    y0 = std::min<double>(y0, p.y); y1 = std::max<double>(y1, p.y);
+    if (first) {
+      x0 = x1 = p.x;
+      y0 = y1 = p.y;
+      first = false;
+    }
+    x0 = std::min<double>(x0, p.x);
+    x1 = std::max<double>(x1, p.x);
+    y0 = std::min<double>(y0, p.y);
+    y1 = std::max<double>(y1, p.y);
   }
   for (const auto& ps : scans) {
-    x0 = std::min(x0, ps.pose.x); x1 = std::max(x1, ps.pose.x);
-    y0 = std::min(y0, ps.pose.y); y1 = std::max(y1, ps.pose.y);
+    x0 = std::min(x0, ps.pose.x);
+    x1 = std::max(x1, ps.pose.x);
+    y0 = std::min(y0, ps.pose.y);
+    y1 = std::max(y1, ps.pose.y);
   }
   const double margin = 1.0;
-  mrpt::maps::COccupancyGridMap2D grid(static_cast<float>(x0 - margin), static_cast<float>(x1 + margin),
-                                        static_cast<float>(y0 - margin), static_cast<float>(y1 + margin),
-                                        static_cast<float>(options.resolution_m));
+  mrpt::maps::COccupancyGridMap2D grid(static_cast<float>(x0 - margin), static_cast<float>(x1 + margin), static_cast<float>(y0 - margin),
+                                       static_cast<float>(y1 + margin), static_cast<float>(options.resolution_m));
   grid.insertionOptions.maxDistanceInsertion = 80.f;
   grid.insertionOptions.wideningBeamsWithDistance = false;
   for (const auto& ps : scans) {
@@ -89,8 +95,7 @@ std::pair<int, int> writeOccupancyGrid(const std::string& prefix, const std::vec
   std::snprintf(buf, sizeof buf,
                 "image: %s\nresolution: %.6f\norigin: [%.6f, %.6f, 0.0]\nnegate: 0\n"
                 "occupied_thresh: %.3f\nfree_thresh: %.3f\n",
-                image.c_str(), grid.getResolution(), grid.getXMin(), grid.getYMin(),
-                options.occupied_thresh, options.free_thresh);
+                image.c_str(), grid.getResolution(), grid.getXMin(), grid.getYMin(), options.occupied_thresh, options.free_thresh);
   yaml.stream() << buf;
   yaml.commit();
   return {static_cast<int>(grid.getSizeX()), static_cast<int>(grid.getSizeY())};

@@ -18,8 +18,7 @@ std::vector<MapPoint> mapPoints(const std::vector<PosedScan>& scans, int decimat
     const double c = std::cos(ps.pose.phi), s = std::sin(ps.pose.phi);
     for (const auto& p : scanToPoints(*ps.scan, true)) {
       if (k++ % step) continue;
-      pts.push_back({static_cast<float>(ps.pose.x + c * p.x - s * p.y),
-                     static_cast<float>(ps.pose.y + s * p.x + c * p.y), 0.f});
+      pts.push_back({static_cast<float>(ps.pose.x + c * p.x - s * p.y), static_cast<float>(ps.pose.y + s * p.x + c * p.y), 0.f});
     }
   }
   return pts;
@@ -30,8 +29,7 @@ void writePly(const std::string& path, const std::vector<MapPoint>& pts, PlyEnco
   common::AtomicFile f(path, binary);
   auto& os = f.stream();
   os << "ply\nformat " << (binary ? "binary_little_endian" : "ascii") << " 1.0\n"
-     << "comment urbanslam map\nelement vertex " << pts.size()
-     << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+     << "comment urbanslam map\nelement vertex " << pts.size() << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
   if (binary) {
     static_assert(sizeof(MapPoint) == 12, "MapPoint must be three packed floats");
     // x86-64 is little-endian, as the header says.
@@ -50,8 +48,7 @@ void writePcd(const std::string& path, const std::vector<MapPoint>& pts) {
   common::AtomicFile f(path);
   auto& os = f.stream();
   os << "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\n"
-     << "TYPE F F F\nCOUNT 1 1 1\nWIDTH " << pts.size() << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS "
-     << pts.size() << "\nDATA ascii\n";
+     << "TYPE F F F\nCOUNT 1 1 1\nWIDTH " << pts.size() << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << pts.size() << "\nDATA ascii\n";
   char buf[96];
   for (const auto& p : pts) {
     std::snprintf(buf, sizeof buf, "%.4f %.4f %.4f\n", p.x, p.y, p.z);

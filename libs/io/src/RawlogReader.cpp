@@ -53,7 +53,6 @@ class GzMrptStream : public mrpt::io::CStream {
   uint64_t pos_ = 0;
 };
 
-
 }  // namespace
 
 struct RawlogReader::Impl {
@@ -118,8 +117,7 @@ struct RawlogReader::Impl {
       obj = arch.ReadObject();
     } catch (const mrpt::serialization::CExceptionEOF&) {
       ended = true;
-      if (stream.getPosition() != before)
-        throw InputError(where() + ": truncated rawlog (file ends inside an entry)");
+      if (stream.getPosition() != before) throw InputError(where() + ": truncated rawlog (file ends inside an entry)");
       if (entries == 0) throw InputError(path + ": empty file (no rawlog entries)");
       return false;
     } catch (const InputError&) {
@@ -142,8 +140,8 @@ struct RawlogReader::Impl {
       ++observations;
       addObservation(o);
     } else {
-      throw InputError(where() + ": unexpected object of class " +
-                       std::string(obj ? obj->GetRuntimeClass()->className : "null") + " (not a rawlog?)");
+      throw InputError(where() + ": unexpected object of class " + std::string(obj ? obj->GetRuntimeClass()->className : "null") +
+                       " (not a rawlog?)");
     }
     return true;
   }

@@ -94,9 +94,7 @@ class ZipEntryStream : public ByteStream {
     done_ += static_cast<uint64_t>(got);
     return static_cast<size_t>(got);
   }
-  double progress() const override {
-    return size_ ? std::min(1.0, static_cast<double>(done_) / static_cast<double>(size_)) : 1.0;
-  }
+  double progress() const override { return size_ ? std::min(1.0, static_cast<double>(done_) / static_cast<double>(size_)) : 1.0; }
 
  private:
   std::string name_;
@@ -107,16 +105,13 @@ class ZipEntryStream : public ByteStream {
 
 }  // namespace
 
-std::unique_ptr<ByteStream> openGzFile(const std::string& path) {
-  return std::make_unique<GzFileStream>(path);
-}
+std::unique_ptr<ByteStream> openGzFile(const std::string& path) { return std::make_unique<GzFileStream>(path); }
 
 std::unique_ptr<ByteStream> openZipEntry(const std::string& zip_path, const std::string& entry) {
   return std::make_unique<ZipEntryStream>(zip_path, entry);
 }
 
-TextScanner::TextScanner(std::unique_ptr<ByteStream> in, std::string name)
-    : in_(std::move(in)), name_(std::move(name)), buf_(1 << 16) {}
+TextScanner::TextScanner(std::unique_ptr<ByteStream> in, std::string name) : in_(std::move(in)), name_(std::move(name)), buf_(1 << 16) {}
 
 bool TextScanner::fill() {
   if (eof_) return false;
@@ -182,10 +177,8 @@ double parseNumber(const std::string& field, const std::string& where, const cha
   errno = 0;
   char* end = nullptr;
   const double v = std::strtod(field.c_str(), &end);
-  if (field.empty() || end != field.c_str() + field.size())
-    throw InputError(where + ": " + what + " '" + field + "' is not a number");
-  if (!std::isfinite(v))
-    throw InputError(where + ": " + what + " is " + field + " (NaN or infinite)");
+  if (field.empty() || end != field.c_str() + field.size()) throw InputError(where + ": " + what + " '" + field + "' is not a number");
+  if (!std::isfinite(v)) throw InputError(where + ": " + what + " is " + field + " (NaN or infinite)");
   return v;
 }
 

@@ -51,8 +51,8 @@ long parseInteger(const std::string& field, const std::string& where, const char
 
 // n laser ranges from fields[first..]: NaN, infinite and negative ranges are corrupt input (an
 // error), 0 and ranges at or beyond max_range are no-returns (valid = 0).
-void parseRanges(const std::vector<std::string>& fields, size_t first, size_t n, double max_range,
-                 const std::string& where, std::vector<float>& ranges, std::vector<uint8_t>& valid);
+void parseRanges(const std::vector<std::string>& fields, size_t first, size_t n, double max_range, const std::string& where,
+                 std::vector<float>& ranges, std::vector<uint8_t>& valid);
 
 // Line-oriented logs: a line yields any number of records, which go out one at a time in file
 // order. Parses lines with parse(line), which appends to pending, until one yields a record.

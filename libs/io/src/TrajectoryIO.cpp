@@ -17,8 +17,8 @@ void writeTum(const std::string& path, const std::vector<StampedPose>& poses) {
   os << "# timestamp x y z qx qy qz qw\n";
   char buf[256];
   for (const auto& p : poses) {
-    std::snprintf(buf, sizeof buf, "%.6f %.6f %.6f 0 0 0 %.9f %.9f\n", p.timestamp, p.pose.x, p.pose.y,
-                  std::sin(p.pose.phi / 2), std::cos(p.pose.phi / 2));
+    std::snprintf(buf, sizeof buf, "%.6f %.6f %.6f 0 0 0 %.9f %.9f\n", p.timestamp, p.pose.x, p.pose.y, std::sin(p.pose.phi / 2),
+                  std::cos(p.pose.phi / 2));
     os << buf;
   }
   f.commit();

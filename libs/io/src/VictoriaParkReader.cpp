@@ -45,8 +45,7 @@ struct VictoriaParkReader::Impl {
     s.ranges.resize(kBeams);
     s.valid.resize(kBeams);
     for (int k = 0; k < kBeams; ++k) {
-      if (!laser->nextToken(token))
-        throw InputError(where + ": truncated (" + std::to_string(k) + " of 361 ranges)");
+      if (!laser->nextToken(token)) throw InputError(where + ": truncated (" + std::to_string(k) + " of 361 ranges)");
       const double r = detail::parseNumber(token, where, "range");
       if (r < 0) throw InputError(where + ": negative range " + token);
       s.ranges[static_cast<size_t>(k)] = static_cast<float>(r);
@@ -65,8 +64,7 @@ struct VictoriaParkReader::Impl {
     while (t.nextLine(line)) {
       detail::splitFields(line, fields);
       if (fields.empty()) continue;
-      if (fields.size() < need)
-        throw InputError(t.name() + ":" + std::to_string(t.lineNumber()) + ": truncated " + what + " line");
+      if (fields.size() < need) throw InputError(t.name() + ":" + std::to_string(t.lineNumber()) + ": truncated " + what + " line");
       return true;
     }
     return false;
@@ -116,9 +114,12 @@ bool VictoriaParkReader::next(Measurement& out) {
     if (c->has_value() && (!best || timestampOf(**c) < timestampOf(**best))) best = c;
   if (!best) return false;
   out = std::move(**best);
-  if (best == &impl_->next_laser) impl_->readLaser();
-  else if (best == &impl_->next_drs) impl_->readDrs();
-  else impl_->readGps();
+  if (best == &impl_->next_laser)
+    impl_->readLaser();
+  else if (best == &impl_->next_drs)
+    impl_->readDrs();
+  else
+    impl_->readGps();
   return true;
 }
 

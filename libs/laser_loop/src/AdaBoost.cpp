@@ -18,8 +18,8 @@ AdaBoostTrainer::AdaBoostTrainer(const PairTable& data, std::vector<uint32_t> su
   for (uint32_t i : subset_) n_pos += data.y[i];
   const size_t n_neg = subset_.size() - n_pos;
   if (n_pos == 0 || n_neg == 0)
-    throw common::InputError("AdaBoost needs both matching and non-matching pairs (got " + std::to_string(n_pos) +
-                             " positive, " + std::to_string(n_neg) + " negative)");
+    throw common::InputError("AdaBoost needs both matching and non-matching pairs (got " + std::to_string(n_pos) + " positive, " +
+                             std::to_string(n_neg) + " negative)");
   w_.assign(data.size(), 0.0);
   for (uint32_t i : subset_) w_[i] = data.y[i] ? 1.0 / (2.0 * n_pos) : 1.0 / (2.0 * n_neg);
   // c does not change between rounds, only the weights: sort once per feature.

@@ -38,8 +38,7 @@ class Parser {
     errno = 0;
     char* end = nullptr;
     const double v = std::strtod(s.c_str(), &end);
-    if (s.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(v))
-      fail(line, what + ": '" + s + "' is not a finite number");
+    if (s.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(v)) fail(line, what + ": '" + s + "' is not a finite number");
     return v;
   }
   long integer(const std::string& s, size_t line, const std::string& what) const {
@@ -87,8 +86,8 @@ std::string modelToText(const ClassifierModel& m) {
   os << "\n";
   os << "stumps " << m.classifier.size() << "\n";
   for (const auto& s : m.classifier.stumps())
-    os << "stump " << featureName(s.stump.feature) << " " << num(s.stump.threshold) << " "
-       << (s.stump.polarity > 0 ? "+1" : "-1") << " " << num(s.alpha) << "\n";
+    os << "stump " << featureName(s.stump.feature) << " " << num(s.stump.threshold) << " " << (s.stump.polarity > 0 ? "+1" : "-1") << " "
+       << num(s.alpha) << "\n";
   os << "end\n";
   return os.str();
 }
@@ -130,8 +129,8 @@ ClassifierModel parseModel(const std::string& text, const std::string& source) {
         p.fail(ln, std::string("not a laser loop-closure model (expected '") + kModelMagic + " <version>' on the first line)");
       const long v = p.integer(f[1], ln, "format version");
       if (v != kModelFormatVersion)
-        p.fail(ln, "model format version " + f[1] + " is not supported (this build reads version " +
-                       std::to_string(kModelFormatVersion) + ")");
+        p.fail(ln,
+               "model format version " + f[1] + " is not supported (this build reads version " + std::to_string(kModelFormatVersion) + ")");
       have_magic = true;
       continue;
     }
@@ -167,9 +166,12 @@ ClassifierModel parseModel(const std::string& text, const std::string& source) {
     } else if (key == "log_features") {
       // Optional: models written before the option existed compare the plain features.
       need(2);
-      if (f[1] == "1") m.params.log_features = true;
-      else if (f[1] == "0") m.params.log_features = false;
-      else p.fail(ln, "log_features must be 0 or 1, got '" + f[1] + "'");
+      if (f[1] == "1")
+        m.params.log_features = true;
+      else if (f[1] == "0")
+        m.params.log_features = false;
+      else
+        p.fail(ln, "log_features must be 0 or 1, got '" + f[1] + "'");
     } else if (key == "submap_window_m") {
       // Optional: models written before the option existed use each scan alone.
       need(2);
@@ -192,8 +194,8 @@ ClassifierModel parseModel(const std::string& text, const std::string& source) {
         p.fail(ln, "the model has " + f[1] + " features; this build computes " + std::to_string(kFeatureCount));
       for (int i = 0; i < kFeatureCount; ++i)
         if (f[static_cast<size_t>(i) + 2] != featureName(i))
-          p.fail(ln, "feature " + std::to_string(i) + " is '" + f[static_cast<size_t>(i) + 2] + "', this build has '" +
-                         featureName(i) + "' (a model from a different feature set)");
+          p.fail(ln, "feature " + std::to_string(i) + " is '" + f[static_cast<size_t>(i) + 2] + "', this build has '" + featureName(i) +
+                         "' (a model from a different feature set)");
       have_features = true;
     } else if (key == "stumps") {
       need(2);
@@ -205,9 +207,12 @@ ClassifierModel parseModel(const std::string& text, const std::string& source) {
       s.stump.feature = featureIndex(f[1]);
       if (s.stump.feature < 0) p.fail(ln, "unknown feature '" + f[1] + "'");
       s.stump.threshold = p.number(f[2], ln, "threshold");
-      if (f[3] == "+1" || f[3] == "1") s.stump.polarity = 1;
-      else if (f[3] == "-1") s.stump.polarity = -1;
-      else p.fail(ln, "polarity must be +1 or -1, got '" + f[3] + "'");
+      if (f[3] == "+1" || f[3] == "1")
+        s.stump.polarity = 1;
+      else if (f[3] == "-1")
+        s.stump.polarity = -1;
+      else
+        p.fail(ln, "polarity must be +1 or -1, got '" + f[3] + "'");
       s.alpha = p.number(f[4], ln, "alpha");
       if (s.alpha < 0) p.fail(ln, "alpha must be >= 0");
       stumps.push_back(s);
@@ -230,8 +235,7 @@ ClassifierModel parseModel(const std::string& text, const std::string& source) {
   if (declared_stumps < 0) missing += " stumps";
   if (!missing.empty()) p.fail(ln, "missing required key(s):" + missing);
   if (static_cast<long>(stumps.size()) != declared_stumps)
-    p.fail(ln, "'stumps " + std::to_string(declared_stumps) + "' declared but " + std::to_string(stumps.size()) +
-                   " stump lines found");
+    p.fail(ln, "'stumps " + std::to_string(declared_stumps) + "' declared but " + std::to_string(stumps.size()) + " stump lines found");
   if (stumps.empty()) p.fail(ln, "the model has no stumps");
   m.classifier = StrongClassifier(std::move(stumps));
   return m;

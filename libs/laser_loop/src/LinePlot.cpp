@@ -19,8 +19,10 @@ cv::Scalar bgr(int c) { return cv::Scalar(c >> 16 & 255, c >> 8 & 255, c & 255);
 
 std::string label(double v) {
   char buf[32];
-  if (v != 0 && (std::fabs(v) < 1e-2 || std::fabs(v) >= 1e4)) std::snprintf(buf, sizeof buf, "%.0e", v);
-  else std::snprintf(buf, sizeof buf, "%.3g", v);
+  if (v != 0 && (std::fabs(v) < 1e-2 || std::fabs(v) >= 1e4))
+    std::snprintf(buf, sizeof buf, "%.0e", v);
+  else
+    std::snprintf(buf, sizeof buf, "%.3g", v);
   return buf;
 }
 
@@ -72,8 +74,10 @@ void drawPanel(cv::Mat& img, int x0, const PlotPanel& p) {
       q.y = std::clamp(q.y, clip.y, clip.y + clip.height - 1);
       pts.push_back(q);
     }
-    if (pts.size() >= 2) cv::polylines(img, pts, false, bgr(s.color_bgr), 2, cv::LINE_AA);
-    else if (pts.size() == 1) cv::circle(img, pts[0], 3, bgr(s.color_bgr), cv::FILLED);
+    if (pts.size() >= 2)
+      cv::polylines(img, pts, false, bgr(s.color_bgr), 2, cv::LINE_AA);
+    else if (pts.size() == 1)
+      cv::circle(img, pts[0], 3, bgr(s.color_bgr), cv::FILLED);
     if (!s.name.empty()) {
       cv::line(img, {x0 + kLeft + pw - 150, legend_y - 4}, {x0 + kLeft + pw - 125, legend_y - 4}, bgr(s.color_bgr), 2);
       cv::putText(img, s.name, {x0 + kLeft + pw - 120, legend_y}, font, 0.4, black, 1, cv::LINE_AA);

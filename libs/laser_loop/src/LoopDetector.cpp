@@ -39,9 +39,7 @@ size_t LoopDetector::addKeyframe(const FeatureVector& f) {
   return keyframes_.size() - 1;
 }
 
-double LoopDetector::score(const FeatureVector& q, size_t id) const {
-  return model_.classifier.score(q, keyframes_.at(id));
-}
+double LoopDetector::score(const FeatureVector& q, size_t id) const { return model_.classifier.score(q, keyframes_.at(id)); }
 
 std::vector<LoopDetector::Match> LoopDetector::query(const FeatureVector& q, const std::vector<size_t>& candidates) const {
   std::vector<Match> out;
@@ -64,8 +62,8 @@ struct BlockStump {
   int polarity;
 };
 
-__attribute__((target_clones("avx2", "default")))
-void screenBlock(const BlockStump* stumps, size_t n_stumps, size_t base, size_t m, float inv_total, float* out) {
+__attribute__((target_clones("avx2", "default"))) void screenBlock(const BlockStump* stumps, size_t n_stumps, size_t base, size_t m,
+                                                                   float inv_total, float* out) {
   constexpr size_t kBlock = 512;
   alignas(64) float acc[kBlock];
   for (size_t i = 0; i < kBlock; ++i) acc[i] = 0.f;
@@ -96,8 +94,7 @@ void LoopDetector::screen(const FeatureVector& query, std::vector<float>& scores
   bs.reserve(stumps_.size());
   for (const auto& st : stumps_)
     bs.push_back({columns_[static_cast<size_t>(st.column)].data(),
-                  static_cast<float>(query[used_features_[static_cast<size_t>(st.column)]]), st.threshold, st.alpha,
-                  st.polarity});
+                  static_cast<float>(query[used_features_[static_cast<size_t>(st.column)]]), st.threshold, st.alpha, st.polarity});
   for (size_t base = 0; base < n; base += kBlock)
     screenBlock(bs.data(), bs.size(), base, std::min(kBlock, n - base), inv_total, scores.data());
 }

@@ -18,8 +18,8 @@ void writeCvCsv(const std::string& path, const CvCurve& cv) {
   os << "T,false_alarms,missed,fa_rate,md_rate,total_rate\n";
   char buf[160];
   for (size_t t = 0; t < cv.total_rate.size(); ++t) {
-    std::snprintf(buf, sizeof buf, "%zu,%zu,%zu,%.6f,%.6f,%.6f\n", t + 1, cv.false_alarms[t], cv.missed[t], cv.fa_rate[t],
-                  cv.md_rate[t], cv.total_rate[t]);
+    std::snprintf(buf, sizeof buf, "%zu,%zu,%zu,%.6f,%.6f,%.6f\n", t + 1, cv.false_alarms[t], cv.missed[t], cv.fa_rate[t], cv.md_rate[t],
+                  cv.total_rate[t]);
     os << buf;
   }
   f.commit();

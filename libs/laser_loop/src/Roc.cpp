@@ -26,14 +26,14 @@ OperatingPoint Roc::at(double fa) const {
     return op;
   }
   const double bar = neg_[k];
-  const size_t detected = static_cast<size_t>(
-      std::lower_bound(pos_.begin(), pos_.end(), bar, [](double a, double b) { return a > b; }) - pos_.begin());
+  const size_t detected =
+      static_cast<size_t>(std::lower_bound(pos_.begin(), pos_.end(), bar, [](double a, double b) { return a > b; }) - pos_.begin());
   op.detection = static_cast<double>(detected) / static_cast<double>(pos_.size());
   op.false_alarm = static_cast<double>(k) / static_cast<double>(neg_.size());
   op.threshold = std::nextafter(bar, std::numeric_limits<double>::infinity());
   // The actual false alarms at that threshold are the negatives strictly above bar (≤ k).
-  const size_t fas = static_cast<size_t>(
-      std::lower_bound(neg_.begin(), neg_.end(), bar, [](double a, double b) { return a > b; }) - neg_.begin());
+  const size_t fas =
+      static_cast<size_t>(std::lower_bound(neg_.begin(), neg_.end(), bar, [](double a, double b) { return a > b; }) - neg_.begin());
   op.false_alarm = static_cast<double>(fas) / static_cast<double>(neg_.size());
   return op;
 }
@@ -64,8 +64,7 @@ std::vector<RocPoint> Roc::curve(size_t max_points) const {
 double Roc::auc() const {
   const auto c = curve(std::numeric_limits<size_t>::max());
   double a = 0;
-  for (size_t i = 1; i < c.size(); ++i)
-    a += (c[i].false_alarm - c[i - 1].false_alarm) * 0.5 * (c[i].detection + c[i - 1].detection);
+  for (size_t i = 1; i < c.size(); ++i) a += (c[i].false_alarm - c[i - 1].false_alarm) * 0.5 * (c[i].detection + c[i - 1].detection);
   return a;
 }
 

@@ -8,21 +8,35 @@ namespace urbanslam::laser_loop {
 
 namespace {
 
-constexpr const char* kNames[kFeatureCount] = {
-    "area",           "average_range",     "mean_centroid",        "clamped_centroid",
-    "close_area",     "close_distance",    "circularity_residual", "circularity_radius",
-    "curvature_mean", "curvature_std",     "distance",             "far_distance",
-    "group_count",    "group_mean_size",   "max_range_count",      "mean_angular_difference",
-    "mean_deviation", "regularity",        "size",                 "std_range"};
+constexpr const char* kNames[kFeatureCount] = {"area",
+                                               "average_range",
+                                               "mean_centroid",
+                                               "clamped_centroid",
+                                               "close_area",
+                                               "close_distance",
+                                               "circularity_residual",
+                                               "circularity_radius",
+                                               "curvature_mean",
+                                               "curvature_std",
+                                               "distance",
+                                               "far_distance",
+                                               "group_count",
+                                               "group_mean_size",
+                                               "max_range_count",
+                                               "mean_angular_difference",
+                                               "mean_deviation",
+                                               "regularity",
+                                               "size",
+                                               "std_range"};
 
 // The beams as unit vectors plus ranges: the hot path for regular scans reuses cached cos/sin
 // tables, merged scans compute them once.
 struct Beams {
   size_t n = 0;
-  const double* r = nullptr;       // raw ranges (only read for short beams)
+  const double* r = nullptr;  // raw ranges (only read for short beams)
   const uint8_t* valid = nullptr;
-  const double* c = nullptr;       // cos(bearing)
-  const double* s = nullptr;       // sin(bearing)
+  const double* c = nullptr;  // cos(bearing)
+  const double* s = nullptr;  // sin(bearing)
   double increment = 0;
   bool closed = false;
 };
@@ -52,8 +66,8 @@ FeatureVector compute(const Beams& b, const FeatureParams& p) {
   const double rmax = p.r_max_m;
 
   // Per-beam data in one pass: short flag, clamped point (far beams at r_max) and short point.
-  thread_local std::vector<double> xs, ys;      // clamped points
-  thread_local std::vector<uint8_t> sh;         // short beams
+  thread_local std::vector<double> xs, ys;  // clamped points
+  thread_local std::vector<uint8_t> sh;     // short beams
   xs.resize(n);
   ys.resize(n);
   sh.resize(n);
@@ -124,8 +138,10 @@ FeatureVector compute(const Beams& b, const FeatureParams& p) {
     if (b.closed) {
       size_t k = 0;
       while (k < n && link[k]) ++k;
-      if (k == n) ring = true;
-      else start = (k + 1) % n;
+      if (k == n)
+        ring = true;
+      else
+        start = (k + 1) % n;
     }
     size_t groups = 0, grouped_points = 0;
     if (ring) {

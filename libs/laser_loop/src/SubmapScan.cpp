@@ -16,8 +16,7 @@ SubmapScanBuilder::SubmapScanBuilder(double window_m, double beam_increment_deg,
 }
 
 PolarScan SubmapScanBuilder::add(const common::Pose2& odom, const std::vector<io::LaserScan>& scans) {
-  if (!window_.empty())
-    path_m_ += std::hypot(odom.x - window_.back().pose.x, odom.y - window_.back().pose.y);
+  if (!window_.empty()) path_m_ += std::hypot(odom.x - window_.back().pose.x, odom.y - window_.back().pose.y);
   Entry e;
   e.pose = odom;
   e.path_m = path_m_;

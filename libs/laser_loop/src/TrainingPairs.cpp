@@ -49,11 +49,11 @@ ScanSet loadLabelledScans(const std::string& path, const ScanLoadOptions& opt) {
   bool have_odom = false;
   std::unique_ptr<SubmapScanBuilder> submap;
   if (opt.submap_window_m > 0)
-    submap = std::make_unique<SubmapScanBuilder>(opt.submap_window_m, opt.params.beam_increment_deg > 0 ? opt.params.beam_increment_deg : 1.0,
-                                                 opt.params.r_max_m);
+    submap = std::make_unique<SubmapScanBuilder>(
+        opt.submap_window_m, opt.params.beam_increment_deg > 0 ? opt.params.beam_increment_deg : 1.0, opt.params.r_max_m);
   auto flush = [&] {
     if (group.empty()) return;
-    const FeatureVector f = submap ? computeFeatures(submap->add(group_odom, group), opt.params)
+    const FeatureVector f = submap              ? computeFeatures(submap->add(group_odom, group), opt.params)
                             : group.size() == 1 ? computeFeatures(group[0], opt.params)
                                                 : computeFeatures(mergeScans(group, opt.params.beam_increment_deg), opt.params);
     scans.push_back({group[0].timestamp, f, group_ref});
@@ -95,8 +95,8 @@ ScanSet loadLabelledScans(const std::string& path, const ScanLoadOptions& opt) {
   std::vector<TimedRef> stream_refs = refs;
   std::stable_sort(refs.begin(), refs.end(), by_t);
   std::stable_sort(gps.begin(), gps.end(), by_t);
-  set.reference_kind = refs.empty() ? "GPS (interpolated between fixes within " + std::to_string(opt.gps_max_gap_s) + " s)"
-                                    : "reference poses";
+  set.reference_kind =
+      refs.empty() ? "GPS (interpolated between fixes within " + std::to_string(opt.gps_max_gap_s) + " s)" : "reference poses";
   bool have_prev = false;
   common::Pose2 prev;
   double path_m = 0;

@@ -30,9 +30,12 @@ StumpFit fitStump(const PairTable& data, int feature, const std::vector<uint32_t
     const double err_plus = neg_below + (w_pos - pos_below);
     const double err_minus = total - err_plus;
     double threshold;
-    if (k == 0) threshold = c[order[0]] - 1.0;
-    else if (k == n) threshold = c[order[n - 1]] + 1.0;
-    else threshold = c[order[k - 1]] + 0.5 * (c[order[k]] - c[order[k - 1]]);
+    if (k == 0)
+      threshold = c[order[0]] - 1.0;
+    else if (k == n)
+      threshold = c[order[n - 1]] + 1.0;
+    else
+      threshold = c[order[k - 1]] + 0.5 * (c[order[k]] - c[order[k - 1]]);
     if (err_plus < best.error) best = {{feature, threshold, 1}, err_plus};
     if (err_minus < best.error) best = {{feature, threshold, -1}, err_minus};
   }

@@ -13,8 +13,8 @@ namespace {
 constexpr uint64_t kTagSide = 10, kTagDesign = 11, kTagPark = 12, kTagFurniture = 13, kTagLots = 19, kTagSquare = 20;
 // Looks are drawn from hashes of their own, never from the geometry's generators: the camera's
 // attributes leave the walls the laser sees exactly as they were.
-constexpr uint64_t kTagLook = 14, kTagDesignLook = 15, kTagFurnitureLook = 16, kTagParkLook = 17, kTagDeadEndLook = 18,
-                   kTagCutLook = 21, kTagIslandLook = 22, kTagCutDetail = 23, kTagAvenueTree = 24;
+constexpr uint64_t kTagLook = 14, kTagDesignLook = 15, kTagFurnitureLook = 16, kTagParkLook = 17, kTagDeadEndLook = 18, kTagCutLook = 21,
+                   kTagIslandLook = 22, kTagCutDetail = 23, kTagAvenueTree = 24;
 
 uint32_t lookId(uint64_t h) { return static_cast<uint32_t>(h >> 32) | 1u; }  // 0 stays "no look"
 
@@ -62,8 +62,7 @@ void addObjects(const StreetGrid& g, const std::vector<Object>& objects, std::ve
 }
 
 void addOutline(std::vector<Segment>& out, const std::vector<OutlineVertex>& v) {
-  for (size_t i = 0; i < v.size(); ++i)
-    out.push_back({v[i].p, v[(i + 1) % v.size()].p, v[i].look, static_cast<float>(v[i].u)});
+  for (size_t i = 0; i < v.size(); ++i) out.push_back({v[i].p, v[(i + 1) % v.size()].p, v[i].look, static_cast<float>(v[i].u)});
 }
 
 // A facade along a block side in side coordinates: u along the side, v into the block (v < 0 is
@@ -126,8 +125,8 @@ struct SideFrame {
 // Each facade carries its look: a repeated design's copies share one (the camera sees the same
 // building again), every other facade has its own. Texture coordinates run along the facade's
 // outline from its start, so copies of a design are textured identically wherever they stand.
-void buildSide(const StreetGrid& g, const SideFrame& s, double length, Rng& rng, int i, int j, int k,
-               std::vector<OutlineVertex>& outline, std::vector<Object>& objects) {
+void buildSide(const StreetGrid& g, const SideFrame& s, double length, Rng& rng, int i, int j, int k, std::vector<OutlineVertex>& outline,
+               std::vector<Object>& objects) {
   const auto& o = g.options();
   const size_t side_start = outline.size();
   outline.push_back({s.origin, {}, 0.0});
@@ -181,17 +180,13 @@ void buildSide(const StreetGrid& g, const SideFrame& s, double length, Rng& rng,
 }
 
 // Trees, lamp posts and parked cars on the sidewalk and parking lane beside one block side.
-void buildFurniture(const StreetGrid& g, const SideFrame& s, double length, Rng& rng, int i, int j, int k,
-                    std::vector<Object>& out) {
+void buildFurniture(const StreetGrid& g, const SideFrame& s, double length, Rng& rng, int i, int j, int k, std::vector<Object>& out) {
   const auto& o = g.options();
   const double sw = g.sidewalkWidth(), pk = g.parkingWidth();
   int n = 0;
-  auto look = [&](SurfaceKind kind) {
-    return makeLook(hash64(g.seed(), kTagFurnitureLook, i, j, k * 65536 + n++), kind);
-  };
+  auto look = [&](SurfaceKind kind) { return makeLook(hash64(g.seed(), kTagFurnitureLook, i, j, k * 65536 + n++), kind); };
   if (o.tree_spacing_m > 0 && rng.chance(o.tree_probability)) {
-    for (double u = 4.0 + rng.uniform(0, o.tree_spacing_m); u < length - 4.0;
-         u += o.tree_spacing_m * rng.uniform(0.7, 1.3))
+    for (double u = 4.0 + rng.uniform(0, o.tree_spacing_m); u < length - 4.0; u += o.tree_spacing_m * rng.uniform(0.7, 1.3))
       out.push_back(circleObject(s.at({u, -0.6 * sw}), rng.uniform(0.15, 0.35), 6, look(SurfaceKind::Tree)));
   }
   if (o.lamp_post_spacing_m > 0) {
@@ -204,8 +199,8 @@ void buildFurniture(const StreetGrid& g, const SideFrame& s, double length, Rng&
     for (double u = 5.0; u + 5.0 < length - 5.0; u += 6.0) {
       if (!rng.chance(o.parked_car_probability)) continue;
       const double len = rng.uniform(3.8, 4.9), wid = rng.uniform(1.6, 1.9);
-      out.push_back(rectObject(s.at({u + 2.5 + rng.uniform(-0.4, 0.4), -sw - pk / 2 + rng.uniform(-0.1, 0.1)}), heading,
-                               len, wid, look(SurfaceKind::ParkedCar)));
+      out.push_back(rectObject(s.at({u + 2.5 + rng.uniform(-0.4, 0.4), -sw - pk / 2 + rng.uniform(-0.1, 0.1)}), heading, len, wid,
+                               look(SurfaceKind::ParkedCar)));
     }
   }
 }
@@ -258,8 +253,10 @@ std::vector<OutlineVertex> clipOutline(const std::vector<OutlineVertex>& v, Vec2
     if ((fa >= 0) != (fb >= 0)) {
       const double t = fa / (fa - fb);
       const Vec2 p = a.p + t * (b.p - a.p);
-      if (fa >= 0) out.push_back({p, cut, 0.0});
-      else out.push_back({p, a.look, a.u + t * norm(b.p - a.p)});
+      if (fa >= 0)
+        out.push_back({p, cut, 0.0});
+      else
+        out.push_back({p, a.look, a.u + t * norm(b.p - a.p)});
     }
   }
   return out;
@@ -280,8 +277,7 @@ bool isCutLook(const SurfaceLook& look, const StreetGrid& g, int i, int j, int q
 
 // A building's outline, cut back where a roundabout's ring (at a corner of the block) or a
 // diagonal avenue (across it) needs the room: the pieces that are left.
-std::vector<std::vector<OutlineVertex>> cutBuilding(const StreetGrid& g, int i, int j, int q,
-                                                   std::vector<OutlineVertex> outline) {
+std::vector<std::vector<OutlineVertex>> cutBuilding(const StreetGrid& g, int i, int j, int q, std::vector<OutlineVertex> outline) {
   std::vector<std::vector<OutlineVertex>> pieces;
   int cut_n = 0;
   auto cutLook = [&]() { return makeLook(hash64(g.seed(), kTagCutLook, i, j, q * 64 + cut_n++), SurfaceKind::Facade); };
@@ -328,7 +324,7 @@ std::vector<std::vector<OutlineVertex>> cutBuilding(const StreetGrid& g, int i, 
       const double len = norm(b - a.p);
       if (a.look.kind != SurfaceKind::Facade || a.u != 0.0 || len < 6.0 || !isCutLook(a.look, g, i, j, q, cut_n)) continue;
       const Vec2 dir = (1.0 / len) * (b - a.p), in{-dir.y, dir.x};  // outlines run counter-clockwise
-      double extra = 0;  // texture coordinate gained in the recesses so far
+      double extra = 0;                                             // texture coordinate gained in the recesses so far
       for (double u = rng.uniform(1.5, 3.5);;) {
         const double w = rng.uniform(1.2, 2.8), depth = rng.uniform(0.3, 0.8);
         if (u + w > len - 1.0) break;
@@ -394,10 +390,8 @@ void buildBuildings(const StreetGrid& g, int i, int j, std::vector<Segment>& out
     }
     if (l.x1 - l.x0 < 4.0 || l.y1 - l.y0 < 4.0) continue;
     // Counter-clockwise sides: bottom, right, top, left; v points into the building.
-    const SideFrame sides[4] = {{{l.x0, l.y0}, {1, 0}, {0, 1}},
-                                {{l.x1, l.y0}, {0, 1}, {-1, 0}},
-                                {{l.x1, l.y1}, {-1, 0}, {0, -1}},
-                                {{l.x0, l.y1}, {0, -1}, {1, 0}}};
+    const SideFrame sides[4] = {
+        {{l.x0, l.y0}, {1, 0}, {0, 1}}, {{l.x1, l.y0}, {0, 1}, {-1, 0}}, {{l.x1, l.y1}, {-1, 0}, {0, -1}}, {{l.x0, l.y1}, {0, -1}, {1, 0}}};
     const double lengths[4] = {l.x1 - l.x0, l.y1 - l.y0, l.x1 - l.x0, l.y1 - l.y0};
     std::vector<OutlineVertex> outline;
     for (int k = 0; k < 4; ++k) {
@@ -424,10 +418,8 @@ void generateBlock(const StreetGrid& g, int i, int j, std::vector<Segment>& out)
     buildBuildings(g, i, j, out, objects);
   }
   // Sidewalk furniture along the block's four sides (counter-clockwise, v into the block).
-  const SideFrame sides[4] = {{{b.x0, b.y0}, {1, 0}, {0, 1}},
-                              {{b.x1, b.y0}, {0, 1}, {-1, 0}},
-                              {{b.x1, b.y1}, {-1, 0}, {0, -1}},
-                              {{b.x0, b.y1}, {0, -1}, {1, 0}}};
+  const SideFrame sides[4] = {
+      {{b.x0, b.y0}, {1, 0}, {0, 1}}, {{b.x1, b.y0}, {0, 1}, {-1, 0}}, {{b.x1, b.y1}, {-1, 0}, {0, -1}}, {{b.x0, b.y1}, {0, -1}, {1, 0}}};
   const double lengths[4] = {b.x1 - b.x0, b.y1 - b.y0, b.x1 - b.x0, b.y1 - b.y0};
   for (int k = 0; k < 4; ++k) {
     Rng rng(hash64(g.seed(), kTagFurniture, i, j, k));
@@ -454,8 +446,10 @@ void generateBlock(const StreetGrid& g, int i, int j, std::vector<Segment>& out)
           const Vec2 p = across * nv + (k * sp + r.uniform(-0.25, 0.25) * sp) * u;
           if (!b.contains(p)) continue;
           const SurfaceLook look = makeLook(r.next(), r.chance(0.2) ? SurfaceKind::LampPost : SurfaceKind::Tree);
-          if (look.kind == SurfaceKind::LampPost) addRectangle(out, p, 0.0, 0.2, 0.2, look);
-          else addCircle(out, p, r.uniform(0.2, 0.4), 6, look);
+          if (look.kind == SurfaceKind::LampPost)
+            addRectangle(out, p, 0.0, 0.2, 0.2, look);
+          else
+            addCircle(out, p, r.uniform(0.2, 0.4), 6, look);
         }
       }
   }
@@ -473,8 +467,10 @@ void generateDeadEnd(const StreetGrid& g, int axis, int i, int j, std::vector<Se
   const double lo = g.deadEndClosedAtEnd(axis, i, j) ? mid : s0, hi = g.deadEndClosedAtEnd(axis, i, j) ? s1 : mid;
   const double c = axis == 0 ? a.y : a.x;
   const SurfaceLook look = makeLook(hash64(g.seed(), kTagDeadEndLook, axis, i, j), SurfaceKind::Barrier);
-  if (axis == 0) addPolygon(out, {{lo, c - h}, {hi, c - h}, {hi, c + h}, {lo, c + h}}, look);
-  else addPolygon(out, {{c - h, lo}, {c + h, lo}, {c + h, hi}, {c - h, hi}}, look);
+  if (axis == 0)
+    addPolygon(out, {{lo, c - h}, {hi, c - h}, {hi, c + h}, {lo, c + h}}, look);
+  else
+    addPolygon(out, {{c - h, lo}, {c + h, lo}, {c + h, hi}, {c - h, hi}}, look);
 }
 
 }  // namespace urbanslam::sim

@@ -13,7 +13,7 @@ namespace {
 
 constexpr uint64_t kTagCamera = 50, kTagGround = 51;
 constexpr double kDeg = M_PI / 180.0;
-constexpr int kMaxLayers = 8;    // walls met by one column's ray (low objects let it go on)
+constexpr int kMaxLayers = 8;     // walls met by one column's ray (low objects let it go on)
 constexpr double kFogTone = 212;  // the haze distant things fade into: the sky at the horizon
 
 // Whatever stands as tall as a building ends the column's ray.
@@ -39,10 +39,7 @@ struct Layer {
 }  // namespace
 
 CameraRenderer::CameraRenderer(const CameraOptions& options, const WallRayCaster& walls, uint64_t seed)
-    : options_(options),
-      walls_(walls),
-      seed_(hash64(seed, kTagCamera, options.noise_seed)),
-      ground_seed_(hash64(seed, kTagGround)) {
+    : options_(options), walls_(walls), seed_(hash64(seed, kTagCamera, options.noise_seed)), ground_seed_(hash64(seed, kTagGround)) {
   fx_ = options.width_px / 2.0 / std::tan(options.hfov_deg * kDeg / 2);
   cx_ = options.width_px / 2.0;
   cy_ = options.cy_px < 0 ? options.height_px / 2.0 : options.cy_px;
@@ -57,8 +54,7 @@ std::vector<double> CameraRenderer::columnRanges(const common::Pose2& camera) co
   for (size_t x = 0; x < bearing_.size(); ++x) {
     const double a = camera.phi + bearing_[x];
     RayHit hit;
-    out[x] = walls_.raycast({camera.x, camera.y}, {std::cos(a), std::sin(a)}, options_.max_range_m, hit) ? hit.range
-                                                                                                         : kNoHit;
+    out[x] = walls_.raycast({camera.x, camera.y}, {std::cos(a), std::sin(a)}, options_.max_range_m, hit) ? hit.range : kNoHit;
   }
   return out;
 }
@@ -110,7 +106,10 @@ io::CameraImage CameraRenderer::render(uint64_t index, double timestamp, const c
       const Vec2 g = o + z * fwd + (z * lateral) * left;
       const auto gx = static_cast<int64_t>(std::floor(g.x)), gy = static_cast<int64_t>(std::floor(g.y));
       const double contrast = std::min(1.0, 10.0 / z);
-      const double tone = 100 + contrast * (static_cast<double>(mix64(ground_seed_ ^ static_cast<uint64_t>(gx * 73856093) ^ static_cast<uint64_t>(gy * 19349663)) % 25) - 12);
+      const double tone =
+          100 + contrast * (static_cast<double>(
+                                mix64(ground_seed_ ^ static_cast<uint64_t>(gx * 73856093) ^ static_cast<uint64_t>(gy * 19349663)) % 25) -
+                            12);
       column[ri] = static_cast<float>(kFogTone + (tone - kFogTone) * ground_fog[ri]);
     }
     for (auto it = layers.rbegin(); it != layers.rend(); ++it) {
@@ -138,7 +137,8 @@ io::CameraImage CameraRenderer::render(uint64_t index, double timestamp, const c
         column[static_cast<size_t>(r)] = gain * static_cast<float>(tex.at(col, hh)) + offset;
       }
     }
-    for (int r = 0; r < hgt; ++r) px[static_cast<size_t>(r) * w + x] = static_cast<uint8_t>(std::clamp(column[static_cast<size_t>(r)], 0.f, 255.f) + 0.5f);
+    for (int r = 0; r < hgt; ++r)
+      px[static_cast<size_t>(r) * w + x] = static_cast<uint8_t>(std::clamp(column[static_cast<size_t>(r)], 0.f, 255.f) + 0.5f);
   }
 
   if (options_.noise_sigma > 0) {

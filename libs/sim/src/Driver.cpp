@@ -56,8 +56,10 @@ void Driver::extendPath() {
     if (!path_.empty()) path_.back().speed_limit = std::min(path_.back().speed_limit, lim);
     path_.push_back({p, s, lim});
   };
-  if (path_.empty()) path_.push_back({entry, 0.0, cruise});
-  else push(entry, path_.back().speed_limit);  // the chord across the intersection
+  if (path_.empty())
+    path_.push_back({entry, 0.0, cruise});
+  else
+    push(entry, path_.back().speed_limit);  // the chord across the intersection
   push(exit, limit);
   if (roundabout) {
     // Counter-clockwise round the island (right-hand traffic) on the ring lane's centre line,
@@ -116,10 +118,8 @@ void Driver::control() {
   // Speed: cruise, but slow enough to brake to every speed limit ahead.
   double v = route_.speed_mps;
   for (size_t i = seg_ + 1; i < path_.size() && path_[i].s - s < 150.0; ++i)
-    v = std::min(v, std::sqrt(path_[i].speed_limit * path_[i].speed_limit +
-                              1.6 * vehicle_.max_decel_mps2 * std::max(0.0, path_[i].s - s)));
-  state_.speed_mps += std::clamp(v - state_.speed_mps, -vehicle_.max_decel_mps2 * route_.step_s,
-                                 vehicle_.max_accel_mps2 * route_.step_s);
+    v = std::min(v, std::sqrt(path_[i].speed_limit * path_[i].speed_limit + 1.6 * vehicle_.max_decel_mps2 * std::max(0.0, path_[i].s - s)));
+  state_.speed_mps += std::clamp(v - state_.speed_mps, -vehicle_.max_decel_mps2 * route_.step_s, vehicle_.max_accel_mps2 * route_.step_s);
 }
 
 void Driver::advanceTo(double t) {

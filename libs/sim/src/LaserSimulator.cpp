@@ -12,8 +12,7 @@ constexpr uint64_t kTagLaser = 40;
 constexpr double kDeg = M_PI / 180.0;
 }  // namespace
 
-LaserSimulator::LaserSimulator(const LaserOptions& options, const CityModel& city, const Traffic* traffic,
-                               uint64_t seed)
+LaserSimulator::LaserSimulator(const LaserOptions& options, const CityModel& city, const Traffic* traffic, uint64_t seed)
     : options_(options), city_(city), traffic_(traffic), seed_(seed) {
   increment_ = options.angular_resolution_deg * kDeg;
   const bool full = options.fov_deg >= 360.0 - 1e-9;
@@ -59,7 +58,8 @@ io::LaserScan LaserSimulator::scan(uint64_t index, double t, double timestamp, c
         if (i < 0 || i >= total) continue;
         const double a = sensor.phi + angle_min_ + static_cast<double>(i) * increment_;
         const Vec2 dir{std::cos(a), std::sin(a)};
-        for (const Segment& seg : m.outline) range[static_cast<size_t>(i)] = std::min(range[static_cast<size_t>(i)], raySegment(o, dir, seg));
+        for (const Segment& seg : m.outline)
+          range[static_cast<size_t>(i)] = std::min(range[static_cast<size_t>(i)], raySegment(o, dir, seg));
       }
     }
   }

@@ -89,8 +89,10 @@ NodeId RoutePlanner::advance() {
       }
     for (const NodeId& n : forward)
       if (!has_straight || n != straight) turns.push_back(n);
-    if (has_straight && (turns.empty() || rng_.chance(options_.straight_probability))) next = straight;
-    else if (!turns.empty()) next = turns[rng_.next() % turns.size()];
+    if (has_straight && (turns.empty() || rng_.chance(options_.straight_probability)))
+      next = straight;
+    else if (!turns.empty())
+      next = turns[rng_.next() % turns.size()];
   }
   --budget_;
   previous_ = current_;

@@ -56,7 +56,8 @@ void declareSimOptions(common::OptionsSchema& s, SimOptions& o) {
   s.add("lookahead_min_m", r.lookahead_min_m, 0.5, 50.0, "m", "pure pursuit look-ahead distance, at least");
   s.add("lookahead_s", r.lookahead_s, 0.0, 10.0, "s", "pure pursuit look-ahead in seconds of travel");
   s.add("revisit_probability", r.revisit_probability, 0.0, 1.0, "", "after exploring, drive back to an earlier intersection");
-  s.add("small_loop_probability", r.small_loop_probability, 0.0, 1.0, "", "a return goes to one of the last few intersections (a loop round a block or two) rather than any earlier one");
+  s.add("small_loop_probability", r.small_loop_probability, 0.0, 1.0, "",
+        "a return goes to one of the last few intersections (a loop round a block or two) rather than any earlier one");
   s.add("explore_min_edges", r.explore_min_edges, 1, 1000, "", "street pieces explored before deciding, at least");
   s.add("explore_max_edges", r.explore_max_edges, 1, 1000, "", "... at most");
   s.add("straight_probability", r.straight_probability, 0.0, 1.0, "", "go straight at an intersection while exploring");
@@ -149,10 +150,8 @@ SimOptions loadSimOptions(const std::string& path, std::string* resolved_ini) {
   declareSimOptions(s, o);
   if (!path.empty()) s.load(common::IniFile::load(path));
   const std::string where = path.empty() ? std::string("defaults") : path;
-  if (o.city.block_min_m > o.city.block_max_m)
-    throw common::ConfigError(where + ": [city] block_min_m: larger than block_max_m");
-  if (o.city.facade_min_m > o.city.facade_max_m)
-    throw common::ConfigError(where + ": [city] facade_min_m: larger than facade_max_m");
+  if (o.city.block_min_m > o.city.block_max_m) throw common::ConfigError(where + ": [city] block_min_m: larger than block_max_m");
+  if (o.city.facade_min_m > o.city.facade_max_m) throw common::ConfigError(where + ": [city] facade_min_m: larger than facade_max_m");
   if (o.city.buildings_per_block_min > o.city.buildings_per_block_max)
     throw common::ConfigError(where + ": [city] buildings_per_block_min: larger than buildings_per_block_max");
   // Avenues closer than a block's length could split one street piece twice.
@@ -160,8 +159,7 @@ SimOptions loadSimOptions(const std::string& path, std::string* resolved_ini) {
     throw common::ConfigError(where + ": [city] avenue_spacing_m: below 300 m or twice a block's pitch (0 turns avenues off)");
   if (o.route.explore_min_edges > o.route.explore_max_edges)
     throw common::ConfigError(where + ": [route] explore_min_edges: larger than explore_max_edges");
-  if (o.gps.outage_min_s > o.gps.outage_max_s)
-    throw common::ConfigError(where + ": [gps] outage_min_s: larger than outage_max_s");
+  if (o.gps.outage_min_s > o.gps.outage_max_s) throw common::ConfigError(where + ": [gps] outage_min_s: larger than outage_max_s");
   if (resolved_ini) *resolved_ini = s.toIni();
   return o;
 }

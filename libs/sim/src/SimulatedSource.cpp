@@ -15,14 +15,11 @@ SimulatedSource::SimulatedSource(const SimOptions& options)
   driver_ = std::make_unique<Driver>(city_->streets(), options);
   if (options.laser.enabled) laser_ = std::make_unique<LaserSimulator>(options.laser, *city_, traffic_.get(), seed);
   if (options.camera.enabled) camera_ = std::make_unique<CameraRenderer>(options.camera, *city_, seed);
-  if (options.odometry.enabled)
-    odometry_ = std::make_unique<OdometrySimulator>(options.odometry, options.vehicle.wheelbase_m, seed);
+  if (options.odometry.enabled) odometry_ = std::make_unique<OdometrySimulator>(options.odometry, options.vehicle.wheelbase_m, seed);
   if (options.gps.enabled) gps_ = std::make_unique<GpsSimulator>(options.gps, seed);
 }
 
-double SimulatedSource::progress() const {
-  return std::min(1.0, driver_->state().odometer_m / (options_.route.route_length_km * 1000.0));
-}
+double SimulatedSource::progress() const { return std::min(1.0, driver_->state().odometer_m / (options_.route.route_length_km * 1000.0)); }
 
 void SimulatedSource::produce() {
   // Sensor clocks are k / rate exactly (no accumulated rounding); equal times fire together.

@@ -44,7 +44,7 @@ SimulationSummary writeSimulation(const SimOptions& options, const std::string& 
     image_loops->stream() << "t_old,t_new,overlap,distance_m\n";
   }
   LoopTruthFinder image_finder(options.loops);
-  std::map<double, std::pair<std::string, double>> image_at;  // time -> (name, camera heading)
+  std::map<double, std::pair<std::string, double>> image_at;                  // time -> (name, camera heading)
   std::vector<std::pair<std::string, std::vector<std::string>>> image_truth;  // eval-image-loop format
   const double max_heading = options.loops.image_max_heading_deg * M_PI / 180.0;
   // The truth at scan times: 32 bytes a scan (a 1000 km drive: ~3 MB), written at the end.

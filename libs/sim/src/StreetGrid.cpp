@@ -10,8 +10,7 @@ namespace urbanslam::sim {
 
 namespace {
 // Tags keep the hash streams of different features apart.
-constexpr uint64_t kTagLine = 1, kTagDeadEnd = 2, kTagDeadEndSide = 3, kTagPark = 4, kTagAvenue = 5,
-                   kTagRoundabout = 6;
+constexpr uint64_t kTagLine = 1, kTagDeadEnd = 2, kTagDeadEndSide = 3, kTagPark = 4, kTagAvenue = 5, kTagRoundabout = 6;
 }  // namespace
 
 StreetGrid::StreetGrid(const CityOptions& options)
@@ -47,9 +46,7 @@ int StreetGrid::lineBelow(int axis, double v) const {
   return i;
 }
 
-Box StreetGrid::cityBox() const {
-  return {linePos(0, 0), linePos(1, 0), linePos(0, lines_ - 1), linePos(1, lines_ - 1)};
-}
+Box StreetGrid::cityBox() const { return {linePos(0, 0), linePos(1, 0), linePos(0, lines_ - 1), linePos(1, lines_ - 1)}; }
 
 Vec2 StreetGrid::node(NodeId n) const {
   if (n.kind == 0) return {linePos(0, n.i), linePos(1, n.j)};
@@ -111,8 +108,7 @@ bool StreetGrid::onAvenue(int a, NodeId n) const {
   if (n.kind != 0) return n.i == a;
   if (!hasAvenues() || !inCity(n) || std::fabs(avenueDistance(a, node(n))) >= mergeRadius()) return false;
   Vec2 p;
-  return (rawCrossing(a, 0, n.i, p) && crossingNode(a, 0, n.i) == n) ||
-         (rawCrossing(a, 1, n.j, p) && crossingNode(a, 1, n.j) == n);
+  return (rawCrossing(a, 0, n.i, p) && crossingNode(a, 0, n.i) == n) || (rawCrossing(a, 1, n.j, p) && crossingNode(a, 1, n.j) == n);
 }
 
 bool StreetGrid::avenueStep(int a, NodeId n, int dir, NodeId& next) const {
@@ -186,8 +182,7 @@ bool StreetGrid::deadEndCandidate(int axis, int i, int j) const {
   if (hasAvenues()) {
     const Vec2 a = node({i, j}), b = node({i1, j1});
     int a0, a1;
-    avenuesNear({std::min(a.x, b.x), std::min(a.y, b.y), std::max(a.x, b.x), std::max(a.y, b.y)},
-                avenueHalfWidth() + width_, a0, a1);
+    avenuesNear({std::min(a.x, b.x), std::min(a.y, b.y), std::max(a.x, b.x), std::max(a.y, b.y)}, avenueHalfWidth() + width_, a0, a1);
     if (a0 <= a1) return false;
   }
   return true;
@@ -209,9 +204,7 @@ EdgeState StreetGrid::edge(int axis, int i, int j) const {
   return EdgeState::DeadEnd;
 }
 
-bool StreetGrid::deadEndClosedAtEnd(int axis, int i, int j) const {
-  return hash64(seed_, kTagDeadEndSide, axis, i, j) & 1;
-}
+bool StreetGrid::deadEndClosedAtEnd(int axis, int i, int j) const { return hash64(seed_, kTagDeadEndSide, axis, i, j) & 1; }
 
 std::vector<NodeId> StreetGrid::neighbours(NodeId n) const {
   std::vector<NodeId> out;
@@ -258,9 +251,7 @@ double StreetGrid::pieceHalfWidth(NodeId a, NodeId b) const {
   return avenue ? avenueHalfWidth() : width_ / 2;
 }
 
-double StreetGrid::pieceLaneOffset(NodeId a, NodeId b) const {
-  return (pieceHalfWidth(a, b) - sidewalkWidth() - parkingWidth()) / 2;
-}
+double StreetGrid::pieceLaneOffset(NodeId a, NodeId b) const { return (pieceHalfWidth(a, b) - sidewalkWidth() - parkingWidth()) / 2; }
 
 // --- roundabouts, blocks ---------------------------------------------------------------------
 

@@ -9,17 +9,15 @@ namespace urbanslam::sim {
 
 namespace {
 
-constexpr uint64_t kTagTexture = 60, kTagWindow = 61, kTagShop = 62, kTagLetter = 63, kTagBlock = 64,
-                   kTagDisplay = 65, kTagStain = 66, kTagHeight = 67, kTagGraffiti = 68;
+constexpr uint64_t kTagTexture = 60, kTagWindow = 61, kTagShop = 62, kTagLetter = 63, kTagBlock = 64, kTagDisplay = 65, kTagStain = 66,
+                   kTagHeight = 67, kTagGraffiti = 68;
 
 int floorInt(double v) { return static_cast<int>(std::floor(v)); }
 int mod(int a, int b) { return ((a % b) + b) % b; }
 uint8_t clampTone(int v) { return static_cast<uint8_t>(std::clamp(v, 0, 255)); }
 // A tone that stands out against `base` (dark on light walls, light on dark ones).
 int contrasting(int base, Rng& r) { return base > 128 ? r.uniformInt(15, 70) : r.uniformInt(185, 245); }
-uint64_t h(uint32_t id, uint64_t tag, int64_t a = 0, int64_t b = 0, int64_t c = 0) {
-  return hash64(id, tag, a, b, c);
-}
+uint64_t h(uint32_t id, uint64_t tag, int64_t a = 0, int64_t b = 0, int64_t c = 0) { return hash64(id, tag, a, b, c); }
 // Pseudo-letter bit (4 columns x 5 rows) of letter `letter` in a sign: blocky glyphs with many
 // corners, the same wherever the sign is seen from.
 bool glyphBit(uint32_t id, int sign, int letter, int row, int col) {
@@ -69,14 +67,22 @@ double facadeHeight(uint32_t id, SurfaceKind kind) {
       const SurfaceTexture t({id, SurfaceKind::Facade, 0.f});  // floors and cornice fit the height exactly
       return t.groundFloorHeight() + r.uniformInt(1, 5) * t.floorHeight() + t.corniceHeight();
     }
-    case SurfaceKind::Featureless: return r.uniform(5.0, 12.0);
-    case SurfaceKind::Tree: return r.uniform(4.0, 6.0);
-    case SurfaceKind::LampPost: return r.uniform(5.0, 6.0);
-    case SurfaceKind::ParkedCar: return r.uniform(1.4, 1.6);
-    case SurfaceKind::Barrier: return r.uniform(2.5, 3.5);
-    case SurfaceKind::Fountain: return r.uniform(0.8, 1.2);
-    case SurfaceKind::Bench: return r.uniform(0.45, 0.55);
-    case SurfaceKind::Island: return r.uniform(0.9, 1.3);  // a planted kerb, hedge on top
+    case SurfaceKind::Featureless:
+      return r.uniform(5.0, 12.0);
+    case SurfaceKind::Tree:
+      return r.uniform(4.0, 6.0);
+    case SurfaceKind::LampPost:
+      return r.uniform(5.0, 6.0);
+    case SurfaceKind::ParkedCar:
+      return r.uniform(1.4, 1.6);
+    case SurfaceKind::Barrier:
+      return r.uniform(2.5, 3.5);
+    case SurfaceKind::Fountain:
+      return r.uniform(0.8, 1.2);
+    case SurfaceKind::Bench:
+      return r.uniform(0.45, 0.55);
+    case SurfaceKind::Island:
+      return r.uniform(0.9, 1.3);  // a planted kerb, hedge on top
   }
   return 3.0;
 }
@@ -185,13 +191,13 @@ uint8_t SurfaceTexture::facade(const Column& c, double hh) const {
     if (c.window && v >= sill_ - 0.12 && v < sill_) return clampTone(accent_);  // sill
     if (c.window && v >= sill_ && v < sill_ + win_h_) {
       const double wv = v - sill_;
-      if (c.frame || c.mullion || wv < frame_w_ || wv >= win_h_ - frame_w_ ||
-          (mullions_ && std::fabs(wv - win_h_ * 0.62) < frame_w_ / 2))
+      if (c.frame || c.mullion || wv < frame_w_ || wv >= win_h_ - frame_w_ || (mullions_ && std::fabs(wv - win_h_ * 0.62) < frame_w_ / 2))
         return clampTone(frame_tone_);
       const uint64_t w = h(look_.id, kTagWindow, c.bay, f);
       switch (w % 5) {
-        case 0: return clampTone(175 + static_cast<int>((w >> 8) % 60));  // a lit room
-        case 1: {  // a blind pulled part way down
+        case 0:
+          return clampTone(175 + static_cast<int>((w >> 8) % 60));  // a lit room
+        case 1: {                                                   // a blind pulled part way down
           const double down = 0.25 + 0.6 * unitFromHash(w);
           if (wv > win_h_ * (1 - down)) return clampTone(std::fmod(wv, 0.16) < 0.03 ? 120 : 200);
           return clampTone(glass_);
@@ -210,7 +216,8 @@ uint8_t SurfaceTexture::facade(const Column& c, double hh) const {
 
 uint8_t SurfaceTexture::at(const Column& c, double hh) const {
   switch (look_.kind) {
-    case SurfaceKind::Facade: return facade(c, hh);
+    case SurfaceKind::Facade:
+      return facade(c, hh);
     case SurfaceKind::Featureless:
       if (hh < 0.4) return clampTone(wall_ - 25);  // plinth
       return clampTone(wall_ + static_cast<int>(mix64(c.coarse ^ static_cast<uint64_t>(floorInt(hh / 2.5))) % 7) - 3);

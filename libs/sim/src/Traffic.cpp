@@ -22,7 +22,8 @@ std::vector<MovingObject> Traffic::near(Vec2 centre, double radius, double t, Ve
   };
   std::vector<Stream> streams;
   if (options_.car_spacing_m > 0)
-    for (double dir : {1.0, -1.0}) streams.push_back({dir * grid_.laneOffset(), options_.car_spacing_m, dir * options_.car_speed_mps, true});
+    for (double dir : {1.0, -1.0})
+      streams.push_back({dir * grid_.laneOffset(), options_.car_spacing_m, dir * options_.car_speed_mps, true});
   if (options_.pedestrian_spacing_m > 0)
     for (double side : {1.0, -1.0})
       for (double dir : {1.0, -1.0})

@@ -50,7 +50,8 @@ std::array<double, 9> GlobalSlam::addKeyframe(Keyframe kf, const KeyframeConstra
       dirty_since_recovery_ = true;
     }
   }
-  kf.pose = filter ? esdf::toPose(filter->mean(static_cast<int>(k))) : (k == 0 ? common::Pose2{} : common::compose(map_.back().pose, constraint.z));
+  kf.pose = filter ? esdf::toPose(filter->mean(static_cast<int>(k)))
+                   : (k == 0 ? common::Pose2{} : common::compose(map_.back().pose, constraint.z));
   // Window recovery moved the last `recent_window` keyframes too.
   const size_t window = static_cast<size_t>(options_.estimator.recent_window);
   if (filter && k > 0) map_.pullPoses(k > window ? k - window : 0);
@@ -89,9 +90,8 @@ bool GlobalSlam::consistent(const LoopClosureRecord& a, const LoopClosureRecord&
   // room) rather than confirm it: the confirmation aligns with another scan of the earlier visit.
   if (a.from == b.from) return false;
   const auto& kf = map_.keyframes();
-  const common::Pose2 predicted =
-      common::compose(common::compose(common::between(kf[b.from].pose, kf[a.from].pose), a.measurement),
-                      common::between(kf[a.to].pose, kf[b.to].pose));
+  const common::Pose2 predicted = common::compose(common::compose(common::between(kf[b.from].pose, kf[a.from].pose), a.measurement),
+                                                  common::between(kf[a.to].pose, kf[b.to].pose));
   const common::Pose2 d = common::between(predicted, b.measurement);
   return std::hypot(d.x, d.y) <= options_.loop_closure.confirm_tolerance_m &&
          std::abs(d.phi) <= options_.loop_closure.confirm_tolerance_deg * kDeg;
@@ -126,8 +126,8 @@ GlobalSlam::Admission GlobalSlam::admit(LoopClosureRecord r, size_t current) {
   // the second usually fails with a huge distance and only the first goes in. Gating both
   // before either goes in (what "current state" suggests) was measured worse: false closures
   // campus 4 -> 6, ACES 3 -> 6, CSAIL 1 -> 2 at the same ATE.
-  auto match = std::find_if(pending_.begin(), pending_.end(),
-                            [&](const LoopClosureRecord& p) { return p.to < current && consistent(p, r); });
+  auto match =
+      std::find_if(pending_.begin(), pending_.end(), [&](const LoopClosureRecord& p) { return p.to < current && consistent(p, r); });
   if (match == pending_.end()) {
     if (pending_.size() < 4 * window) pending_.push_back(r);
     return Admission::Pending;
@@ -137,7 +137,7 @@ GlobalSlam::Admission GlobalSlam::admit(LoopClosureRecord r, size_t current) {
   bool accepted = false;
   for (LoopClosureRecord* c : {&first, &r}) {
     const auto res = map_.filter()->observeRelative(static_cast<int>(c->from), static_cast<int>(c->to), esdf::toVec(c->measurement),
-                                            c->information, true);
+                                                    c->information, true);
     c->accepted = res.accepted;
     c->mahalanobis2 = res.gate.mahalanobis2;
     if (!res.accepted) c->reason = ClosureReason::Gating;
@@ -151,7 +151,8 @@ GlobalSlam::Admission GlobalSlam::admit(LoopClosureRecord r, size_t current) {
 }
 
 void GlobalSlam::closeLoops(size_t current) {
-  if (!map_.filter() || !options_.loop_closure.enabled || current % static_cast<size_t>(options_.loop_closure.every_n_keyframes) != 0) return;
+  if (!map_.filter() || !options_.loop_closure.enabled || current % static_cast<size_t>(options_.loop_closure.every_n_keyframes) != 0)
+    return;
   common::Stopwatch sw;
   expirePending(current);
   // 6. Candidates: initial set near the estimate, final set by Mahalanobis distance (keyframes
@@ -203,7 +204,9 @@ void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double scor
     const ClosureReason reason = r.reason;
     const Admission a = admit(std::move(r), current);
     ev.accepted = a == Admission::Accepted;
-    ev.fate = a == Admission::Accepted ? "accepted" : a == Admission::Pending ? "pending" : (reason == ClosureReason::None ? "gating" : reasonName(reason));
+    ev.fate = a == Admission::Accepted  ? "accepted"
+              : a == Admission::Pending ? "pending"
+                                        : (reason == ClosureReason::None ? "gating" : reasonName(reason));
     if (ev.accepted) recoverAll();
     stats_.closure_ms.push_back(sw.milliseconds());
   } else {
@@ -216,7 +219,9 @@ void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double scor
     r.to_time = map_.keyframes()[current].timestamp;
     r.detector = "image";
     r.score = score;
-    r.reason = !filter ? ClosureReason::NoFilter : !options_.loop_closure.enabled ? ClosureReason::LoopClosureDisabled : ClosureReason::NoScans;
+    r.reason = !filter                          ? ClosureReason::NoFilter
+               : !options_.loop_closure.enabled ? ClosureReason::LoopClosureDisabled
+                                                : ClosureReason::NoScans;
     ev.fate = reasonName(r.reason);
     reportClosure(r);
   }

@@ -48,7 +48,8 @@ const alignment::MatchReference* LocalSubmap::reference(const std::vector<common
   }
   cache_.generation = generation_;
   cache_.offsets = std::move(offsets);
-  cache_.reference = points.empty() ? nullptr : std::make_unique<const alignment::MatchReference>(std::move(points), Eigen::Vector2d::Zero(), matcher_);
+  cache_.reference =
+      points.empty() ? nullptr : std::make_unique<const alignment::MatchReference>(std::move(points), Eigen::Vector2d::Zero(), matcher_);
   return cache_.reference.get();
 }
 

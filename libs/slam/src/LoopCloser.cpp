@@ -22,23 +22,32 @@ double largestPositionSigma(const Eigen::Matrix3d& cov) {
 
 const char* reasonName(ClosureReason reason) {
   switch (reason) {
-    case ClosureReason::None: return "";
-    case ClosureReason::Classifier: return "classifier";
-    case ClosureReason::Alignment: return "alignment";
-    case ClosureReason::Ambiguous: return "ambiguous";
-    case ClosureReason::FreeSpace: return "free_space";
-    case ClosureReason::Gating: return "gating";
-    case ClosureReason::Unconfirmed: return "unconfirmed";
-    case ClosureReason::NoScans: return "no_scans";
-    case ClosureReason::NoFilter: return "no_filter";
-    case ClosureReason::LoopClosureDisabled: return "loop_closure_disabled";
+    case ClosureReason::None:
+      return "";
+    case ClosureReason::Classifier:
+      return "classifier";
+    case ClosureReason::Alignment:
+      return "alignment";
+    case ClosureReason::Ambiguous:
+      return "ambiguous";
+    case ClosureReason::FreeSpace:
+      return "free_space";
+    case ClosureReason::Gating:
+      return "gating";
+    case ClosureReason::Unconfirmed:
+      return "unconfirmed";
+    case ClosureReason::NoScans:
+      return "no_scans";
+    case ClosureReason::NoFilter:
+      return "no_filter";
+    case ClosureReason::LoopClosureDisabled:
+      return "loop_closure_disabled";
   }
   return "";
 }
 
 LoopCloser::LoopCloser(const LoopClosureOptions& options)
-    : options_(options),
-      chi2_2dof_(esdf::chi2Quantile(options.mahalanobis_probability, 2)) {}
+    : options_(options), chi2_2dof_(esdf::chi2Quantile(options.mahalanobis_probability, 2)) {}
 
 void LoopCloser::setScorer(CandidateScorer scorer, std::string name) {
   scorer_ = std::move(scorer);
@@ -64,7 +73,7 @@ Eigen::Matrix3d LoopCloser::relativeCovariance(esdf::Esdf& filter, size_t i, siz
 }
 
 std::vector<size_t> LoopCloser::candidates(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, const KeyframeGrid& grid,
-                                            size_t current) {
+                                           size_t current) {
   const auto& cur = keyframes[current];
   if (current < static_cast<size_t>(options_.min_keyframe_gap)) return {};
   const size_t newest_allowed = current - static_cast<size_t>(options_.min_keyframe_gap);
@@ -152,9 +161,8 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
     // one the global coarse alignment first (CRF-match, then ICP), as in the thesis.
     const Eigen::Matrix3d s = relativeCovariance(filter, earlier, current);
     const double sxy = std::sqrt(std::max(s(0, 0), s(1, 1))), sphi = std::sqrt(s(2, 2));
-    ao.method = 3 * sxy < options_.auto_local_max_m && 3 * sphi < options_.auto_local_max_deg * M_PI / 180
-                    ? alignment::Method::PlIcp
-                    : alignment::Method::CrfIcp;
+    ao.method = 3 * sxy < options_.auto_local_max_m && 3 * sphi < options_.auto_local_max_deg * M_PI / 180 ? alignment::Method::PlIcp
+                                                                                                           : alignment::Method::CrfIcp;
   } else {
     ao.method = alignment::parseMethod(options_.method);
   }
@@ -190,8 +198,7 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
   r.information = cov.inverse();
   esdf::GateResult gate;
   if (commit) {
-    gate = filter.observeRelative(static_cast<int>(earlier), static_cast<int>(current), esdf::toVec(a.transform),
-                                  r.information, true).gate;
+    gate = filter.observeRelative(static_cast<int>(earlier), static_cast<int>(current), esdf::toVec(a.transform), r.information, true).gate;
   } else {
     gate = filter.gateRelative(static_cast<int>(earlier), static_cast<int>(current), esdf::toVec(a.transform), r.information);
   }

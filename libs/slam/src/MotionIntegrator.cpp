@@ -7,8 +7,7 @@
 
 namespace urbanslam::slam {
 
-MotionIntegrator::MotionIntegrator(const MotionOptions& motion, const VehicleOptions& vehicle)
-    : motion_(motion), vehicle_(vehicle) {}
+MotionIntegrator::MotionIntegrator(const MotionOptions& motion, const VehicleOptions& vehicle) : motion_(motion), vehicle_(vehicle) {}
 
 void MotionIntegrator::reset() {
   increment_ = {};
@@ -31,8 +30,8 @@ void MotionIntegrator::addOdometry(const io::OdometryReading& m) {
     const common::Pose2 d = common::between(last_odom_.pose, m.pose);
     const double dist = std::hypot(d.x, d.y), turn = std::abs(d.phi);
     const double sxy = motion_.odometry_sigma_xy_min_m + motion_.odometry_sigma_xy_per_m * dist;
-    const double sphi = motion_.odometry_sigma_phi_min_rad + motion_.odometry_sigma_phi_per_rad * turn +
-                        motion_.odometry_sigma_phi_per_m_rad * dist;
+    const double sphi =
+        motion_.odometry_sigma_phi_min_rad + motion_.odometry_sigma_phi_per_rad * turn + motion_.odometry_sigma_phi_per_m_rad * dist;
     // Wheel odometry errors are systematic over an increment (a wheel radius, a slipping tyre,
     // a gyro bias): the readings' errors add up linearly, not in quadrature. Compounding a square
     // root of the covariance with the same unit noise for every reading does that; with

@@ -51,7 +51,9 @@ void PipelineStats::recordStep(double ms, size_t keyframes) {
 
 void Pipeline::addObserver(PipelineObserver* observer) { observers_.push_back(observer); }
 
-void Pipeline::setCandidateScorer(CandidateScorer scorer, std::string name) { global_.setCandidateScorer(std::move(scorer), std::move(name)); }
+void Pipeline::setCandidateScorer(CandidateScorer scorer, std::string name) {
+  global_.setCandidateScorer(std::move(scorer), std::move(name));
+}
 
 bool Pipeline::acceptLabel(const std::string& label) const {
   if (labels_.empty()) return true;

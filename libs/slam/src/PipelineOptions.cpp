@@ -20,7 +20,8 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("wheelbase_m", o.vehicle.wheelbase_m, 0.1, 20.0, "m", "wheelbase L for speed + steering logs");
 
   s.section("motion", "Motion between keyframes: model and noise");
-  s.add("model", o.motion.model, {"auto", "odometry", "steering"}, "auto: steering model for speed+steering logs (Victoria Park), else odometry");
+  s.add("model", o.motion.model, {"auto", "odometry", "steering"},
+        "auto: steering model for speed+steering logs (Victoria Park), else odometry");
   s.add("odometry_sigma_xy_per_m", o.motion.odometry_sigma_xy_per_m, 0.0, 1.0, "m/m", "odometry position noise per metre travelled");
   s.add("odometry_sigma_xy_min_m", o.motion.odometry_sigma_xy_min_m, 1e-6, 1.0, "m", "odometry position noise floor per increment");
   s.add("odometry_sigma_phi_per_rad", o.motion.odometry_sigma_phi_per_rad, 0.0, 1.0, "rad/rad", "heading noise per radian turned");
@@ -30,49 +31,79 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("steering_sigma_deg", o.motion.steering_sigma_deg, 1e-3, 45.0, "deg", "steering model: steering angle noise (Q_v)");
 
   s.section("local", "Local SLAM: the odometry between keyframes weighed against a scan match with the local submap");
-  s.add("scan_matching", o.local.scan_matching, "match each scan with the local submap of the last keyframes, weighed against the odometry");
+  s.add("scan_matching", o.local.scan_matching,
+        "match each scan with the local submap of the last keyframes, weighed against the odometry");
   s.add("submap_keyframes", o.local.submap_keyframes, 1, 100, "keyframes", "match against a local submap of the last this many keyframes");
-  s.add("match_every_scan", o.local.match_every_scan, "also match the scans between keyframes with the submap; the trajectory at odometry times follows them (the map holds keyframes only)");
+  s.add("match_every_scan", o.local.match_every_scan,
+        "also match the scans between keyframes with the submap; the trajectory at odometry times follows them (the map holds keyframes "
+        "only)");
   s.add("resolution_m", o.local.resolution_m, 0.01, 1.0, "m", "likelihood grid cell of the correlative search");
   s.add("hit_sigma_m", o.local.hit_sigma_m, 0.005, 1.0, "m", "spread of a return about the surface it hit (likelihood grid)");
   s.add("miss_floor", o.local.miss_floor, 1e-6, 1.0, "", "density of a return the submap does not explain, relative to a hit's peak");
-  s.add("match_min_interval_s", o.local.match_min_interval_s, 0.0, 10.0, "s", "a scan between keyframes is matched only this long after the last matched scan (a fast scanner's trajectory needs no node per scan)");
-  s.add("grid_radius_m", o.local.grid_radius_m, 2.0, 200.0, "m", "the correlative search's likelihood grid covers the submap this far (along x and y) around its newest keyframe; returns beyond score nothing there (the refinement uses every return)");
-  s.add("voxel_m", o.local.voxel_m, 0.01, 10.0, "m", "the correlative search scores one scan point per voxel of this size (the refinement uses every point)");
-  s.add("search_window_m", o.local.search_window_m, 0.0, 10.0, "m", "the correlative search reaches at least this far from the odometry (and at least its 3 sigma and twice its travel: odometry can be wrong in direction)");
+  s.add("match_min_interval_s", o.local.match_min_interval_s, 0.0, 10.0, "s",
+        "a scan between keyframes is matched only this long after the last matched scan (a fast scanner's trajectory needs no node per "
+        "scan)");
+  s.add("grid_radius_m", o.local.grid_radius_m, 2.0, 200.0, "m",
+        "the correlative search's likelihood grid covers the submap this far (along x and y) around its newest keyframe; returns beyond "
+        "score nothing there (the refinement uses every return)");
+  s.add("voxel_m", o.local.voxel_m, 0.01, 10.0, "m",
+        "the correlative search scores one scan point per voxel of this size (the refinement uses every point)");
+  s.add("search_window_m", o.local.search_window_m, 0.0, 10.0, "m",
+        "the correlative search reaches at least this far from the odometry (and at least its 3 sigma and twice its travel: odometry can "
+        "be wrong in direction)");
   s.add("search_window_deg", o.local.search_window_deg, 0.0, 180.0, "deg", "... and turns at least this far from it");
-  s.add("odometry_outlier_probability", o.local.odometry_outlier_probability, 0.0, 0.5, "", "probability that the odometry is wrong beyond its covariance (a missed turn, reversing, slip): what a scan match far from it pays");
-  s.add("point_sigma_m", o.local.point_sigma_m, 0.001, 1.0, "m", "a return's distance to the submap's surface in the least-squares refinement");
-  s.add("covariance_scale", o.local.covariance_scale, 0.1, 1000.0, "", "the filter gets the match's posterior covariance times this (consecutive matches share the submap's points: correlated errors)");
+  s.add(
+      "odometry_outlier_probability", o.local.odometry_outlier_probability, 0.0, 0.5, "",
+      "probability that the odometry is wrong beyond its covariance (a missed turn, reversing, slip): what a scan match far from it pays");
+  s.add("point_sigma_m", o.local.point_sigma_m, 0.001, 1.0, "m",
+        "a return's distance to the submap's surface in the least-squares refinement");
+  s.add("covariance_scale", o.local.covariance_scale, 0.1, 1000.0, "",
+        "the filter gets the match's posterior covariance times this (consecutive matches share the submap's points: correlated errors)");
   s.add("min_sigma_xy_m", o.local.min_sigma_xy_m, 0.0, 1.0, "m", "floor on the scan-matching position sigma");
   s.add("min_sigma_phi_deg", o.local.min_sigma_phi_deg, 0.0, 10.0, "deg", "floor on the scan-matching heading sigma");
 
   s.section("loop_closure", "Global SLAM: loop-closure candidates, detection, alignment, gating");
   s.add("enabled", o.loop_closure.enabled, "search for loop closures");
-  s.add("detector", o.loop_closure.detector, {"none", "laser"}, "none: alignment + gating verify every candidate; laser: AdaBoost classifier first");
+  s.add("detector", o.loop_closure.detector, {"none", "laser"},
+        "none: alignment + gating verify every candidate; laser: AdaBoost classifier first");
   s.add("laser_model", o.loop_closure.laser_model, {}, "laser classifier model; empty: share/laser_loop/default.model");
   s.add("laser_threshold", o.loop_closure.laser_threshold, -100.0, 100.0, "", "classifier decision offset (higher: fewer false alarms)");
-  s.add("image_detector", o.loop_closure.image_detector, {"none", "tree_of_words"}, "image loop closures: tree_of_words proposes pairs from keyframe images ([image_loop])");
-  s.add("image_max_offset_s", o.loop_closure.image_max_offset_s, 0.0, 3600.0, "s", "an image belongs to the nearest keyframe in time only within this");
-  s.add("min_keyframe_gap", o.loop_closure.min_keyframe_gap, 1, 100000, "keyframes", "only keyframes at least this much older are candidates");
+  s.add("image_detector", o.loop_closure.image_detector, {"none", "tree_of_words"},
+        "image loop closures: tree_of_words proposes pairs from keyframe images ([image_loop])");
+  s.add("image_max_offset_s", o.loop_closure.image_max_offset_s, 0.0, 3600.0, "s",
+        "an image belongs to the nearest keyframe in time only within this");
+  s.add("min_keyframe_gap", o.loop_closure.min_keyframe_gap, 1, 100000, "keyframes",
+        "only keyframes at least this much older are candidates");
   s.add("search_radius_m", o.loop_closure.search_radius_m, 0.1, 1000.0, "m", "initial candidate set: within this distance (plus 3 sigma)");
-  s.add("mahalanobis_probability", o.loop_closure.mahalanobis_probability, 0.5, 0.999999, "", "final candidate set: chi2 (2 dof) probability");
+  s.add("mahalanobis_probability", o.loop_closure.mahalanobis_probability, 0.5, 0.999999, "",
+        "final candidate set: chi2 (2 dof) probability");
   s.add("max_candidates", o.loop_closure.max_candidates, 1, 1000, "", "candidates aligned per keyframe");
   s.add("every_n_keyframes", o.loop_closure.every_n_keyframes, 1, 1000, "keyframes", "search at every n-th keyframe");
-  s.add("method", o.loop_closure.method, {"auto", "icp", "plicp", "crf", "crf+icp"}, "alignment of a candidate pair; auto: PL-ICP when the relative pose is well known, CRF-match + ICP otherwise");
-  s.add("auto_local_max_m", o.loop_closure.auto_local_max_m, 0.0, 100.0, "m", "auto: PL-ICP when 3 sigma of the relative position is below this");
-  s.add("auto_local_max_deg", o.loop_closure.auto_local_max_deg, 0.0, 180.0, "deg", "auto: ... and 3 sigma of the relative heading below this");
+  s.add("method", o.loop_closure.method, {"auto", "icp", "plicp", "crf", "crf+icp"},
+        "alignment of a candidate pair; auto: PL-ICP when the relative pose is well known, CRF-match + ICP otherwise");
+  s.add("auto_local_max_m", o.loop_closure.auto_local_max_m, 0.0, 100.0, "m",
+        "auto: PL-ICP when 3 sigma of the relative position is below this");
+  s.add("auto_local_max_deg", o.loop_closure.auto_local_max_deg, 0.0, 180.0, "deg",
+        "auto: ... and 3 sigma of the relative heading below this");
   s.add("max_rms_m", o.loop_closure.max_rms_m, 0.001, 10.0, "m", "alignment accepted only below this RMS residual");
-  s.add("min_matched_fraction", o.loop_closure.min_matched_fraction, 0.0, 1.0, "", "alignment accepted only with this share of points matched");
-  s.add("ambiguity_offset_m", o.loop_closure.ambiguity_offset_m, 0.0, 100.0, "m", "alignment accepted only when PL-ICP restarted from the result shifted by this along x and y finds no pose matching clearly more points; 0: off");
+  s.add("min_matched_fraction", o.loop_closure.min_matched_fraction, 0.0, 1.0, "",
+        "alignment accepted only with this share of points matched");
+  s.add("ambiguity_offset_m", o.loop_closure.ambiguity_offset_m, 0.0, 100.0, "m",
+        "alignment accepted only when PL-ICP restarted from the result shifted by this along x and y finds no pose matching clearly more "
+        "points; 0: off");
   s.add("ambiguity_min_gain", o.loop_closure.ambiguity_min_gain, 0.0, 1.0, "", "clearly more: this share more points matched");
-  s.add("max_free_space_conflict", o.loop_closure.max_free_space_conflict, 0.0, 1.0, "", "alignment accepted only when at most this share of either scan's points lies in the other scan's free space; 1: off");
-  s.add("free_space_no_return_m", o.loop_closure.free_space_no_return_m, 0.0, 1000.0, "m", "free-space test: a beam without a return (or beyond max_range_m) saw free space this far; 0: says nothing");
-  s.add("free_space_margin_m", o.loop_closure.free_space_margin_m, 0.0, 10.0, "m", "a point is in the other scan's free space when this much (+5 % of the range) in front of where its beam ended");
-  s.add("min_constraint_ratio", o.loop_closure.min_constraint_ratio, 0.0, 1.0, "", "alignment accepted only when its weakest translation direction has this share of the strongest's information (corridors slide)");
+  s.add("max_free_space_conflict", o.loop_closure.max_free_space_conflict, 0.0, 1.0, "",
+        "alignment accepted only when at most this share of either scan's points lies in the other scan's free space; 1: off");
+  s.add("free_space_no_return_m", o.loop_closure.free_space_no_return_m, 0.0, 1000.0, "m",
+        "free-space test: a beam without a return (or beyond max_range_m) saw free space this far; 0: says nothing");
+  s.add("free_space_margin_m", o.loop_closure.free_space_margin_m, 0.0, 10.0, "m",
+        "a point is in the other scan's free space when this much (+5 % of the range) in front of where its beam ended");
+  s.add("min_constraint_ratio", o.loop_closure.min_constraint_ratio, 0.0, 1.0, "",
+        "alignment accepted only when its weakest translation direction has this share of the strongest's information (corridors slide)");
   s.add("covariance_scale", o.loop_closure.covariance_scale, 0.1, 1000.0, "", "inflation of the alignment covariance");
   s.add("chi2_gate_probability", o.loop_closure.chi2_gate_probability, 0.5, 0.9999999, "", "innovation gate (chi2, 3 dof)");
-  s.add("confirm_window", o.loop_closure.confirm_window, 0, 1000, "keyframes", "a closure is added once another within this many keyframes agrees with it; 0: at once");
+  s.add("confirm_window", o.loop_closure.confirm_window, 0, 1000, "keyframes",
+        "a closure is added once another within this many keyframes agrees with it; 0: at once");
   s.add("confirm_tolerance_m", o.loop_closure.confirm_tolerance_m, 0.0, 100.0, "m", "agreement of two closures: position");
   s.add("confirm_tolerance_deg", o.loop_closure.confirm_tolerance_deg, 0.0, 180.0, "deg", "agreement of two closures: heading");
 

@@ -47,8 +47,8 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   // config.ini first: whoever looks at the outputs can see how they were made.
   {
     common::AtomicFile f(path("config.ini"));
-    f.stream() << "// Resolved configuration of this run (input: " << info.input_path << ", ini: "
-               << (info.ini_path.empty() ? "built-in defaults" : info.ini_path) << ")\n"
+    f.stream() << "// Resolved configuration of this run (input: " << info.input_path
+               << ", ini: " << (info.ini_path.empty() ? "built-in defaults" : info.ini_path) << ")\n"
                << info.resolved_ini;
     f.commit();
   }
@@ -71,12 +71,13 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   files.push("pose_graph.g2o");
   {
     common::AtomicFile f(path("loop_closures.csv"));
-    f.stream() << "from_keyframe,to_keyframe,from_time,to_time,detector,score,accepted,reason,x,y,phi,rms_m,mahalanobis2,gate_threshold,free_space_conflict,prior_sigma_m\n";
+    f.stream() << "from_keyframe,to_keyframe,from_time,to_time,detector,score,accepted,reason,x,y,phi,rms_m,mahalanobis2,gate_threshold,"
+                  "free_space_conflict,prior_sigma_m\n";
     char buf[512];
     for (const auto& c : p.loopClosures()) {
       std::snprintf(buf, sizeof buf, "%zu,%zu,%.6f,%.6f,%s,%.6g,%d,%s,%.6f,%.6f,%.6f,%.6g,%.6g,%.6g,%.4f,%.4g\n", c.from, c.to, c.from_time,
-                    c.to_time, c.detector.c_str(), c.score, c.accepted ? 1 : 0, reasonName(c.reason), c.measurement.x,
-                    c.measurement.y, c.measurement.phi, c.rms_m, c.mahalanobis2, c.gate_threshold, c.free_space_conflict, c.prior_sigma_m);
+                    c.to_time, c.detector.c_str(), c.score, c.accepted ? 1 : 0, reasonName(c.reason), c.measurement.x, c.measurement.y,
+                    c.measurement.phi, c.rms_m, c.mahalanobis2, c.gate_threshold, c.free_space_conflict, c.prior_sigma_m);
       f.stream() << buf;
     }
     f.commit();
@@ -85,11 +86,26 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
 
   const auto posed = p.posedKeyframes();
   const auto pts = io::mapPoints(posed, o.map.point_decimation);
-  if (o.output.write_ply_binary) { io::writePly(path("map.ply"), pts, io::PlyEncoding::BinaryLittleEndian); files.push("map.ply"); }
-  if (o.output.write_ply_ascii) { io::writePly(path("map_ascii.ply"), pts, io::PlyEncoding::Ascii); files.push("map_ascii.ply"); }
-  if (o.output.write_pcd) { io::writePcd(path("map.pcd"), pts); files.push("map.pcd"); }
-  if (o.output.write_xyz) { io::writeXyz(path("map.xyz"), pts); files.push("map.xyz"); }
-  if (o.output.write_simplemap) { io::writeSimpleMap(path("map.simplemap"), posed); files.push("map.simplemap"); }
+  if (o.output.write_ply_binary) {
+    io::writePly(path("map.ply"), pts, io::PlyEncoding::BinaryLittleEndian);
+    files.push("map.ply");
+  }
+  if (o.output.write_ply_ascii) {
+    io::writePly(path("map_ascii.ply"), pts, io::PlyEncoding::Ascii);
+    files.push("map_ascii.ply");
+  }
+  if (o.output.write_pcd) {
+    io::writePcd(path("map.pcd"), pts);
+    files.push("map.pcd");
+  }
+  if (o.output.write_xyz) {
+    io::writeXyz(path("map.xyz"), pts);
+    files.push("map.xyz");
+  }
+  if (o.output.write_simplemap) {
+    io::writeSimpleMap(path("map.simplemap"), posed);
+    files.push("map.simplemap");
+  }
   Json grid = Json::object();
   if (o.output.write_grid && !pts.empty()) {  // camera-only runs have no map points
     io::OccupancyGridOptions g;

@@ -11,8 +11,10 @@ BagOfWords makeBagOfWords(std::vector<WordWeight> raw) {
   double total = 0;
   for (const auto& e : raw) {
     if (!(e.weight > 0)) continue;
-    if (!bag.entries.empty() && bag.entries.back().word == e.word) bag.entries.back().weight += e.weight;
-    else bag.entries.push_back(e);
+    if (!bag.entries.empty() && bag.entries.back().word == e.word)
+      bag.entries.back().weight += e.weight;
+    else
+      bag.entries.push_back(e);
     total += e.weight;
   }
   if (total > 0)

@@ -7,11 +7,9 @@
 
 namespace urbanslam::vision_loop {
 
-std::vector<ImageId> selectCandidates(const std::vector<common::Pose2>& image_poses,
-                                      const std::vector<PositionCovariance>& covariances,
+std::vector<ImageId> selectCandidates(const std::vector<common::Pose2>& image_poses, const std::vector<PositionCovariance>& covariances,
                                       const common::Pose2& current, const CandidateGateOptions& options) {
-  if (covariances.size() != image_poses.size())
-    throw common::InputError("selectCandidates: one covariance per image pose expected");
+  if (covariances.size() != image_poses.size()) throw common::InputError("selectCandidates: one covariance per image pose expected");
   std::vector<ImageId> out;
   const double floor = options.min_sigma_m * options.min_sigma_m;
   for (size_t i = 0; i < image_poses.size(); ++i) {

@@ -21,9 +21,12 @@ ImageFeatures FeatureExtractor::extract(const cv::Mat& image) const {
   ImageFeatures f;
   if (image.empty()) return f;
   cv::Mat gray;
-  if (image.channels() == 3) cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);
-  else if (image.channels() == 4) cv::cvtColor(image, gray, cv::COLOR_BGRA2GRAY);
-  else gray = image;
+  if (image.channels() == 3)
+    cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);
+  else if (image.channels() == 4)
+    cv::cvtColor(image, gray, cv::COLOR_BGRA2GRAY);
+  else
+    gray = image;
   if (gray.depth() != CV_8U) gray.convertTo(gray, CV_8U);
   const int side = std::max(gray.cols, gray.rows);
   if (options_.max_image_side_px > 0 && side > options_.max_image_side_px) {
@@ -39,8 +42,7 @@ ImageFeatures FeatureExtractor::extract(const cv::Mat& image) const {
   if (static_cast<int>(f.keypoints.size()) > options_.max_features) {
     std::vector<int> order(f.keypoints.size());
     for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
-    std::stable_sort(order.begin(), order.end(),
-                     [&](int a, int b) { return f.keypoints[a].response > f.keypoints[b].response; });
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return f.keypoints[a].response > f.keypoints[b].response; });
     order.resize(options_.max_features);
     std::sort(order.begin(), order.end());
     std::vector<cv::KeyPoint> kp;

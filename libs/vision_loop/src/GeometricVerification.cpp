@@ -5,8 +5,7 @@
 
 namespace urbanslam::vision_loop {
 
-VerificationResult verifyPair(const ImageFeatures& a, const ImageFeatures& b, DescriptorType type,
-                              const VerificationOptions& options) {
+VerificationResult verifyPair(const ImageFeatures& a, const ImageFeatures& b, DescriptorType type, const VerificationOptions& options) {
   VerificationResult r;
   if (a.descriptors.rows < 2 || b.descriptors.rows < 2) return r;
   cv::Mat da = a.descriptors, db = b.descriptors;
@@ -37,8 +36,7 @@ VerificationResult verifyPair(const ImageFeatures& a, const ImageFeatures& b, De
   r.matches = static_cast<int>(pa.size());
   if (r.matches < 8 || r.matches < options.min_inliers) return r;
   std::vector<uchar> mask;
-  const cv::Mat f = cv::findFundamentalMat(pa, pb, cv::FM_RANSAC, options.ransac_threshold_px,
-                                           options.ransac_confidence, mask);
+  const cv::Mat f = cv::findFundamentalMat(pa, pb, cv::FM_RANSAC, options.ransac_threshold_px, options.ransac_confidence, mask);
   if (f.empty()) return r;
   r.inliers = cv::countNonZero(mask);
   r.accepted = r.inliers >= options.min_inliers;

@@ -59,8 +59,8 @@ float inverseNorm(const uint8_t* centre, int bytes) {
   return n2 > 0 ? static_cast<float>(1.0 / std::sqrt(n2)) : 0.f;
 }
 
-KMeansResult kmeans(const DescriptorSet& set, const std::vector<uint32_t>& points, DescriptorType type, uint32_t k,
-                    int max_iterations, uint64_t seed, int threads) {
+KMeansResult kmeans(const DescriptorSet& set, const std::vector<uint32_t>& points, DescriptorType type, uint32_t k, int max_iterations,
+                    uint64_t seed, int threads) {
   const int bytes = set.bytes;
   const size_t n = points.size();
   KMeansResult r;
@@ -165,8 +165,7 @@ KMeansResult kmeans(const DescriptorSet& set, const std::vector<uint32_t>& point
         for (int j = 0; j < bytes; ++j) norm += s[j] * s[j];
         norm = std::sqrt(norm);
         if (norm <= 0) continue;
-        for (int j = 0; j < bytes; ++j)
-          out[j] = static_cast<uint8_t>(std::min(255.0, std::round(s[j] / norm * kSiftNorm)));
+        for (int j = 0; j < bytes; ++j) out[j] = static_cast<uint8_t>(std::min(255.0, std::round(s[j] / norm * kSiftNorm)));
         inv_c[c] = inverseNorm(out, bytes);
       } else {
         const double* s = sums.data() + c * bytes * 8;
@@ -221,8 +220,10 @@ VocabularyData buildVocabularyTree(const DescriptorSet& set, DescriptorType type
     v.first_child.push_back(0);
     v.child_count.push_back(0);
     v.word_of_node.push_back(VocabularyData::kNoWord);
-    if (centre) v.centres.insert(v.centres.end(), centre, centre + bytes);
-    else v.centres.insert(v.centres.end(), bytes, 0);
+    if (centre)
+      v.centres.insert(v.centres.end(), centre, centre + bytes);
+    else
+      v.centres.insert(v.centres.end(), bytes, 0);
     return static_cast<uint32_t>(v.first_child.size() - 1);
   };
 
@@ -241,16 +242,14 @@ VocabularyData buildVocabularyTree(const DescriptorSet& set, DescriptorType type
     std::vector<KMeansResult> results(level.size());
     std::vector<size_t> order(level.size());
     for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::sort(order.begin(), order.end(),
-              [&](size_t a, size_t b) { return level[a].points.size() > level[b].points.size(); });
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return level[a].points.size() > level[b].points.size(); });
     std::atomic<size_t> done_points{0};
     std::mutex progress_mutex;
     auto report = [&] {
       if (!progress) return;
       std::lock_guard<std::mutex> lock(progress_mutex);
       progress((depth + double(done_points) / set.count) / options.depth,
-               "level " + std::to_string(depth + 1) + "/" + std::to_string(options.depth) + ", " +
-                   std::to_string(level.size()) + " nodes");
+               "level " + std::to_string(depth + 1) + "/" + std::to_string(options.depth) + ", " + std::to_string(level.size()) + " nodes");
     };
     auto cluster = [&](size_t i, int inner_threads) {
       const Pending& p = level[i];

@@ -53,9 +53,7 @@ std::vector<QueryResult> ImageDatabase::query(const BagOfWords& bag, const Query
   if (restricted)
     for (ImageId c : *options.candidates)
       if (c < allowed_.size()) allowed_[c] = 0;
-  auto better = [](const QueryResult& a, const QueryResult& b) {
-    return a.score > b.score || (a.score == b.score && a.image < b.image);
-  };
+  auto better = [](const QueryResult& a, const QueryResult& b) { return a.score > b.score || (a.score == b.score && a.image < b.image); };
   if (results.size() > options.max_results) {
     std::nth_element(results.begin(), results.begin() + options.max_results, results.end(), better);
     results.resize(options.max_results);

@@ -10,7 +10,8 @@ void declareImageLoopOptions(common::OptionsSchema& s, ImageLoopOptions& o) {
   s.add("exclude_recent_frames", o.exclude_recent_frames, 0, 1000000, "frames", "the last frames are never loop candidates");
   s.add("temporal_consistency", o.temporal_consistency, 0, 100, "queries", "earlier consecutive queries whose islands must agree");
   s.add("island_gap_frames", o.island_gap_frames, 0, 1000, "frames", "matches this close form one island");
-  s.add("max_island_distance_frames", o.max_island_distance_frames, 0, 1000, "frames", "islands of consecutive queries agree when this close");
+  s.add("max_island_distance_frames", o.max_island_distance_frames, 0, 1000, "frames",
+        "islands of consecutive queries agree when this close");
   s.add("max_query_results", o.max_query_results, 1, 100000, "images", "top-k images asked from the database");
   s.add("geometric_verification", o.geometric_verification, "verify a match with a RANSAC fundamental matrix");
   s.add("verify_candidates", o.verify_candidates, 1, 100, "images", "best images of the winning island tried");

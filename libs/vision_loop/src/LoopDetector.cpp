@@ -9,19 +9,25 @@ namespace urbanslam::vision_loop {
 
 const char* loopStatusName(LoopStatus s) {
   switch (s) {
-    case LoopStatus::Detected: return "detected";
-    case LoopStatus::NoFeatures: return "no_features";
-    case LoopStatus::DatabaseTooSmall: return "database_too_small";
-    case LoopStatus::LowPriorScore: return "low_prior_score";
-    case LoopStatus::NoCandidates: return "no_candidates";
-    case LoopStatus::NotConsistent: return "not_consistent";
-    case LoopStatus::VerificationFailed: return "verification_failed";
+    case LoopStatus::Detected:
+      return "detected";
+    case LoopStatus::NoFeatures:
+      return "no_features";
+    case LoopStatus::DatabaseTooSmall:
+      return "database_too_small";
+    case LoopStatus::LowPriorScore:
+      return "low_prior_score";
+    case LoopStatus::NoCandidates:
+      return "no_candidates";
+    case LoopStatus::NotConsistent:
+      return "not_consistent";
+    case LoopStatus::VerificationFailed:
+      return "verification_failed";
   }
   return "?";
 }
 
-LoopDetector::LoopDetector(std::shared_ptr<const Vocabulary> vocabulary, const FeatureOptions& features,
-                           const LoopDetectorOptions& options)
+LoopDetector::LoopDetector(std::shared_ptr<const Vocabulary> vocabulary, const FeatureOptions& features, const LoopDetectorOptions& options)
     : vocabulary_(std::move(vocabulary)),
       extractor_([&] {
         if (!vocabulary_ || vocabulary_->empty()) throw common::InputError("loop detector needs a vocabulary");
@@ -50,8 +56,7 @@ bool LoopDetector::consistentWithPrevious(const Island& island, ImageId query) {
   bool agree = false;
   if (window_open_ && query - window_query_ <= static_cast<ImageId>(options_.max_query_gap_frames)) {
     const Island& p = window_island_;
-    const bool overlap = (p.first <= island.first && island.first <= p.last) ||
-                         (island.first <= p.first && p.first <= island.last);
+    const bool overlap = (p.first <= island.first && island.first <= p.last) || (island.first <= p.first && p.first <= island.last);
     long gap = 0;
     if (!overlap) gap = std::min(std::labs(long(p.first) - long(island.last)), std::labs(long(island.first) - long(p.last)));
     agree = gap <= options_.max_island_distance_frames;
@@ -118,12 +123,11 @@ LoopResult LoopDetector::process(ImageFeatures features, BagOfWords bag, const s
     is.score += h.score;
     is.members.push_back(h);
   }
-  const Island& best = *std::max_element(islands.begin(), islands.end(),
-                                         [](const Island& a, const Island& b) { return a.score < b.score; });
+  const Island& best =
+      *std::max_element(islands.begin(), islands.end(), [](const Island& a, const Island& b) { return a.score < b.score; });
   std::vector<QueryResult> members = best.members;
-  std::sort(members.begin(), members.end(), [](const QueryResult& a, const QueryResult& b) {
-    return a.score > b.score || (a.score == b.score && a.image < b.image);
-  });
+  std::sort(members.begin(), members.end(),
+            [](const QueryResult& a, const QueryResult& b) { return a.score > b.score || (a.score == b.score && a.image < b.image); });
   r.match = members.front().image;
   r.score = members.front().score;
   r.normalized_score = r.score / prior;

@@ -25,8 +25,7 @@ GroundTruthLoops GroundTruthLoops::load(const std::string& path) {
     if (!(s >> query)) continue;
     size_t count = 0;
     while (s >> match) gt.add(query, match), ++count;
-    if (count == 0)
-      throw common::InputError(path + ":" + std::to_string(n) + ": image '" + query + "' lists no matching images");
+    if (count == 0) throw common::InputError(path + ":" + std::to_string(n) + ": image '" + query + "' lists no matching images");
   }
   return gt;
 }
@@ -68,8 +67,7 @@ SweepResult sweepThresholds(const std::vector<EvaluationFrame>& frames, const Gr
     return p;
   };
   // Timings at the detector's own α, measured before the cache holds any verification.
-  out.at_default =
-      run(options.min_normalized_score, &out.detections_at_default, &out.mean_query_ms, &out.mean_verification_ms);
+  out.at_default = run(options.min_normalized_score, &out.detections_at_default, &out.mean_query_ms, &out.mean_verification_ms);
   for (double t : thresholds) {
     out.curve.push_back(run(t, nullptr, nullptr, nullptr));
     const PrPoint& p = out.curve.back();
@@ -86,8 +84,8 @@ void writePrCurveCsv(const std::vector<PrPoint>& curve, const std::string& path)
   common::AtomicFile f(path);
   f.stream() << "threshold,detections,true_positives,false_positives,precision,recall\n" << std::setprecision(6);
   for (const auto& p : curve)
-    f.stream() << p.threshold << ',' << p.detections << ',' << p.true_positives << ',' << p.false_positives << ','
-               << p.precision << ',' << p.recall << '\n';
+    f.stream() << p.threshold << ',' << p.detections << ',' << p.true_positives << ',' << p.false_positives << ',' << p.precision << ','
+               << p.recall << '\n';
   f.commit();
 }
 

@@ -36,8 +36,7 @@ void writePrCurvePng(const std::vector<PrPoint>& curve, const std::string& title
   std::vector<PrPoint> pts = curve;
   std::sort(pts.begin(), pts.end(), [](const PrPoint& a, const PrPoint& b) { return a.threshold > b.threshold; });
   for (size_t i = 1; i < pts.size(); ++i)
-    cv::line(img, px(pts[i - 1].recall, pts[i - 1].precision), px(pts[i].recall, pts[i].precision),
-             cv::Scalar(200, 80, 0), 2, cv::LINE_AA);
+    cv::line(img, px(pts[i - 1].recall, pts[i - 1].precision), px(pts[i].recall, pts[i].precision), cv::Scalar(200, 80, 0), 2, cv::LINE_AA);
   for (const auto& p : pts) cv::circle(img, px(p.recall, p.precision), 3, cv::Scalar(200, 80, 0), -1, cv::LINE_AA);
   common::writeAtomically(path, [&](const std::string& tmp) {
     if (!cv::imwrite(tmp, img)) throw common::InputError(path + ": cannot write PNG");

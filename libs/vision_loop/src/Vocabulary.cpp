@@ -74,8 +74,8 @@ BagOfWords Vocabulary::transform(const cv::Mat& descriptors, std::vector<WordId>
   if (descriptors.empty()) return {};
   if (descriptors.type() != CV_8U || descriptors.cols != bytes_)
     throw common::InputError("vocabulary (" + descriptorName(data_.type) + ", " + std::to_string(bytes_) +
-                             " bytes) cannot quantize descriptors of " + std::to_string(descriptors.cols) +
-                             " columns / type " + std::to_string(descriptors.type()));
+                             " bytes) cannot quantize descriptors of " + std::to_string(descriptors.cols) + " columns / type " +
+                             std::to_string(descriptors.type()));
   std::vector<WordWeight> raw;
   raw.reserve(descriptors.rows);
   for (int r = 0; r < descriptors.rows; ++r) {
@@ -89,9 +89,8 @@ BagOfWords Vocabulary::transform(const cv::Mat& descriptors, std::vector<WordId>
 
 std::string Vocabulary::summary() const {
   std::ostringstream s;
-  s << descriptorName(data_.type) << " k=" << data_.branching << " L=" << data_.depth << ": " << wordCount()
-    << " words, " << nodeCount() << " nodes, from " << data_.training_images << " images ("
-    << data_.training_descriptors << " descriptors)";
+  s << descriptorName(data_.type) << " k=" << data_.branching << " L=" << data_.depth << ": " << wordCount() << " words, " << nodeCount()
+    << " nodes, from " << data_.training_images << " images (" << data_.training_descriptors << " descriptors)";
   return s.str();
 }
 

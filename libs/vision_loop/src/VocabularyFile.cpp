@@ -70,9 +70,13 @@ struct Writer {
   std::ostream& out;
   Checksum sum;
   template <typename T>
-  void put(const T& v) { bytes(&v, sizeof v); }
+  void put(const T& v) {
+    bytes(&v, sizeof v);
+  }
   template <typename T>
-  void array(const std::vector<T>& v) { bytes(v.data(), v.size() * sizeof(T)); }
+  void array(const std::vector<T>& v) {
+    bytes(v.data(), v.size() * sizeof(T));
+  }
   void bytes(const void* p, size_t n) {
     sum.add(p, n);
     out.write(static_cast<const char*>(p), static_cast<std::streamsize>(n));
@@ -143,8 +147,8 @@ Vocabulary loadVocabulary(const std::string& path) {
   const auto version = r.get<uint32_t>("version");
   if (version != kVocabularyFormatVersion)
     throw common::InputError(path + ": vocabulary format version " + std::to_string(version) +
-                             " is not supported (this build reads version " +
-                             std::to_string(kVocabularyFormatVersion) + "); rebuild it with build-vocabulary");
+                             " is not supported (this build reads version " + std::to_string(kVocabularyFormatVersion) +
+                             "); rebuild it with build-vocabulary");
   VocabularyData d;
   const auto type = r.get<uint32_t>("header");
   if (type != static_cast<uint32_t>(DescriptorType::Sift) && type != static_cast<uint32_t>(DescriptorType::Orb))
@@ -158,8 +162,8 @@ Vocabulary loadVocabulary(const std::string& path) {
   d.training_descriptors = r.get<uint64_t>("header");
   // Guard the allocations against a corrupt header before the checksum can tell.
   if (nodes == 0 || nodes > (1ull << 32) - 1 || words == 0 || words > nodes)
-    throw common::InputError(path + ": corrupt vocabulary header (" + std::to_string(nodes) + " nodes, " +
-                             std::to_string(words) + " words)");
+    throw common::InputError(path + ": corrupt vocabulary header (" + std::to_string(nodes) + " nodes, " + std::to_string(words) +
+                             " words)");
   const size_t bytes = static_cast<size_t>(descriptorBytes(d.type));
   r.array(d.first_child, nodes, "child indices");
   r.array(d.child_count, nodes, "child counts");

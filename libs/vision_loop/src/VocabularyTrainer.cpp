@@ -46,8 +46,7 @@ Vocabulary trainVocabulary(const std::vector<cv::Mat>& per_image, DescriptorType
   for (const cv::Mat& d : per_image) {
     if (d.empty()) continue;
     if (d.type() != CV_8U || d.cols != bytes)
-      throw common::InputError("training descriptors do not match " + descriptorName(type) + " (" +
-                               std::to_string(bytes) + " bytes)");
+      throw common::InputError("training descriptors do not match " + descriptorName(type) + " (" + std::to_string(bytes) + " bytes)");
     total += d.rows;
     ++images;
   }

@@ -34,40 +34,37 @@ struct CovarianceOptions {
   CovarianceMethod method = CovarianceMethod::LineVariance;
   double association_gate_m = 0.3;  // pairs farther apart at the final transform are ignored
   LineNormalOptions normals;
-  bool scale_by_residuals = true;   // line variance: inflate by chi^2/dof when it exceeds 1
-  double max_std_m = 100.0;         // weak prior bounding free directions
+  bool scale_by_residuals = true;  // line variance: inflate by chi^2/dof when it exceeds 1
+  double max_std_m = 100.0;        // weak prior bounding free directions
   double max_std_rad = 3.14159;
   bool hessian_point_to_line = false;  // Hessian of the point-to-line error instead of point-to-point
-  int samples = 30;                 // sampling method
+  int samples = 30;                    // sampling method
   double sample_sigma_m = 0.3;
   double sample_sigma_rad = 0.1;
   unsigned seed = 1;
 };
 
 // Covariance of `transform` (the pose of `moving` in `reference`'s frame), order (x, y, phi).
-Eigen::Matrix3d lineVarianceCovariance(const IndexedReference& reference, const PointSet& moving,
-                                       const common::Pose2& transform, const CovarianceOptions& options);
-Eigen::Matrix3d hessianCovariance(const IndexedReference& reference, const PointSet& moving,
-                                  const common::Pose2& transform, const CovarianceOptions& options);
-Eigen::Matrix3d samplingCovariance(const IndexedReference& reference, const PointSet& moving,
-                                   const common::Pose2& transform, const IcpOptions& icp,
-                                   bool point_to_line, const CovarianceOptions& options);
+Eigen::Matrix3d lineVarianceCovariance(const IndexedReference& reference, const PointSet& moving, const common::Pose2& transform,
+                                       const CovarianceOptions& options);
+Eigen::Matrix3d hessianCovariance(const IndexedReference& reference, const PointSet& moving, const common::Pose2& transform,
+                                  const CovarianceOptions& options);
+Eigen::Matrix3d samplingCovariance(const IndexedReference& reference, const PointSet& moving, const common::Pose2& transform,
+                                   const IcpOptions& icp, bool point_to_line, const CovarianceOptions& options);
 
 // Dispatch on options.method (the ICP options are used by Sampling only).
-Eigen::Matrix3d alignmentCovariance(const IndexedReference& reference, const PointSet& moving,
-                                    const common::Pose2& transform, const IcpOptions& icp,
-                                    bool point_to_line, const CovarianceOptions& options);
-Eigen::Matrix3d alignmentCovariance(const PointSet& reference, const PointSet& moving,
-                                    const common::Pose2& transform, const IcpOptions& icp,
-                                    bool point_to_line, const CovarianceOptions& options);
+Eigen::Matrix3d alignmentCovariance(const IndexedReference& reference, const PointSet& moving, const common::Pose2& transform,
+                                    const IcpOptions& icp, bool point_to_line, const CovarianceOptions& options);
+Eigen::Matrix3d alignmentCovariance(const PointSet& reference, const PointSet& moving, const common::Pose2& transform,
+                                    const IcpOptions& icp, bool point_to_line, const CovarianceOptions& options);
 
 // How well the geometry constrains the translation: ratio of the smallest to the largest
 // eigenvalue of the translational point-to-line information (with the rotation marginalised).
 // Near 0 for a corridor (free along its axis), near 1 for a room corner. 0 without associations.
-double translationConstraintRatio(const IndexedReference& reference, const PointSet& moving,
-                                  const common::Pose2& transform, const CovarianceOptions& options);
-double translationConstraintRatio(const PointSet& reference, const PointSet& moving,
-                                  const common::Pose2& transform, const CovarianceOptions& options);
+double translationConstraintRatio(const IndexedReference& reference, const PointSet& moving, const common::Pose2& transform,
+                                  const CovarianceOptions& options);
+double translationConstraintRatio(const PointSet& reference, const PointSet& moving, const common::Pose2& transform,
+                                  const CovarianceOptions& options);
 
 CovarianceMethod parseCovarianceMethod(const std::string& name);  // line|hessian|sampling
 std::string covarianceMethodName(CovarianceMethod method);

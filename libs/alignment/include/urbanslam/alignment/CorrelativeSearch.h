@@ -21,9 +21,9 @@ struct CorrelativeWindow {
 
 struct CorrelativeResult {
   common::Pose2 pose;
-  double score = 0;        // scan log-likelihood + prior log-density at pose
-  double scan_score = 0;   // the scan's share of it
-  int nodes = 0;           // blocks scored (the search's cost)
+  double score = 0;       // scan log-likelihood + prior log-density at pose
+  double scan_score = 0;  // the scan's share of it
+  int nodes = 0;          // blocks scored (the search's cost)
 };
 
 // points: the scan's points in its own frame (thinned so they are roughly independent).

@@ -38,25 +38,25 @@ struct CrfOptions {
     return o;
   }();
   std::vector<double> feature_radii_m = {0.3, 0.8, 2.0};  // turning-angle scales
-  double feature_sigma_rad = 0.3;      // width of the local potential per feature
-  double missing_feature_cost = 1.0;   // -log phi when a feature exists in one scan only
-  double pair_sigma_m = 0.2;           // width of the distance-consistency potential
-  double pair_direction_sigma_rad = 0.35;  // width of the relative-direction term (0 = off)
-  double tangent_radius_m = 0.3;       // the sweep tangent at a point spans this radius
-  double pair_floor = 1e-3;            // psi floor: no joint assignment is impossible
-  double outlier_local = 0.05;         // phi of the outlier state (a perfect feature match is 1)
-  double outlier_pair = 0.05;          // psi between the outlier state and anything
-  std::vector<int> edge_offsets = {1, 4, 13};  // links i -- i+s among the subsampled points
+  double feature_sigma_rad = 0.3;                         // width of the local potential per feature
+  double missing_feature_cost = 1.0;                      // -log phi when a feature exists in one scan only
+  double pair_sigma_m = 0.2;                              // width of the distance-consistency potential
+  double pair_direction_sigma_rad = 0.35;                 // width of the relative-direction term (0 = off)
+  double tangent_radius_m = 0.3;                          // the sweep tangent at a point spans this radius
+  double pair_floor = 1e-3;                               // psi floor: no joint assignment is impossible
+  double outlier_local = 0.05;                            // phi of the outlier state (a perfect feature match is 1)
+  double outlier_pair = 0.05;                             // psi between the outlier state and anything
+  std::vector<int> edge_offsets = {1, 4, 13};             // links i -- i+s among the subsampled points
   int bp_iterations = 15;
-  double bp_damping = 0.5;             // new message = (1 - damping) * computed + damping * old
-  double bp_tolerance = 1e-4;          // max change of any message to stop early
-  double min_marginal = 0.05;          // associations less probable than this are not used
-  int candidates_per_point = 3;        // most probable states of each point entering the consensus
-  int consensus_hypotheses = 300;      // two-association transform hypotheses scored
-  unsigned seed = 1;                   // of the hypothesis draws (results are reproducible)
-  int hypotheses_kept = 4;             // distinct best hypotheses reported for verification
-  double guess_sigma_m = 0;            // > 0: weak prior on the associations from the guess
-  double inlier_gate_m = 0.3;          // final weighted least squares uses pairs closer than this
+  double bp_damping = 0.5;         // new message = (1 - damping) * computed + damping * old
+  double bp_tolerance = 1e-4;      // max change of any message to stop early
+  double min_marginal = 0.05;      // associations less probable than this are not used
+  int candidates_per_point = 3;    // most probable states of each point entering the consensus
+  int consensus_hypotheses = 300;  // two-association transform hypotheses scored
+  unsigned seed = 1;               // of the hypothesis draws (results are reproducible)
+  int hypotheses_kept = 4;         // distinct best hypotheses reported for verification
+  double guess_sigma_m = 0;        // > 0: weak prior on the associations from the guess
+  double inlier_gate_m = 0.3;      // final weighted least squares uses pairs closer than this
   int min_associations = 6;
 };
 
@@ -69,13 +69,11 @@ struct CrfDiagnostics {
 
 // CRF-match of `moving` onto `reference`. `guess` only matters when guess_sigma_m > 0.
 // Matches refer to indices of the input sets.
-RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving,
-                            const common::Pose2& guess, const CrfOptions& options,
+RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, const common::Pose2& guess, const CrfOptions& options,
                             CrfDiagnostics* diagnostics = nullptr);
 
 // The transform-invariant shape features of the points of `subsampled.segmented` (one vector
 // per point, NaN = undefined because the segment ends within the radius). Exposed for tests.
-std::vector<std::vector<double>> crfShapeFeatures(const SubsamplingResult& subsampled,
-                                                  const std::vector<double>& radii_m);
+std::vector<std::vector<double>> crfShapeFeatures(const SubsamplingResult& subsampled, const std::vector<double>& radii_m);
 
 }  // namespace urbanslam::alignment

@@ -14,7 +14,7 @@ struct FreeSpaceOptions {
   // margin_m + margin_fraction * that range (beam divergence, range noise, alignment error).
   double margin_m = 0.3;
   double margin_fraction = 0.05;
-  double min_range_m = 0.2;   // beams shorter than this see nothing useful (the robot itself)
+  double min_range_m = 0.2;  // beams shorter than this see nothing useful (the robot itself)
   // A beam with no return (at or beyond the sensor's or the configured maximum range) saw free
   // space up to this distance: outdoors most of a scan is sky and open ground. 0: a no-return
   // says nothing (glass and black surfaces also return nothing).
@@ -22,8 +22,8 @@ struct FreeSpaceOptions {
 };
 
 struct FreeSpaceConflict {
-  int tested = 0;      // points that fell inside the other scan's field of view, on returns
-  int conflicts = 0;   // of those, points inside the other scan's free space
+  int tested = 0;     // points that fell inside the other scan's field of view, on returns
+  int conflicts = 0;  // of those, points inside the other scan's free space
   double fraction() const { return tested > 0 ? static_cast<double>(conflicts) / tested : 0.0; }
 };
 

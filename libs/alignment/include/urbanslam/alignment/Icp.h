@@ -19,37 +19,34 @@ namespace urbanslam::alignment {
 enum class RobustKernel { None, Huber, Cauchy };
 
 struct IcpOptions {
-  double gate_initial_m = 4.0;     // association gate of the first iterations (bench: 4 m beats
-                                   // 1.5 and 2.5 m from initial errors of 1-2 m)
-  double gate_final_m = 0.2;       // smallest gate; must exceed noise + beam spacing
-  double gate_shrink = 0.6;        // gate *= this each time the estimate settles at a gate
+  double gate_initial_m = 4.0;  // association gate of the first iterations (bench: 4 m beats
+                                // 1.5 and 2.5 m from initial errors of 1-2 m)
+  double gate_final_m = 0.2;    // smallest gate; must exceed noise + beam spacing
+  double gate_shrink = 0.6;     // gate *= this each time the estimate settles at a gate
   int max_iterations = 60;
-  double tolerance_m = 1e-4;       // an update smaller than this (and tolerance_rad) has settled
+  double tolerance_m = 1e-4;  // an update smaller than this (and tolerance_rad) has settled
   double tolerance_rad = 1e-4;
   // The kernel weights pairs only at the final gate (see Icp.cpp). Applied at every gate it
   // cost success on the Freiburg pairs (PL-ICP from 1 m / 30 deg: none 84 %, Cauchy 73 %).
   RobustKernel kernel = RobustKernel::Cauchy;
-  double kernel_scale_m = 0.05;    // residual at which the kernel starts to discount a pair
-  int min_matches = 8;             // fewer pairs than this: no solution
-  double min_overlap = 0.25;       // fraction of moving points matched at the final gate
-  LineNormalOptions normals;       // point-to-line only
+  double kernel_scale_m = 0.05;  // residual at which the kernel starts to discount a pair
+  int min_matches = 8;           // fewer pairs than this: no solution
+  double min_overlap = 0.25;     // fraction of moving points matched at the final gate
+  LineNormalOptions normals;     // point-to-line only
 };
 
 class NearestNeighbours;
 
 // Point-to-point ICP of `moving` onto `reference`, starting from `guess`.
-RegistrationResult icp(const PointSet& reference, const PointSet& moving, const common::Pose2& guess,
-                       const IcpOptions& options);
+RegistrationResult icp(const PointSet& reference, const PointSet& moving, const common::Pose2& guess, const IcpOptions& options);
 
 // Point-to-line ICP.
-RegistrationResult plIcp(const PointSet& reference, const PointSet& moving,
-                         const common::Pose2& guess, const IcpOptions& options);
+RegistrationResult plIcp(const PointSet& reference, const PointSet& moving, const common::Pose2& guess, const IcpOptions& options);
 
 // The shared loop, for callers that run many alignments against one reference (sampling
 // covariance): a prebuilt index of the reference and its normals (one per reference point;
 // empty = point-to-point).
-RegistrationResult icpWithIndex(const PointSet& reference, const NearestNeighbours& index,
-                                const std::vector<LineNormal>& normals, const PointSet& moving,
-                                const common::Pose2& guess, const IcpOptions& options);
+RegistrationResult icpWithIndex(const PointSet& reference, const NearestNeighbours& index, const std::vector<LineNormal>& normals,
+                                const PointSet& moving, const common::Pose2& guess, const IcpOptions& options);
 
 }  // namespace urbanslam::alignment

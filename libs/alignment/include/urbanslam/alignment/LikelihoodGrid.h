@@ -22,11 +22,11 @@
 namespace urbanslam::alignment {
 
 struct LikelihoodGridOptions {
-  double resolution_m = 0.05;      // cell size
-  double hit_sigma_m = 0.05;       // spread of a return about the surface it hit (noise + cell size)
-  double miss_floor = 0.05;        // κ: the density of an unexplained return relative to a hit's peak
-  double max_radius_m = 40.0;      // cells farther than this from the centre (along x or y) are left out
-  int levels = 5;                  // pyramid levels above the base (blocks of 2^levels cells; wider windows get more root blocks)
+  double resolution_m = 0.05;  // cell size
+  double hit_sigma_m = 0.05;   // spread of a return about the surface it hit (noise + cell size)
+  double miss_floor = 0.05;    // κ: the density of an unexplained return relative to a hit's peak
+  double max_radius_m = 40.0;  // cells farther than this from the centre (along x or y) are left out
+  int levels = 5;              // pyramid levels above the base (blocks of 2^levels cells; wider windows get more root blocks)
 };
 
 class LikelihoodGrid {
@@ -70,8 +70,8 @@ class LikelihoodGrid {
 
  private:
   double resolution_;
-  Eigen::Vector2d origin_;   // corner of cell (0, 0)
-  int pad_ = 0;              // cells before cell 0 on each axis (blocks that start outside)
+  Eigen::Vector2d origin_;  // corner of cell (0, 0)
+  int pad_ = 0;             // cells before cell 0 on each axis (blocks that start outside)
   int width_ = 0, height_ = 0;
   float floor_ = 0;
   struct Dims {
@@ -90,9 +90,13 @@ class LikelihoodGrid {
     template <typename U>
     NoFill(const NoFill<U>&) {}
     template <typename U>
-    void construct(U* p) { ::new (static_cast<void*>(p)) U; }
+    void construct(U* p) {
+      ::new (static_cast<void*>(p)) U;
+    }
     template <typename U, typename... A>
-    void construct(U* p, A&&... a) { ::new (static_cast<void*>(p)) U(std::forward<A>(a)...); }
+    void construct(U* p, A&&... a) {
+      ::new (static_cast<void*>(p)) U(std::forward<A>(a)...);
+    }
   };
   using Cells = std::vector<float, NoFill<float>>;
   std::vector<Cells> level_;

@@ -38,8 +38,8 @@ class MotionPrior {
  private:
   common::Pose2 mean_;
   Eigen::Matrix3d information_;
-  double log_gauss_norm_;   // log of the Gaussian's peak density times (1 - outlier share)
-  double log_uniform_;      // log of the uniform share's density
+  double log_gauss_norm_;  // log of the Gaussian's peak density times (1 - outlier share)
+  double log_uniform_;     // log of the uniform share's density
 };
 
 }  // namespace urbanslam::alignment

@@ -24,8 +24,7 @@ class NearestNeighbours {
   // prunes every branch beyond the bound (ICP's gate leaves most unmatched points far away).
   bool nearestWithin(const Eigen::Vector2d& query, double max_distance_sq, int* index, double* distance_sq) const;
   // Up to k nearest, closest first.
-  size_t knn(const Eigen::Vector2d& query, size_t k, std::vector<int>* indices,
-             std::vector<double>* distances_sq) const;
+  size_t knn(const Eigen::Vector2d& query, size_t k, std::vector<int>* indices, std::vector<double>* distances_sq) const;
 
  private:
   struct Impl;

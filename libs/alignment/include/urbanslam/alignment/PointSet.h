@@ -12,11 +12,11 @@
 namespace urbanslam::alignment {
 
 struct ScanPoint {
-  Eigen::Vector2d p = Eigen::Vector2d::Zero();      // metres, in the scan's frame
-  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();    // Cartesian covariance (thesis eq. 3.4)
-  double range_m = 0;                               // original range (eq. 3.1)
-  double bearing_rad = 0;                           // original bearing
-  int beam = 0;                                     // index of the beam in the original sweep
+  Eigen::Vector2d p = Eigen::Vector2d::Zero();    // metres, in the scan's frame
+  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();  // Cartesian covariance (thesis eq. 3.4)
+  double range_m = 0;                             // original range (eq. 3.1)
+  double bearing_rad = 0;                         // original bearing
+  int beam = 0;                                   // index of the beam in the original sweep
 };
 
 // Points in increasing beam order (the order of the sweep). A concatenation of several scans

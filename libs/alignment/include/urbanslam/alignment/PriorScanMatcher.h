@@ -28,30 +28,30 @@ namespace urbanslam::alignment {
 
 struct PriorMatcherOptions {
   LikelihoodGridOptions grid;
-  double voxel_m = 0.2;                       // the search scores one point per voxel
-  double search_window_m = 1.0;               // translation reach of the search (+-, each axis) at least
-  double search_window_deg = 30.0;            // heading reach at least
-  double max_search_window_m = 3.0;           // the prior's 3σ widens the window up to this
+  double voxel_m = 0.2;              // the search scores one point per voxel
+  double search_window_m = 1.0;      // translation reach of the search (+-, each axis) at least
+  double search_window_deg = 30.0;   // heading reach at least
+  double max_search_window_m = 3.0;  // the prior's 3σ widens the window up to this
   double max_search_window_deg = 90.0;
-  double odometry_outlier_probability = 1e-4; // the prior's uniform share (MotionPrior.h)
-  double point_sigma_m = 0.05;                // a return's distance to the reference surface (refinement)
-  double kernel_scale_m = 0.05;               // Cauchy kernel scale
-  double gate_m = 0.3;                        // refinement associations farther than this are ignored
+  double odometry_outlier_probability = 1e-4;  // the prior's uniform share (MotionPrior.h)
+  double point_sigma_m = 0.05;                 // a return's distance to the reference surface (refinement)
+  double kernel_scale_m = 0.05;                // Cauchy kernel scale
+  double gate_m = 0.3;                         // refinement associations farther than this are ignored
   int max_iterations = 30;
-  int min_points = 10;                        // fewer voxels: no match, the prior alone
+  int min_points = 10;  // fewer voxels: no match, the prior alone
   LineNormalOptions normals;
 };
 
 struct PriorMatchResult {
-  bool valid = false;                 // false: too few points, the prior is the answer
+  bool valid = false;  // false: too few points, the prior is the answer
   std::string failure_reason;
-  common::Pose2 pose;                 // posterior mode: the scan's pose in the reference's frame
+  common::Pose2 pose;                                 // posterior mode: the scan's pose in the reference's frame
   Eigen::Matrix3d cov = Eigen::Matrix3d::Identity();  // posterior covariance (x, y, phi)
-  common::Pose2 search_pose;          // the correlative search's pose
-  double scan_log_likelihood = 0;     // at search_pose
-  double prior_weight = 1;            // the prior's Gaussian share at the result (0: odometry outvoted)
-  int voxels = 0, points = 0, matched = 0;  // thinned points, refinement points, associated at the end
-  double rms_residual_m = 0;          // distance of the associated points to their neighbours
+  common::Pose2 search_pose;                          // the correlative search's pose
+  double scan_log_likelihood = 0;                     // at search_pose
+  double prior_weight = 1;                            // the prior's Gaussian share at the result (0: odometry outvoted)
+  int voxels = 0, points = 0, matched = 0;            // thinned points, refinement points, associated at the end
+  double rms_residual_m = 0;                          // distance of the associated points to their neighbours
   int iterations = 0, search_nodes = 0;
   double time_ms = 0;
   double matchedFraction() const { return points > 0 ? static_cast<double>(matched) / points : 0.0; }

@@ -11,18 +11,18 @@
 namespace urbanslam::alignment {
 
 struct Correspondence {
-  int moving = 0;        // index into the moving set
-  int reference = 0;     // index into the reference set
-  double weight = 1.0;   // robust-kernel / CRF marginal weight
+  int moving = 0;       // index into the moving set
+  int reference = 0;    // index into the reference set
+  double weight = 1.0;  // robust-kernel / CRF marginal weight
 };
 
 struct RegistrationResult {
   common::Pose2 transform;
   int iterations = 0;
   bool converged = false;
-  std::string failure_reason;          // empty when converged
-  std::vector<Correspondence> matches; // at the final transform
-  double rms_residual_m = 0;           // of the matched pairs, in the minimised error
+  std::string failure_reason;           // empty when converged
+  std::vector<Correspondence> matches;  // at the final transform
+  double rms_residual_m = 0;            // of the matched pairs, in the minimised error
 };
 
 }  // namespace urbanslam::alignment

@@ -15,19 +15,27 @@ class Json {
   enum class Type { Null, Bool, Number, Integer, String, Array, Object };
 
   Json() = default;
-  Json(bool b) : type_(Type::Bool), bool_(b) {}                       // NOLINT
-  Json(double d) : type_(Type::Number), number_(d) {}                 // NOLINT
-  Json(int i) : type_(Type::Integer), integer_(i) {}                  // NOLINT
-  Json(long i) : type_(Type::Integer), integer_(i) {}                 // NOLINT
-  Json(long long i) : type_(Type::Integer), integer_(i) {}            // NOLINT
-  Json(unsigned long i) : type_(Type::Integer), integer_(static_cast<long long>(i)) {}  // NOLINT
+  Json(bool b) : type_(Type::Bool), bool_(b) {}                                              // NOLINT
+  Json(double d) : type_(Type::Number), number_(d) {}                                        // NOLINT
+  Json(int i) : type_(Type::Integer), integer_(i) {}                                         // NOLINT
+  Json(long i) : type_(Type::Integer), integer_(i) {}                                        // NOLINT
+  Json(long long i) : type_(Type::Integer), integer_(i) {}                                   // NOLINT
+  Json(unsigned long i) : type_(Type::Integer), integer_(static_cast<long long>(i)) {}       // NOLINT
   Json(unsigned long long i) : type_(Type::Integer), integer_(static_cast<long long>(i)) {}  // NOLINT
-  Json(unsigned i) : type_(Type::Integer), integer_(i) {}             // NOLINT
-  Json(const char* s) : type_(Type::String), string_(s) {}            // NOLINT
-  Json(std::string s) : type_(Type::String), string_(std::move(s)) {} // NOLINT
+  Json(unsigned i) : type_(Type::Integer), integer_(i) {}                                    // NOLINT
+  Json(const char* s) : type_(Type::String), string_(s) {}                                   // NOLINT
+  Json(std::string s) : type_(Type::String), string_(std::move(s)) {}                        // NOLINT
 
-  static Json array() { Json j; j.type_ = Type::Array; return j; }
-  static Json object() { Json j; j.type_ = Type::Object; return j; }
+  static Json array() {
+    Json j;
+    j.type_ = Type::Array;
+    return j;
+  }
+  static Json object() {
+    Json j;
+    j.type_ = Type::Object;
+    return j;
+  }
   template <typename T>
   static Json arrayOf(const std::vector<T>& v) {
     Json j = array();
@@ -56,7 +64,7 @@ class Json {
   double number_ = 0;
   long long integer_ = 0;
   std::string string_;
-  std::vector<Json> items_;               // array items, or object values (parallel to keys_)
+  std::vector<Json> items_;  // array items, or object values (parallel to keys_)
   std::vector<std::string> keys_;
 };
 

@@ -18,14 +18,13 @@ class OptionsSchema {
   // Subsequent add() calls go into this section.
   void section(const std::string& name, const std::string& doc);
 
-  void add(const std::string& key, double& value, double min, double max, const std::string& unit,
-           const std::string& doc, bool required = false);
-  void add(const std::string& key, int& value, int min, int max, const std::string& unit,
-           const std::string& doc, bool required = false);
+  void add(const std::string& key, double& value, double min, double max, const std::string& unit, const std::string& doc,
+           bool required = false);
+  void add(const std::string& key, int& value, int min, int max, const std::string& unit, const std::string& doc, bool required = false);
   void add(const std::string& key, bool& value, const std::string& doc, bool required = false);
   // choices empty: any string (e.g. a path).
-  void add(const std::string& key, std::string& value, const std::vector<std::string>& choices,
-           const std::string& doc, bool required = false);
+  void add(const std::string& key, std::string& value, const std::vector<std::string>& choices, const std::string& doc,
+           bool required = false);
 
   // Applies the ini on top of the current values. Throws ConfigError.
   void load(const IniFile& ini);
@@ -46,8 +45,7 @@ class OptionsSchema {
   const std::vector<Section>& sections() const { return sections_; }
 
  private:
-  Option& push(const std::string& key, const std::string& unit, const std::string& range,
-               const std::string& doc, bool required);
+  Option& push(const std::string& key, const std::string& unit, const std::string& range, const std::string& doc, bool required);
 
   std::vector<Section> sections_;
   std::vector<Option> options_;

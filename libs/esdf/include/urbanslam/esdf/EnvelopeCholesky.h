@@ -26,10 +26,10 @@ class EnvelopeCholesky {
 
  private:
   int n_ = 0;
-  std::vector<int> lo_;      // lo_[p]: first column of row p's envelope (window indices)
-  std::vector<size_t> row_;  // row_[p]: index in blocks_ of L(p, lo_[p])
-  std::vector<Mat3> blocks_; // L(p, lo_[p] .. p), row after row
-  std::vector<Mat3> inv_;    // L(p, p)^-1
+  std::vector<int> lo_;       // lo_[p]: first column of row p's envelope (window indices)
+  std::vector<size_t> row_;   // row_[p]: index in blocks_ of L(p, lo_[p])
+  std::vector<Mat3> blocks_;  // L(p, lo_[p] .. p), row after row
+  std::vector<Mat3> inv_;     // L(p, p)^-1
   const Mat3& l(int p, int j) const { return blocks_[row_[p] + static_cast<size_t>(j - lo_[p])]; }
   Mat3& l(int p, int j) { return blocks_[row_[p] + static_cast<size_t>(j - lo_[p])]; }
 };

@@ -63,8 +63,8 @@ struct EsdfOptions {
 
 struct ObservationResult {
   bool accepted = true;
-  GateResult gate;     // filled when the observation was gated
-  double chi2 = 0;     // e' Omega e of the innovation at the linearisation point
+  GateResult gate;  // filled when the observation was gated
+  double chi2 = 0;  // e' Omega e of the innovation at the linearisation point
 };
 
 struct RecoveryStats {
@@ -141,9 +141,9 @@ class Esdf {
   struct Factor {
     enum class Kind : std::uint8_t { Prior, Motion, Relative };
     Kind kind;
-    int a, b;          // b = -1 for a prior
-    Vec3 z;            // prior mean, motion input u (padded), or relative measurement
-    Mat3 weight;       // prior information, Q_v (padded), or Omega
+    int a, b;     // b = -1 for a prior
+    Vec3 z;       // prior mean, motion input u (padded), or relative measurement
+    Mat3 weight;  // prior information, Q_v (padded), or Omega
     double dt = 0;
     std::shared_ptr<const MotionModel> model;
     Vec3 lin_a, lin_b;  // linearisation point
@@ -159,8 +159,20 @@ class Esdf {
   struct Contribution {
     Mat3 aa = Mat3::Zero(), bb = Mat3::Zero(), ab = Mat3::Zero();
     Vec3 eta_a = Vec3::Zero(), eta_b = Vec3::Zero();
-    void scale(double k) { aa *= k; bb *= k; ab *= k; eta_a *= k; eta_b *= k; }
-    void accumulate(const Contribution& o) { aa += o.aa; bb += o.bb; ab += o.ab; eta_a += o.eta_a; eta_b += o.eta_b; }
+    void scale(double k) {
+      aa *= k;
+      bb *= k;
+      ab *= k;
+      eta_a *= k;
+      eta_b *= k;
+    }
+    void accumulate(const Contribution& o) {
+      aa += o.aa;
+      bb += o.bb;
+      ab += o.ab;
+      eta_a += o.eta_a;
+      eta_b += o.eta_b;
+    }
   };
   Contribution contribution(const Factor& f) const;
   void add(const Factor& f, const Contribution& c);
@@ -181,9 +193,9 @@ class Esdf {
   std::vector<int> first_factor_of_pose_;  // factors_.size() when the pose was created
 
   SparseCholesky full_factor_;
-  EnvelopeCholesky window_factor_;  // partial recovery of the recent poses
+  EnvelopeCholesky window_factor_;                     // partial recovery of the recent poses
   double gate_probability_ = -1, gate_threshold_ = 0;  // cached chi2 quantile
-  std::uint64_t values_stamp_ = 0;          // bumped on every change of Lambda or eta
+  std::uint64_t values_stamp_ = 0;                     // bumped on every change of Lambda or eta
   std::uint64_t full_factor_values_ = ~std::uint64_t{0};
 
   // Conservative covariance support: for poses k >= chain_base_, x_k = Phi_k x_{base-1} + noise

@@ -7,8 +7,8 @@
 
 namespace urbanslam::esdf {
 
-using MatU = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 3>;  // F_u: 3 x (2 or 3), no heap
-using VecU = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;  // u: 2 or 3 inputs
+using MatU = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 3>;               // F_u: 3 x (2 or 3), no heap
+using VecU = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;               // u: 2 or 3 inputs
 using MatQ = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3>;  // Q_v
 
 class MotionModel {

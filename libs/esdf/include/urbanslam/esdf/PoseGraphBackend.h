@@ -60,16 +60,16 @@ struct PoseGraphBackendResult {
   int full_recoveries = 0, partial_recoveries = 0;
   long long factors_relinearised = 0;
   int final_relinearise_passes = 0;
-  bool converged = false;        // the final relinearisation ended with nothing left to relinearise
+  bool converged = false;  // the final relinearisation ended with nothing left to relinearise
   // Loop closures whose heading innovation (at the estimate when they were added) exceeded
   // pi/2, and the largest one: a closure linearised that far off may land on the wrong branch.
   int large_heading_innovations = 0;
   int heading_triggered_recoveries = 0;  // full recoveries forced by full_recovery_heading_innovation_rad
   double max_heading_innovation_rad = 0;
-  std::vector<double> step_ms;   // processing time of each edge (recovery charged to the last edge of a step)
-  double time_s = 0;             // filter time (excludes reading the file)
-  double recovery_s = 0;         // of which full recoveries
-  size_t memory_bytes = 0;       // filter storage at the end
+  std::vector<double> step_ms;  // processing time of each edge (recovery charged to the last edge of a step)
+  double time_s = 0;            // filter time (excludes reading the file)
+  double recovery_s = 0;        // of which full recoveries
+  size_t memory_bytes = 0;      // filter storage at the end
 };
 
 PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& graph, const PoseGraphBackendOptions& options = {});

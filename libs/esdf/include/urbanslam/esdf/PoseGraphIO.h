@@ -19,8 +19,8 @@ struct PoseGraphVertex {
 
 struct PoseGraphEdge {
   long from, to;
-  Vec3 measurement;   // pose of `to` in the frame of `from`
-  Mat3 information;   // in (x, y, phi) order, symmetric
+  Vec3 measurement;  // pose of `to` in the frame of `from`
+  Mat3 information;  // in (x, y, phi) order, symmetric
 };
 
 struct PoseGraph {
@@ -39,7 +39,6 @@ std::string formatPoseGraph(const PoseGraph& graph, PoseGraphFormat format);
 
 // Sum over edges of e' Omega e with e = ⊖z ⊕ (⊖x_from ⊕ x_to) (the g2o / MRPT chi2), for
 // poses given by vertex id -> index in `poses` (ids must be 0..n-1 after `indexOf`).
-double poseGraphChi2(const PoseGraph& graph, const std::vector<Vec3>& poses_by_vertex_index,
-                     const std::vector<long>& vertex_ids);
+double poseGraphChi2(const PoseGraph& graph, const std::vector<Vec3>& poses_by_vertex_index, const std::vector<long>& vertex_ids);
 
 }  // namespace urbanslam::esdf

@@ -32,9 +32,7 @@ Vec3 between(const Vec3& a, const Vec3& b);
 void betweenJacobians(const Vec3& a, const Vec3& b, Mat3* ja, Mat3* jb);
 
 // Difference of two poses in the state chart: a - b with the heading difference wrapped.
-inline Vec3 poseDifference(const Vec3& a, const Vec3& b) {
-  return {a.x() - b.x(), a.y() - b.y(), common::wrapToPi(a.z() - b.z())};
-}
+inline Vec3 poseDifference(const Vec3& a, const Vec3& b) { return {a.x() - b.x(), a.y() - b.y(), common::wrapToPi(a.z() - b.z())}; }
 
 // The error of a relative-pose edge in the g2o/MRPT convention, e = ⊖z ⊕ (⊖a ⊕ b), heading
 // wrapped. Its chi-square e' Ω e is what `urbanslam graph` reports, so the filter uses this same

@@ -11,7 +11,7 @@
 namespace urbanslam::esdf {
 
 struct TrajectoryError {
-  size_t matched = 0;           // vertex ids present in both
+  size_t matched = 0;  // vertex ids present in both
   double ate_rmse_m = 0, ate_max_m = 0;
   double heading_mean_abs_rad = 0, heading_max_abs_rad = 0;
   Vec3 alignment = Vec3::Zero();  // (tx, ty, theta) mapping the estimate onto the reference

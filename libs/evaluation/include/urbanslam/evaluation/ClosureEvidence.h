@@ -15,10 +15,10 @@ struct ClosureEvidence {
   // (the scans favour the run); reference: it stays at the reference's pose; neither: it ends
   // elsewhere or does not converge; no_scans: a keyframe has no scan.
   std::string verdict;
-  common::Pose2 from_reference;     // where PL-ICP started at the reference's pose ended
-  double matched_fraction = 0;      // share of B's points matched there
-  double run_conflict = 0;          // mutual free-space conflict at the run's measurement
-  double reference_conflict = 0;    // ... and at the reference's relative pose
+  common::Pose2 from_reference;   // where PL-ICP started at the reference's pose ended
+  double matched_fraction = 0;    // share of B's points matched there
+  double run_conflict = 0;        // mutual free-space conflict at the run's measurement
+  double reference_conflict = 0;  // ... and at the reference's relative pose
 };
 
 // Two poses of B in A's frame count as the same within these (PL-ICP's own spread on real
@@ -29,7 +29,6 @@ constexpr double kSamePoseDeg = 1.0;
 // `run` and `reference` are poses of B's vehicle frame in A's, as loop_closures.csv stores them.
 // PL-ICP runs with the aligner's default options, not the run's [loop_closure] ones: an
 // independent check of the closure, not a repeat of the run's own acceptance test.
-ClosureEvidence weighClosure(const io::LaserScan& a, const io::LaserScan& b, const common::Pose2& run,
-                             const common::Pose2& reference);
+ClosureEvidence weighClosure(const io::LaserScan& a, const io::LaserScan& b, const common::Pose2& run, const common::Pose2& reference);
 
 }  // namespace urbanslam::evaluation

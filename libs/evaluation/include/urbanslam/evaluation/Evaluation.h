@@ -27,17 +27,17 @@ struct MeanStd {
 };
 
 struct RelationMetrics {
-  size_t used = 0, skipped = 0;   // relations whose times fall outside the trajectory are skipped
+  size_t used = 0, skipped = 0;  // relations whose times fall outside the trajectory are skipped
   MeanStd abs_trans_m, sqr_trans_m2, abs_rot_deg, sqr_rot_deg2;
-  double time_offset_s = 0;       // added to the trajectory's timestamps
+  double time_offset_s = 0;  // added to the trajectory's timestamps
 };
 
 // Pose of a time-sorted trajectory at time t by linear interpolation; false outside its span
 // or across a gap longer than max_gap_s.
 bool interpolatePose(const std::vector<io::StampedPose>& traj, double t, double max_gap_s, common::Pose2& out);
 
-RelationMetrics relationMetrics(const std::vector<io::StampedPose>& traj, const std::vector<Relation>& rel,
-                                double time_offset_s, double max_gap_s = 1.0);
+RelationMetrics relationMetrics(const std::vector<io::StampedPose>& traj, const std::vector<Relation>& rel, double time_offset_s,
+                                double max_gap_s = 1.0);
 
 // Where the error comes from: each relation by where its two times fall among the scans the run
 // placed by scan matching (`scan_times`, in the trajectory's time base, any order):
@@ -53,9 +53,8 @@ struct RelationClass {
 struct RelationsByScans {
   RelationClass at_scans, one_interval, other;
 };
-RelationsByScans relationsByScans(const std::vector<io::StampedPose>& traj, const std::vector<Relation>& rel,
-                                  double time_offset_s, const std::vector<double>& scan_times, double max_gap_s = 1.0,
-                                  double at_scan_s = 0.002);
+RelationsByScans relationsByScans(const std::vector<io::StampedPose>& traj, const std::vector<Relation>& rel, double time_offset_s,
+                                  const std::vector<double>& scan_times, double max_gap_s = 1.0, double at_scan_s = 0.002);
 
 // The offset to add to the trajectory's timestamps so that it matches the relations' time base.
 // Coarse, then refined to 0.5 ms: the one that minimises the relation error of `reference`
@@ -71,10 +70,10 @@ struct TrajectoryMetrics {
   size_t matched = 0;
   double ate_rmse_m = 0, ate_max_m = 0;
   double rpe_trans_rmse_m = 0, rpe_rot_rmse_deg = 0;  // between consecutive matched poses
-  bool positions_only = false;     // reference without headings (GPS)
-  std::vector<double> times, errors_m;  // per matched pose, after alignment (for plots)
-  std::vector<io::StampedPose> aligned;  // the estimate, rigidly aligned onto the reference
-  common::Pose2 alignment;               // the rigid transform from the estimate's frame to the reference's
+  bool positions_only = false;                        // reference without headings (GPS)
+  std::vector<double> times, errors_m;                // per matched pose, after alignment (for plots)
+  std::vector<io::StampedPose> aligned;               // the estimate, rigidly aligned onto the reference
+  common::Pose2 alignment;                            // the rigid transform from the estimate's frame to the reference's
 };
 
 // Matches every reference pose to the estimate at the same time (interpolated), aligns the
@@ -105,8 +104,8 @@ struct LoopMetrics {
 };
 // An accepted closure is true when its measured relative pose agrees with the reference's
 // relative pose of the two times within the tolerances (§5.6), false otherwise.
-LoopMetrics classifyLoopClosures(const std::vector<LoopRow>& loops, const std::vector<io::StampedPose>& reference,
-                                 bool positions_only, double tol_m = 0.5, double tol_deg = 5.0);
+LoopMetrics classifyLoopClosures(const std::vector<LoopRow>& loops, const std::vector<io::StampedPose>& reference, bool positions_only,
+                                 double tol_m = 0.5, double tol_deg = 5.0);
 
 // Accepted closures checked against the relations, which are independent of any corrected log:
 // a closure (times a, b) is checkable when a relation (t1, t2), in either direction, has
@@ -119,7 +118,7 @@ struct RelationLoopCheck {
   std::vector<FalseClosure> contradictions;  // reference: the relation carried to the closure's times
 };
 RelationLoopCheck checkLoopsWithRelations(const std::vector<LoopRow>& loops, const std::vector<io::StampedPose>& nodes,
-                                          const std::vector<Relation>& rel, double time_offset_s, double bridge_s = 3.0,
-                                          double tol_m = 0.5, double tol_deg = 5.0);
+                                          const std::vector<Relation>& rel, double time_offset_s, double bridge_s = 3.0, double tol_m = 0.5,
+                                          double tol_deg = 5.0);
 
 }  // namespace urbanslam::evaluation

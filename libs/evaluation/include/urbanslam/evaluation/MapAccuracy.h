@@ -20,10 +20,10 @@ struct WallSegment {
 std::vector<WallSegment> readWallsCsv(const std::string& path);
 
 struct MapAccuracyMetrics {
-  size_t points = 0;                // map points scored
+  size_t points = 0;  // map points scored
   double mean_m = 0, median_m = 0, p95_m = 0;
-  double within_0_1_m = 0;          // fraction of points within 0.1 m of a wall
-  double beyond_1_m = 0;            // fraction farther than 1 m (moving objects, or a broken map)
+  double within_0_1_m = 0;  // fraction of points within 0.1 m of a wall
+  double beyond_1_m = 0;    // fraction farther than 1 m (moving objects, or a broken map)
 };
 
 // `to_truth` carries the map's frame into the walls' (e.g. the ATE's rigid alignment). Distances

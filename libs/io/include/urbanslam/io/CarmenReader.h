@@ -19,8 +19,8 @@ class TextScanner;
 }
 
 struct CarmenInfo {
-  bool corrected = false;       // Freiburg corrected log: FLASER poses are a reference trajectory
-  bool has_timestamps = true;   // false: timestamps all 0 or mostly repeated; scan index used instead
+  bool corrected = false;      // Freiburg corrected log: FLASER poses are a reference trajectory
+  bool has_timestamps = true;  // false: timestamps all 0 or mostly repeated; scan index used instead
   double front_max_range_m = 80;
   double rear_max_range_m = 80;
   double front_offset_m = 0, rear_offset_m = 0;
@@ -58,24 +58,24 @@ class CarmenReader : public DataSource {
   static constexpr size_t kMaxRunLines = 4096;  // bounds memory on logs whose time never moves
   std::vector<std::vector<Measurement>> run_;
   double run_stamp_ = 0, run_step_ = 0;
-  double line_step_ = 0;                 // printed resolution of the current line's time
-  bool line_is_scan_ = false;            // the current line is a laser line
+  double line_step_ = 0;       // printed resolution of the current line's time
+  bool line_is_scan_ = false;  // the current line is a laser line
   // How the log prints its times (prescan): fixed-point keeps trailing zeros, %g does not.
   bool stamp_fixed_point_ = false;
-  int stamp_digits_ = 0;                 // most significant digits seen
-  std::vector<Measurement> ready_;       // released measurements, handed out in order
+  int stamp_digits_ = 0;            // most significant digits seen
+  std::vector<Measurement> ready_;  // released measurements, handed out in order
   size_t ready_pos_ = 0;
   std::vector<std::string> fields_;
 
   // Raw odometry reconstruction.
-  bool have_odom_ = false;         // an ODOM line was seen
+  bool have_odom_ = false;  // an ODOM line was seen
   bool have_raw_ = false;
-  common::Pose2 last_odom_line_;   // pose of the previous ODOM line (its segment's frame)
-  common::Pose2 raw_;              // chained raw odometry
-  bool last_was_scan_ = false;     // the previous record was a FLASER/RLASER/ROBOTLASER1
-  common::Pose2 last_scan_pose_;   // its logged pose (an anchor repeats it)
+  common::Pose2 last_odom_line_;  // pose of the previous ODOM line (its segment's frame)
+  common::Pose2 raw_;             // chained raw odometry
+  bool last_was_scan_ = false;    // the previous record was a FLASER/RLASER/ROBOTLASER1
+  common::Pose2 last_scan_pose_;  // its logged pose (an anchor repeats it)
   long scans_ = 0;
-  bool any_odom_lines_ = false;    // from the prescan: ODOM lines exist
+  bool any_odom_lines_ = false;  // from the prescan: ODOM lines exist
 };
 
 }  // namespace urbanslam::io

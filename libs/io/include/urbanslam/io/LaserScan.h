@@ -13,14 +13,14 @@
 namespace urbanslam::io {
 
 struct LaserScan {
-  double timestamp = 0;             // seconds (Unix time, or the log's own time base)
-  std::string label;                // sensor label, e.g. "FLASER", "RLASER", "" (MRPT allows empty)
-  std::vector<float> ranges;        // metres, beam i at angle_min_rad + i * angle_increment_rad
-  std::vector<uint8_t> valid;       // 1 = a real return; 0 = no return / out of range / NaN
-  double angle_min_rad = 0;         // bearing of beam 0 in the sensor frame (counter-clockwise)
-  double angle_increment_rad = 0;   // > 0: beams ordered right to left
-  double max_range_m = 0;           // readings >= this are no-returns
-  common::Pose2 sensor_pose;        // sensor frame in the vehicle frame
+  double timestamp = 0;            // seconds (Unix time, or the log's own time base)
+  std::string label;               // sensor label, e.g. "FLASER", "RLASER", "" (MRPT allows empty)
+  std::vector<float> ranges;       // metres, beam i at angle_min_rad + i * angle_increment_rad
+  std::vector<uint8_t> valid;      // 1 = a real return; 0 = no return / out of range / NaN
+  double angle_min_rad = 0;        // bearing of beam 0 in the sensor frame (counter-clockwise)
+  double angle_increment_rad = 0;  // > 0: beams ordered right to left
+  double max_range_m = 0;          // readings >= this are no-returns
+  common::Pose2 sensor_pose;       // sensor frame in the vehicle frame
 
   size_t size() const { return ranges.size(); }
   double bearing(size_t i) const { return angle_min_rad + static_cast<double>(i) * angle_increment_rad; }

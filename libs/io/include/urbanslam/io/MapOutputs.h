@@ -55,7 +55,6 @@ struct OccupancyGridOptions {
 };
 
 // Writes `<prefix>.png` and `<prefix>.yaml`; returns the PNG's size in cells (width, height).
-std::pair<int, int> writeOccupancyGrid(const std::string& prefix, const std::vector<PosedScan>& scans,
-                                       const OccupancyGridOptions& options);
+std::pair<int, int> writeOccupancyGrid(const std::string& prefix, const std::vector<PosedScan>& scans, const OccupancyGridOptions& options);
 
 }  // namespace urbanslam::io

@@ -22,8 +22,7 @@ enum class ImageStorage {
 
 class RawlogWriter {
  public:
-  RawlogWriter(const std::string& path, RawlogLayout layout, int gz_level = 5,
-               ImageStorage images = ImageStorage::Embedded);
+  RawlogWriter(const std::string& path, RawlogLayout layout, int gz_level = 5, ImageStorage images = ImageStorage::Embedded);
   ~RawlogWriter();
   void write(const Measurement& m);
   // Flushes and renames into place. Without close(), the temporary file is removed.

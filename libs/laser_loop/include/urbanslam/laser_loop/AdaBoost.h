@@ -16,8 +16,8 @@ namespace urbanslam::laser_loop {
 
 struct BoostRound {
   WeightedStump chosen;
-  double error = 0;   // ε_t
-  double beta = 0;    // β_t
+  double error = 0;                        // ε_t
+  double beta = 0;                         // β_t
   std::vector<double> normalised_weights;  // W̃_t over the training subset (only when traced)
 };
 
@@ -44,7 +44,7 @@ class AdaBoostTrainer {
   const PairTable& data_;
   std::vector<uint32_t> subset_;
   std::vector<std::vector<uint32_t>> order_;  // per feature: subset sorted by c
-  std::vector<double> w_;          // indexed like the table (only subset entries used)
+  std::vector<double> w_;                     // indexed like the table (only subset entries used)
   std::vector<double> w_subset_;
   bool trace_;
   bool finished_ = false;

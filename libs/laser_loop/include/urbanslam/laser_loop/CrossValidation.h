@@ -28,7 +28,7 @@ struct CvOptions {
 };
 
 struct CvCurve {
-  std::vector<size_t> false_alarms, missed;   // pooled counts, index T−1
+  std::vector<size_t> false_alarms, missed;  // pooled counts, index T−1
   std::vector<double> fa_rate, md_rate, total_rate;
   size_t n_pos = 0, n_neg = 0;
   int chosen_T = 0;

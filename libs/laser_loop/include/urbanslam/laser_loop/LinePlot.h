@@ -16,7 +16,7 @@ struct PlotSeries {
 struct PlotPanel {
   std::string title, x_label, y_label;
   std::vector<PlotSeries> series;
-  bool log_x = false;  // for ROC curves at small false-alarm rates
+  bool log_x = false;                                   // for ROC curves at small false-alarm rates
   double x_min = 0, x_max = -1, y_min = 0, y_max = -1;  // max < min: from the data
 };
 

@@ -69,7 +69,7 @@ class LoopDetector {
   ClassifierModel model_;
   double factor_ = 0.5;
   double alpha_total_ = 0;
-  std::vector<int> used_features_;          // column c holds feature used_features_[c]
+  std::vector<int> used_features_;  // column c holds feature used_features_[c]
   std::vector<CompiledStump> stumps_;
   std::vector<std::vector<float>> columns_;
   std::vector<FeatureVector> keyframes_;

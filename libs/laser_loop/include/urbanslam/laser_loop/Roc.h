@@ -16,8 +16,8 @@ struct RocPoint {
 struct OperatingPoint {
   double target_false_alarm = 0;
   double detection = 0;
-  double false_alarm = 0;       // achieved (<= target)
-  double threshold = 0;         // smallest threshold reaching it (match iff score >= threshold)
+  double false_alarm = 0;  // achieved (<= target)
+  double threshold = 0;    // smallest threshold reaching it (match iff score >= threshold)
 };
 
 class Roc {

@@ -23,9 +23,9 @@
 namespace urbanslam::laser_loop {
 
 struct FeatureParams {
-  double r_max_m = 50.0;       // ranges at or beyond this count as far (no structure seen)
-  double g_max_dist_m = 1.0;   // gate on the distance between consecutive points (3.11, groups)
-  int g_min_size = 3;          // a cluster is a group when it has more than this many points
+  double r_max_m = 50.0;      // ranges at or beyond this count as far (no structure seen)
+  double g_max_dist_m = 1.0;  // gate on the distance between consecutive points (3.11, groups)
+  int g_min_size = 3;         // a cluster is a group when it has more than this many points
   // Counts and sums over beams (size, distances, groups, angular difference, ...) scale with the
   // angular resolution, so features of a 0.5° SICK and a 1° SICK are not comparable. Scans finer
   // than this are decimated to it (every k-th beam, k = round(this / increment)) before the
@@ -42,26 +42,26 @@ struct FeatureParams {
 };
 
 enum class Feature : int {
-  Area = 0,              // 3.6
-  AverageRange,          // 3.7
-  MeanCentroid,          // 3.8–3.9 (short points, divided by N)
-  ClampedCentroid,       // the twentieth: centroid of all beams with ranges clamped to r_max
-  CloseArea,             // 3.10
-  CloseDistance,         // 3.11
-  CircularityResidual,   // 3.12–3.13: algebraic residual sum of squares [m^4]
-  CircularityRadius,     // 3.12–3.13: radius of the least-squares circle [m]
-  CurvatureMean,         // 3.14
-  CurvatureStd,          // 3.14
-  Distance,              // 3.15
-  FarDistance,           // 3.16
-  GroupCount,            // groups
-  GroupMeanSize,         // groups
-  MaxRangeCount,         // 3.17–3.18
-  MeanAngularDifference, // 3.19 (a sum, as the equation says)
-  MeanDeviation,         // 3.20
-  Regularity,            // 3.21
-  Size,                  // 3.22–3.23
-  StdRange,              // 3.24
+  Area = 0,               // 3.6
+  AverageRange,           // 3.7
+  MeanCentroid,           // 3.8–3.9 (short points, divided by N)
+  ClampedCentroid,        // the twentieth: centroid of all beams with ranges clamped to r_max
+  CloseArea,              // 3.10
+  CloseDistance,          // 3.11
+  CircularityResidual,    // 3.12–3.13: algebraic residual sum of squares [m^4]
+  CircularityRadius,      // 3.12–3.13: radius of the least-squares circle [m]
+  CurvatureMean,          // 3.14
+  CurvatureStd,           // 3.14
+  Distance,               // 3.15
+  FarDistance,            // 3.16
+  GroupCount,             // groups
+  GroupMeanSize,          // groups
+  MaxRangeCount,          // 3.17–3.18
+  MeanAngularDifference,  // 3.19 (a sum, as the equation says)
+  MeanDeviation,          // 3.20
+  Regularity,             // 3.21
+  Size,                   // 3.22–3.23
+  StdRange,               // 3.24
 };
 constexpr int kFeatureCount = 20;
 

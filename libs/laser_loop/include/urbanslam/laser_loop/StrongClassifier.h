@@ -31,9 +31,7 @@ class StrongClassifier {
 
   // Σ α_t c_t / Σ α_t (0 for an empty classifier).
   double score(const FeatureVector& a, const FeatureVector& b) const;
-  bool match(const FeatureVector& a, const FeatureVector& b, double factor = 0.5) const {
-    return score(a, b) >= factor;
-  }
+  bool match(const FeatureVector& a, const FeatureVector& b, double factor = 0.5) const { return score(a, b) >= factor; }
 
  private:
   // score() form: per feature used, its stumps' thresholds sorted, with the α sums of the stumps

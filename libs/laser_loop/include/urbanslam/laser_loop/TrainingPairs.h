@@ -33,10 +33,10 @@ namespace urbanslam::laser_loop {
 
 struct LabelledScan {
   FeatureVector features{};
-  common::Pose2 pose;       // reference pose (x, y; phi valid when has_heading)
+  common::Pose2 pose;  // reference pose (x, y; phi valid when has_heading)
   bool has_heading = true;
   double timestamp = 0;
-  double path_m = 0;        // length of the reference trajectory from the first labelled scan
+  double path_m = 0;  // length of the reference trajectory from the first labelled scan
 };
 
 struct ScanLoadOptions {
@@ -71,9 +71,9 @@ struct PairRules {
   // 180° scanner sees disjoint halves of a place from opposite headings, so restricting it
   // measures the classifier on pairs whose scans can overlap. Scans without a heading pass.
   double max_heading_diff_rad = M_PI;
-  size_t max_positives = 20000;          // random subset when more exist
-  double negatives_per_positive = 1.0;   // 1 = balanced (training); more for FA resolution (eval)
-  size_t min_negatives = 0;              // at least this many negatives (when available)
+  size_t max_positives = 20000;         // random subset when more exist
+  double negatives_per_positive = 1.0;  // 1 = balanced (training); more for FA resolution (eval)
+  size_t min_negatives = 0;             // at least this many negatives (when available)
   uint64_t seed = 1;
 };
 

@@ -8,8 +8,7 @@
 
 namespace urbanslam::sim {
 
-inline common::Pose2 stepBicycle(const common::Pose2& p, double speed_mps, double steering_rad, double dt,
-                                 double wheelbase_m) {
+inline common::Pose2 stepBicycle(const common::Pose2& p, double speed_mps, double steering_rad, double dt, double wheelbase_m) {
   const double ds = speed_mps * dt;
   const double dphi = ds * std::tan(steering_rad) / wheelbase_m;
   if (std::fabs(dphi) < 1e-9) {

@@ -13,7 +13,7 @@ namespace urbanslam::sim {
 struct CityTile {
   int tx = 0, ty = 0;
   Box box;
-  int cells = 0;         // cells per side
+  int cells = 0;  // cells per side
   double cell_m = 0;
   std::vector<Segment> segments;
   // Compressed rows: the segments of cell (cx, cy) are index[offset[c] .. offset[c+1]),

@@ -13,8 +13,8 @@
 namespace urbanslam::sim {
 
 struct VehicleState {
-  double time_s = 0;      // since the start of the drive
-  common::Pose2 pose;     // rear axle, world frame
+  double time_s = 0;   // since the start of the drive
+  common::Pose2 pose;  // rear axle, world frame
   double speed_mps = 0;
   double steering_rad = 0;
   double odometer_m = 0;  // true distance driven
@@ -34,8 +34,8 @@ class Driver {
  private:
   struct PathPoint {
     Vec2 p;
-    double s = 0;           // arc length along the path
-    double speed_limit = 0; // at this point (slow through turns)
+    double s = 0;            // arc length along the path
+    double speed_limit = 0;  // at this point (slow through turns)
   };
   void extendPath();
   double clearance(NodeId n) const;
@@ -48,7 +48,7 @@ class Driver {
   RoutePlanner planner_;
   std::deque<NodeId> nodes_;  // the next intersections (the first is the one just left)
   std::deque<PathPoint> path_;
-  size_t seg_ = 0;            // the vehicle is on path_[seg_] -> path_[seg_ + 1]
+  size_t seg_ = 0;  // the vehicle is on path_[seg_] -> path_[seg_ + 1]
   VehicleState state_;
   double next_control_s_ = 0;
 };

@@ -20,9 +20,7 @@ inline double cross(Vec2 a, Vec2 b) { return a.x * b.y - a.y * b.x; }
 inline double norm(Vec2 a) { return std::hypot(a.x, a.y); }
 
 // What a wall is made of, for the camera (the laser sees only geometry).
-enum class SurfaceKind : uint8_t {
-  Facade, Featureless, Pillar, Tree, LampPost, ParkedCar, Barrier, Fountain, Bench, Island
-};
+enum class SurfaceKind : uint8_t { Facade, Featureless, Pillar, Tree, LampPost, ParkedCar, Barrier, Fountain, Bench, Island };
 
 // The appearance of a surface: `id` selects its procedural texture (facades of one repeated
 // design share it), height_m is how tall it stands (the map is 2D).
@@ -72,8 +70,10 @@ inline bool clipSegment(const Segment& s, const Box& b, Segment& out) {
       if (q[i] < 0) return false;
     } else {
       const double r = q[i] / p[i];
-      if (p[i] < 0) t0 = std::max(t0, r);
-      else t1 = std::min(t1, r);
+      if (p[i] < 0)
+        t0 = std::max(t0, r);
+      else
+        t1 = std::min(t1, r);
     }
   }
   if (t0 > t1) return false;

@@ -20,29 +20,29 @@ struct VehicleOptions {
 
 struct RouteOptions {
   double route_length_km = 3.0;
-  double speed_mps = 10.0;         // cruising speed on straight streets
-  double turn_speed_mps = 4.0;     // speed through a turn
-  double lookahead_min_m = 4.0;    // pure pursuit look-ahead: at least this ...
-  double lookahead_s = 0.6;        // ... or this many seconds of travel
-  double revisit_probability = 0.9;  // after exploring, head back to an earlier intersection
+  double speed_mps = 10.0;              // cruising speed on straight streets
+  double turn_speed_mps = 4.0;          // speed through a turn
+  double lookahead_min_m = 4.0;         // pure pursuit look-ahead: at least this ...
+  double lookahead_s = 0.6;             // ... or this many seconds of travel
+  double revisit_probability = 0.9;     // after exploring, head back to an earlier intersection
   double small_loop_probability = 0.5;  // ... and then to one of the last few (a block-sized loop)
-  int explore_min_edges = 2;       // street pieces driven freely before deciding to return
+  int explore_min_edges = 2;            // street pieces driven freely before deciding to return
   int explore_max_edges = 12;
-  double straight_probability = 0.5;  // at an intersection while exploring
+  double straight_probability = 0.5;   // at an intersection while exploring
   double start_time_s = 1700000000.0;  // timestamp of the first measurement
-  double step_s = 0.01;            // integration step of the vehicle
+  double step_s = 0.01;                // integration step of the vehicle
 };
 
 struct LaserOptions {
   bool enabled = true;
   std::string label = "LASER";
   double rate_hz = 10.0;
-  double fov_deg = 180.0;          // 180 (front) or 360
+  double fov_deg = 180.0;  // 180 (front) or 360
   double angular_resolution_deg = 0.5;
   double max_range_m = 80.0;
   double range_sigma_m = 0.01;
   double range_sigma_per_m = 0.0005;
-  double dropout_probability = 0.01;  // a beam returns nothing (glass, black paint)
+  double dropout_probability = 0.01;           // a beam returns nothing (glass, black paint)
   double x_m = 1.5, y_m = 0.0, yaw_deg = 0.0;  // mounting pose on the vehicle (rear axle frame)
 };
 
@@ -54,14 +54,14 @@ struct CameraOptions {
   std::string label = "CAMERA";
   double rate_hz = 2.0;
   int width_px = 640, height_px = 480;
-  double hfov_deg = 90.0;        // horizontal field of view (square pixels: fy = fx)
-  double cy_px = -1.0;           // row of the horizon; < 0: the image centre
+  double hfov_deg = 90.0;                      // horizontal field of view (square pixels: fy = fx)
+  double cy_px = -1.0;                         // row of the horizon; < 0: the image centre
   double x_m = 1.0, y_m = 0.0, yaw_deg = 0.0;  // mounting pose on the vehicle (rear axle frame)
-  double height_m = 1.6;         // above the ground
-  double max_range_m = 150.0;    // nothing drawn beyond (sky and ground only)
-  double fog_distance_m = 250.0; // distance fog: contrast falls by 1/e over this; 0: none
-  double noise_sigma = 2.0;      // pixel noise (grey levels, 1 sigma)
-  int noise_seed = 0;            // with the city seed: the noise stream (same city, other noise)
+  double height_m = 1.6;                       // above the ground
+  double max_range_m = 150.0;                  // nothing drawn beyond (sky and ground only)
+  double fog_distance_m = 250.0;               // distance fog: contrast falls by 1/e over this; 0: none
+  double noise_sigma = 2.0;                    // pixel noise (grey levels, 1 sigma)
+  int noise_seed = 0;                          // with the city seed: the noise stream (same city, other noise)
 };
 
 struct OdometryOptions {
@@ -74,11 +74,11 @@ struct OdometryOptions {
   double sigma_per_rad = 0.15;         // heading error per radian turned (1 sigma)
   double sigma_phi_per_m_rad = 0.032;  // heading drift per metre travelled (1 sigma)
   double correlation_length_m = 2.0;   // distance over which those errors decorrelate
-  double scale_bias = 0.01;         // wheel radius error: distance reads (1 + this) too long
-  double steering_bias_deg = 0.1;   // steering encoder offset: a straight drive curves
-  double slip_probability = 0.01;   // per second: a wheel slip event
+  double scale_bias = 0.01;            // wheel radius error: distance reads (1 + this) too long
+  double steering_bias_deg = 0.1;      // steering encoder offset: a straight drive curves
+  double slip_probability = 0.01;      // per second: a wheel slip event
   double slip_duration_s = 0.5;
-  double slip_scale = 0.3;          // during a slip the distance reads up to this much too long
+  double slip_scale = 0.3;  // during a slip the distance reads up to this much too long
 };
 
 struct GpsOptions {
@@ -94,19 +94,19 @@ struct GpsOptions {
 };
 
 struct TrafficOptions {
-  double car_spacing_m = 120.0;        // mean gap between moving cars per lane; 0: none
+  double car_spacing_m = 120.0;  // mean gap between moving cars per lane; 0: none
   double car_speed_mps = 8.0;
   double pedestrian_spacing_m = 40.0;  // mean gap between pedestrians per sidewalk; 0: none
   double pedestrian_speed_mps = 1.3;
-  double clearance_m = 8.0;            // moving objects this close to the vehicle are left out
+  double clearance_m = 8.0;  // moving objects this close to the vehicle are left out
 };
 
 struct LoopTruthOptions {
-  double min_gap_s = 30.0;        // a loop pair is at least this far apart in time
-  double max_distance_m = 15.0;   // ... and its sensor positions at most this far apart
-  double match_radius_m = 0.3;    // a beam end point overlaps when the other scan has one this close
-  double min_overlap = 0.5;       // reported when at least this fraction overlaps
-  int point_stride = 4;           // every n-th beam end point is compared
+  double min_gap_s = 30.0;       // a loop pair is at least this far apart in time
+  double max_distance_m = 15.0;  // ... and its sensor positions at most this far apart
+  double match_radius_m = 0.3;   // a beam end point overlaps when the other scan has one this close
+  double min_overlap = 0.5;      // reported when at least this fraction overlaps
+  int point_stride = 4;          // every n-th beam end point is compared
   // Image loop pairs (image_loops.csv) use the keys above on the wall points of every
   // image_column_stride-th image column, and need the views to point within this angle.
   double image_max_heading_deg = 45.0;

@@ -14,11 +14,11 @@
 namespace urbanslam::sim {
 
 struct SimulationSummary {
-  double duration_s = 0;      // simulated time
+  double duration_s = 0;  // simulated time
   double distance_m = 0;
   size_t scans = 0, odometry = 0, gps = 0, measurements = 0;
   size_t images = 0, image_loop_pairs = 0, loop_images = 0;  // loop_images: images that close a loop
-  double render_wall_s = 0;    // of simulate_wall_s: rendering images
+  double render_wall_s = 0;                                  // of simulate_wall_s: rendering images
   size_t loop_pairs = 0;
   size_t wall_segments = 0;
   size_t tiles_seen = 0, tiles_built = 0;

@@ -27,16 +27,16 @@ class SurfaceTexture {
   // What a vertical line of the surface at u needs, computed once.
   struct Column {
     double u = 0;
-    int bay = 0;          // window bay index along the facade
-    double bay_u = 0;     // position inside the bay [0, bay width)
-    bool window = false;  // inside a window opening (horizontally) ...
-    bool frame = false;   // ... and on its frame
-    bool mullion = false; // on the window's vertical bar
+    int bay = 0;           // window bay index along the facade
+    double bay_u = 0;      // position inside the bay [0, bay width)
+    bool window = false;   // inside a window opening (horizontally) ...
+    bool frame = false;    // ... and on its frame
+    bool mullion = false;  // on the window's vertical bar
     bool pilaster = false;
-    bool door = false;    // ground floor door opening
-    int letter = 0;       // sign letter index and the bit column inside it (-1: gap)
+    bool door = false;  // ground floor door opening
+    int letter = 0;     // sign letter index and the bit column inside it (-1: gap)
     int letter_col = -1;
-    int shop = 0;         // shop front index (its own sign colours)
+    int shop = 0;                       // shop front index (its own sign colours)
     int block_even = 0, block_odd = 0;  // wall material block index in even / odd courses
     double block_u_even = 0, block_u_odd = 0;
     uint64_t coarse = 0;  // hash of the coarse u cell (stains, bark, panels)

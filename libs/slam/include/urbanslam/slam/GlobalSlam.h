@@ -58,7 +58,7 @@ class GlobalSlam {
   const std::vector<PipelineObserver*>& observers_;
   LoopCloser closer_;
   std::unique_ptr<laser_loop::LoopDetector> laser_detector_;  // [loop_closure] detector = laser
-  std::deque<LoopClosureRecord> pending_;  // passed alignment + gate, awaiting confirmation
+  std::deque<LoopClosureRecord> pending_;                     // passed alignment + gate, awaiting confirmation
   std::vector<LoopClosureRecord> closures_;
   bool dirty_since_recovery_ = false;
 };

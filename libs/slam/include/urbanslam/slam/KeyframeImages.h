@@ -37,9 +37,9 @@ class KeyframeImageAssigner {
     std::optional<io::CameraImage> before, after;  // the last image up to `time`, the first after
   };
   double max_offset_s_;
-  std::optional<Slot> open_;                // the newest keyframe, whose image may still change
-  std::optional<double> previous_time_;     // the keyframe before it
-  std::optional<io::CameraImage> latest_;   // the most recent image since the open keyframe
+  std::optional<Slot> open_;               // the newest keyframe, whose image may still change
+  std::optional<double> previous_time_;    // the keyframe before it
+  std::optional<io::CameraImage> latest_;  // the most recent image since the open keyframe
   std::optional<AssignedImage> close();
 };
 

@@ -39,11 +39,11 @@ class LocalSubmap {
   alignment::PriorMatcherOptions matcher_;
   alignment::ScanModelOptions scan_model_;
   size_t capacity_;
-  std::deque<alignment::PointSet> sets_;   // each keyframe's points in its own frame
-  size_t generation_ = 0;                  // keyframes added so far
+  std::deque<alignment::PointSet> sets_;  // each keyframe's points in its own frame
+  size_t generation_ = 0;                 // keyframes added so far
   struct Cache {
     size_t generation = static_cast<size_t>(-1);
-    std::vector<common::Pose2> offsets;    // each keyframe in the newest one's frame
+    std::vector<common::Pose2> offsets;  // each keyframe in the newest one's frame
     std::unique_ptr<const alignment::MatchReference> reference;
   };
   mutable Cache cache_;

@@ -37,17 +37,17 @@ const char* reasonName(ClosureReason reason);
 
 // One loop-closure hypothesis and what became of it (a row of loop_closures.csv).
 struct LoopClosureRecord {
-  size_t from = 0, to = 0;           // earlier keyframe, current keyframe
+  size_t from = 0, to = 0;  // earlier keyframe, current keyframe
   double from_time = 0, to_time = 0;
-  std::string detector;              // which source proposed it: "pose" (near the estimate; alignment + gating verify), "laser" or "image"
-  double score = 0;                  // classifier margin, image normalised score, or alignment matched fraction
+  std::string detector;  // which source proposed it: "pose" (near the estimate; alignment + gating verify), "laser" or "image"
+  double score = 0;      // classifier margin, image normalised score, or alignment matched fraction
   bool accepted = false;
-  ClosureReason reason = ClosureReason::None;  // when not accepted
-  common::Pose2 measurement;         // aligned relative pose (from -> to)
+  ClosureReason reason = ClosureReason::None;                 // when not accepted
+  common::Pose2 measurement;                                  // aligned relative pose (from -> to)
   Eigen::Matrix3d information = Eigen::Matrix3d::Identity();  // as added to the filter
   double rms_m = 0, mahalanobis2 = 0, gate_threshold = 0;
-  double free_space_conflict = 0;    // alignment::mutualFreeSpaceConflict at the measurement
-  double prior_sigma_m = 0;          // largest std. deviation of the relative position before the closure
+  double free_space_conflict = 0;  // alignment::mutualFreeSpaceConflict at the measurement
+  double prior_sigma_m = 0;        // largest std. deviation of the relative position before the closure
 };
 
 // Optional appearance test of a candidate pair before alignment (the laser classifier).
@@ -72,8 +72,8 @@ class LoopCloser {
   std::vector<size_t> candidates(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, const KeyframeGrid& grid, size_t current);
   // Detection, alignment and gating of one candidate. With `commit`, a closure that passes is
   // added to the filter; without, it is only tested (accepted = passed) for later confirmation.
-  LoopClosureRecord tryClose(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current,
-                             bool commit = true, const Detection* detection = nullptr);
+  LoopClosureRecord tryClose(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current, bool commit = true,
+                             const Detection* detection = nullptr);
 
  private:
   Eigen::Matrix3d relativeCovariance(esdf::Esdf& filter, size_t i, size_t k);

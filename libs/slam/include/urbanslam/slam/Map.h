@@ -21,10 +21,10 @@ namespace urbanslam::slam {
 struct Keyframe {
   size_t index = 0;
   double timestamp = 0;
-  common::Pose2 pose;   // current estimate
-  io::LaserScan scan;   // kept so the map can be rebuilt from the current estimates; empty
-                        // for keyframes made from camera images alone
-  bool has_image = false;              // an image was attached (nearest in time)
+  common::Pose2 pose;                   // current estimate
+  io::LaserScan scan;                   // kept so the map can be rebuilt from the current estimates; empty
+                                        // for keyframes made from camera images alone
+  bool has_image = false;               // an image was attached (nearest in time)
   vision_loop::BagOfWords image_words;  // its Tree of Words vector (tree_of_words only); no pixels
   bool hasScan() const { return !scan.ranges.empty(); }
 };
@@ -42,9 +42,9 @@ struct GraphEdge {
 // spread between anchors, so it follows the scans rather than the odometry alone.
 struct ScanAnchor {
   double timestamp = 0;
-  size_t keyframe = 0;    // the keyframe it hangs from
-  common::Pose2 offset;   // its pose in that keyframe's frame
-  common::Pose2 odom;     // odometry pose at its time
+  size_t keyframe = 0;   // the keyframe it hangs from
+  common::Pose2 offset;  // its pose in that keyframe's frame
+  common::Pose2 odom;    // odometry pose at its time
 };
 
 class Map {
@@ -89,8 +89,8 @@ class Map {
  private:
   struct OdometrySample {
     double timestamp;
-    common::Pose2 odom;   // odometry pose at the reading
-    size_t anchor;        // last anchor before it (npos: none yet)
+    common::Pose2 odom;  // odometry pose at the reading
+    size_t anchor;       // last anchor before it (npos: none yet)
   };
 
   std::vector<Keyframe> keyframes_;

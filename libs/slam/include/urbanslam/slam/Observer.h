@@ -14,9 +14,9 @@
 namespace urbanslam::slam {
 
 struct KeyframeEvent {
-  size_t index = 0;             // keyframe id (0-based, in creation order)
+  size_t index = 0;  // keyframe id (0-based, in creation order)
   double timestamp = 0;
-  common::Pose2 pose;           // current estimate of the vehicle pose
+  common::Pose2 pose;  // current estimate of the vehicle pose
   // Marginal covariance of (x, y, phi), row-major; all zero when the estimator has none
   // (dead reckoning).
   std::array<double, 9> covariance{};
@@ -32,10 +32,10 @@ struct PosesUpdatedEvent {
 struct LoopClosureEvent {
   size_t from_keyframe = 0, to_keyframe = 0;  // earlier, current
   double timestamp = 0;
-  std::string detector;      // which source proposed it: "pose", "laser" or "image"
+  std::string detector;  // which source proposed it: "pose", "laser" or "image"
   double score = 0;
   bool accepted = false;
-  std::string reason;        // why rejected: reasonName() of slam::ClosureReason (LoopCloser.h); empty if accepted
+  std::string reason;  // why rejected: reasonName() of slam::ClosureReason (LoopCloser.h); empty if accepted
 };
 
 // The image chosen for a keyframe (the nearest in time, within [loop_closure]
@@ -50,8 +50,8 @@ struct KeyframeImageEvent {
 // earlier keyframe `matched_keyframe`, and what became of the proposal so far.
 struct ImageMatchEvent {
   size_t current_keyframe = 0, matched_keyframe = 0;
-  double score = 0;        // normalised score (similarity relative to the previous frame's)
-  bool accepted = false;   // the closure went into the filter
+  double score = 0;       // normalised score (similarity relative to the previous frame's)
+  bool accepted = false;  // the closure went into the filter
   // "accepted"; "pending" (passed alignment and gating, awaiting a confirming closure; the
   // final fate follows as a LoopClosureEvent with detector "image"); else why not: the
   // reasonName() of its slam::ClosureReason.
@@ -59,16 +59,16 @@ struct ImageMatchEvent {
 };
 
 struct CandidatesEvent {
-  size_t keyframe = 0;                 // the current keyframe
+  size_t keyframe = 0;  // the current keyframe
   const std::vector<size_t>* candidates = nullptr;
 };
 
 struct StepEvent {
-  size_t scans = 0;             // laser scans processed so far
+  size_t scans = 0;  // laser scans processed so far
   size_t keyframes = 0;
-  double timestamp = 0;         // of the last measurement
-  double step_ms = 0;           // processing time of this scan
-  double progress = 0;          // fraction of the input read, [0,1]
+  double timestamp = 0;  // of the last measurement
+  double step_ms = 0;    // processing time of this scan
+  double progress = 0;   // fraction of the input read, [0,1]
 };
 
 class PipelineObserver {

@@ -76,8 +76,8 @@ class Pipeline {
   Map map_;
   LocalSlam local_;
   GlobalSlam global_;
-  std::unique_ptr<vision_loop::LoopDetector> image_detector_; // [loop_closure] image_detector = tree_of_words
-  std::vector<size_t> image_keyframes_;  // image database id -> keyframe
+  std::unique_ptr<vision_loop::LoopDetector> image_detector_;  // [loop_closure] image_detector = tree_of_words
+  std::vector<size_t> image_keyframes_;                        // image database id -> keyframe
   KeyframeImageAssigner images_;
   bool have_first_ts_ = false;
 };

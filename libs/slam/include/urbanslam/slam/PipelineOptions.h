@@ -10,9 +10,9 @@
 namespace urbanslam::slam {
 
 struct InputOptions {
-  std::string laser_labels;   // comma-separated sensor labels to use; empty = every laser
-  double min_range_m = 0.0;   // beams shorter than this are ignored (robot body, dust)
-  double max_range_m = 0.0;   // beams at or beyond this are ignored; 0 = the sensor's own maximum
+  std::string laser_labels;  // comma-separated sensor labels to use; empty = every laser
+  double min_range_m = 0.0;  // beams shorter than this are ignored (robot body, dust)
+  double max_range_m = 0.0;  // beams at or beyond this are ignored; 0 = the sensor's own maximum
 };
 
 struct KeyframeOptions {
@@ -41,49 +41,49 @@ struct MotionOptions {
 // Local SLAM: the odometry increment between keyframes refined by aligning their scans.
 struct LocalOptions {
   bool scan_matching = true;
-  int submap_keyframes = 5;            // the scan is matched against the last this many keyframes
+  int submap_keyframes = 5;  // the scan is matched against the last this many keyframes
   // The scans between keyframes are matched with the submap too, and the trajectory at odometry
   // times follows them (the filter and the map still hold keyframes only).
   bool match_every_scan = true;
-  double match_min_interval_s = 0.0;   // ... but no scan sooner than this after the last matched one
+  double match_min_interval_s = 0.0;  // ... but no scan sooner than this after the last matched one
   // The matcher (alignment/PriorScanMatcher.h): odometry prior and scan evidence weighed by
   // their uncertainties.
-  double resolution_m = 0.05;          // likelihood grid cell
-  double hit_sigma_m = 0.05;           // spread of a return about the surface it hit
-  double miss_floor = 0.05;            // density of an unexplained return relative to a hit's peak
-  double voxel_m = 0.2;                // the correlative search scores one scan point per voxel
-  double grid_radius_m = 40.0;         // the likelihood grid covers the submap this far around its last keyframe
-  double search_window_m = 0.3;        // the search reaches at least this far from the odometry
+  double resolution_m = 0.05;    // likelihood grid cell
+  double hit_sigma_m = 0.05;     // spread of a return about the surface it hit
+  double miss_floor = 0.05;      // density of an unexplained return relative to a hit's peak
+  double voxel_m = 0.2;          // the correlative search scores one scan point per voxel
+  double grid_radius_m = 40.0;   // the likelihood grid covers the submap this far around its last keyframe
+  double search_window_m = 0.3;  // the search reaches at least this far from the odometry
   double search_window_deg = 5.0;
   double odometry_outlier_probability = 1e-4;  // the odometry being wrong beyond its covariance
-  double point_sigma_m = 0.01;         // a return's distance to the reference surface (refinement)
+  double point_sigma_m = 0.01;                 // a return's distance to the reference surface (refinement)
   // The filter gets the match's covariance times this: consecutive matches share the submap's
   // points, so their errors are correlated, which the filter's independent edges cannot say.
   double covariance_scale = 4.0;
-  double min_sigma_xy_m = 0.01;        // floors on the scan-matching uncertainty
+  double min_sigma_xy_m = 0.01;  // floors on the scan-matching uncertainty
   double min_sigma_phi_deg = 0.25;
 };
 
 // Global SLAM: loop-closure search, verification and the ESDF update.
 struct LoopClosureOptions {
   bool enabled = true;
-  std::string detector = "none";       // none (alignment + gating only) | laser (AdaBoost classifier)
-  std::string laser_model;             // classifier model file; empty = share/laser_loop/default.model
-  double laser_threshold = 0.0;        // strong-classifier margin offset (higher: fewer false alarms)
+  std::string detector = "none";  // none (alignment + gating only) | laser (AdaBoost classifier)
+  std::string laser_model;        // classifier model file; empty = share/laser_loop/default.model
+  double laser_threshold = 0.0;   // strong-classifier margin offset (higher: fewer false alarms)
   // Image proposals (Tree of Words, [image_loop]) go through the same alignment, gating and
   // confirmation as the laser candidates; without scans they are only recorded.
   std::string image_detector = "tree_of_words";  // none | tree_of_words
-  double image_max_offset_s = 0.5;      // an image is attached to the nearest keyframe only this close in time
-  int min_keyframe_gap = 30;           // closures only with keyframes at least this much older
-  double search_radius_m = 4.0;        // initial set: earlier keyframes this close (+ 3 sigma)
-  double mahalanobis_probability = 0.99;  // final set: chi2 (2 dof) gate on the relative position
-  int max_candidates = 3;              // aligned per keyframe, nearest (Mahalanobis) first
-  int every_n_keyframes = 1;           // search at every n-th keyframe
-  std::string method = "auto";         // alignment of a candidate pair: auto | icp | plicp | crf | crf+icp
-  double auto_local_max_m = 1.0;       // auto: PL-ICP when the relative pose is known to 3 sigma within this ...
-  double auto_local_max_deg = 15.0;    // ... and this; CRF-match + ICP otherwise
-  double max_rms_m = 0.08;             // alignment accepted only below this residual ...
-  double min_matched_fraction = 0.5;   // ... and with this share of points matched
+  double image_max_offset_s = 0.5;               // an image is attached to the nearest keyframe only this close in time
+  int min_keyframe_gap = 30;                     // closures only with keyframes at least this much older
+  double search_radius_m = 4.0;                  // initial set: earlier keyframes this close (+ 3 sigma)
+  double mahalanobis_probability = 0.99;         // final set: chi2 (2 dof) gate on the relative position
+  int max_candidates = 3;                        // aligned per keyframe, nearest (Mahalanobis) first
+  int every_n_keyframes = 1;                     // search at every n-th keyframe
+  std::string method = "auto";                   // alignment of a candidate pair: auto | icp | plicp | crf | crf+icp
+  double auto_local_max_m = 1.0;                 // auto: PL-ICP when the relative pose is known to 3 sigma within this ...
+  double auto_local_max_deg = 15.0;              // ... and this; CRF-match + ICP otherwise
+  double max_rms_m = 0.08;                       // alignment accepted only below this residual ...
+  double min_matched_fraction = 0.5;             // ... and with this share of points matched
   // ... and with the geometry constraining every direction: the weakest / strongest translation
   // eigenvalue of the alignment's information at least this. A closure along a corridor slides.
   double min_constraint_ratio = 0.15;
@@ -92,14 +92,14 @@ struct LoopClosureOptions {
   // repeated doors, a long facade). Checked only when the relative pose is uncertain enough
   // for the gate to admit such a shift. 0: off.
   double ambiguity_offset_m = 0.75;
-  double ambiguity_min_gain = 0.05;    // "clearly more": this share more points matched
+  double ambiguity_min_gain = 0.05;  // "clearly more": this share more points matched
   // ... and with the two scans agreeing on free space: at most this share of either scan's
   // points may lie where the other scan's beams passed through (1: off).
   double max_free_space_conflict = 0.2;
-  double free_space_margin_m = 0.3;    // a point conflicts this far (+5 % of the range) inside free space
-  double free_space_no_return_m = 0;   // a beam without a return saw free space this far (0: unknown)
+  double free_space_margin_m = 0.3;   // a point conflicts this far (+5 % of the range) inside free space
+  double free_space_no_return_m = 0;  // a beam without a return saw free space this far (0: unknown)
   double covariance_scale = 4.0;
-  double chi2_gate_probability = 0.99;   // innovation gate (3 dof); 0.99 measured better than 0.999 on Intel
+  double chi2_gate_probability = 0.99;  // innovation gate (3 dof); 0.99 measured better than 0.999 on Intel
   // A closure goes into the filter only once a second one, within this many keyframes, agrees
   // with it (0: no confirmation).
   int confirm_window = 3;
@@ -108,9 +108,9 @@ struct LoopClosureOptions {
 };
 
 struct EstimatorOptions {
-  std::string type = "esdf";           // esdf | dead_reckoning
-  bool relinearise = true;             // relinearise moved factors after a loop closure
-  int recent_window = 30;              // poses recovered after each keyframe (constant time)
+  std::string type = "esdf";  // esdf | dead_reckoning
+  bool relinearise = true;    // relinearise moved factors after a loop closure
+  int recent_window = 30;     // poses recovered after each keyframe (constant time)
 };
 
 struct MapOptions {

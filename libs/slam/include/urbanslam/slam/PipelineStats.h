@@ -6,16 +6,15 @@
 namespace urbanslam::slam {
 
 struct PipelineStats {
-  size_t measurements = 0, scans = 0, scans_used = 0, odometry = 0, drive = 0, images = 0, gps = 0,
-         reference = 0, keyframes = 0;
+  size_t measurements = 0, scans = 0, scans_used = 0, odometry = 0, drive = 0, images = 0, gps = 0, reference = 0, keyframes = 0;
   size_t scan_matches_used = 0, scan_matches_rejected = 0;
-  size_t scans_anchored = 0;     // scans between keyframes placed by a submap match ([local] match_every_scan)
+  size_t scans_anchored = 0;  // scans between keyframes placed by a submap match ([local] match_every_scan)
   size_t closures_tried = 0, closures_accepted = 0, closures_rejected = 0;
-  size_t image_keyframes = 0;   // keyframes with an image attached
-  size_t image_proposals = 0;   // Tree of Words detections (each also a loop_closures.csv row)
+  size_t image_keyframes = 0;  // keyframes with an image attached
+  size_t image_proposals = 0;  // Tree of Words detections (each also a loop_closures.csv row)
   double first_timestamp = 0, last_timestamp = 0;
-  double wall_s = 0;             // processing time, reading included
-  std::vector<double> step_ms;   // per processed scan
+  double wall_s = 0;            // processing time, reading included
+  std::vector<double> step_ms;  // per processed scan
   // The same, by the map's size when the step ran: decade k holds the steps taken with 10^k to
   // 10^(k+1) - 1 keyframes (constant time per step means the same figures in every decade).
   std::vector<std::vector<double>> step_ms_by_decade;

@@ -17,15 +17,14 @@ struct PositionCovariance {
 };
 
 struct CandidateGateOptions {
-  double chi2_gate = 9.21;      // χ²(2 DOF) at 99 %
-  double view_range_m = 5.0;    // two camera positions this close may see the same place
-  double min_sigma_m = 0.1;     // floor on the covariance (a near-singular Σ would gate out everything)
+  double chi2_gate = 9.21;    // χ²(2 DOF) at 99 %
+  double view_range_m = 5.0;  // two camera positions this close may see the same place
+  double min_sigma_m = 0.1;   // floor on the covariance (a near-singular Σ would gate out everything)
 };
 
 // Images i (ids = indices of `image_poses`) whose position, less view_range_m, is within the
 // χ² gate of the current position. `covariances` has one entry per image.
-std::vector<ImageId> selectCandidates(const std::vector<common::Pose2>& image_poses,
-                                      const std::vector<PositionCovariance>& covariances,
+std::vector<ImageId> selectCandidates(const std::vector<common::Pose2>& image_poses, const std::vector<PositionCovariance>& covariances,
                                       const common::Pose2& current, const CandidateGateOptions& options = {});
 
 }  // namespace urbanslam::vision_loop

@@ -11,19 +11,18 @@
 namespace urbanslam::vision_loop {
 
 struct VerificationOptions {
-  double ratio = 0.8;                 // Lowe's ratio: best match distance < ratio · second best
-  double ransac_threshold_px = 3.0;   // max distance of a point to its epipolar line
+  double ratio = 0.8;                // Lowe's ratio: best match distance < ratio · second best
+  double ransac_threshold_px = 3.0;  // max distance of a point to its epipolar line
   double ransac_confidence = 0.99;
-  int min_inliers = 20;               // accept with at least this many epipolar inliers
+  int min_inliers = 20;  // accept with at least this many epipolar inliers
 };
 
 struct VerificationResult {
   bool accepted = false;
-  int matches = 0;   // after the ratio test (and the one-to-one check)
-  int inliers = 0;   // of the fundamental matrix
+  int matches = 0;  // after the ratio test (and the one-to-one check)
+  int inliers = 0;  // of the fundamental matrix
 };
 
-VerificationResult verifyPair(const ImageFeatures& a, const ImageFeatures& b, DescriptorType type,
-                              const VerificationOptions& options = {});
+VerificationResult verifyPair(const ImageFeatures& a, const ImageFeatures& b, DescriptorType type, const VerificationOptions& options = {});
 
 }  // namespace urbanslam::vision_loop

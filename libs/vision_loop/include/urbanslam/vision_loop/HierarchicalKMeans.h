@@ -24,16 +24,16 @@ struct DescriptorSet {
 };
 
 struct KMeansOptions {
-  uint32_t branching = 10;   // k
-  uint32_t depth = 6;        // L: up to k^L words
-  int max_iterations = 10;   // Lloyd iterations per node (stops earlier when assignments settle)
-  uint64_t seed = 1;         // same seed + same data → same tree, whatever the thread count
-  int threads = 0;           // 0: all hardware threads
+  uint32_t branching = 10;  // k
+  uint32_t depth = 6;       // L: up to k^L words
+  int max_iterations = 10;  // Lloyd iterations per node (stops earlier when assignments settle)
+  uint64_t seed = 1;        // same seed + same data → same tree, whatever the thread count
+  int threads = 0;          // 0: all hardware threads
 };
 
 struct KMeansResult {
-  std::vector<uint8_t> centres;       // clusters × bytes (empty clusters removed)
-  std::vector<uint32_t> assignment;   // per input point: its cluster, w.r.t. the final centres
+  std::vector<uint8_t> centres;      // clusters × bytes (empty clusters removed)
+  std::vector<uint32_t> assignment;  // per input point: its cluster, w.r.t. the final centres
   int iterations = 0;
   size_t clusters() const { return assignment.empty() ? 0 : centres.size() / bytes_; }
   size_t bytes_ = 1;
@@ -42,8 +42,8 @@ struct KMeansResult {
 // One level of k-means over `points` (indices into `set`). Returns at most k clusters; fewer
 // when there are fewer distinct points. Centres for SIFT are unit directions scaled to SIFT's
 // own norm (512) and rounded to bytes, so they are compared exactly as at run time.
-KMeansResult kmeans(const DescriptorSet& set, const std::vector<uint32_t>& points, DescriptorType type,
-                    uint32_t k, int max_iterations, uint64_t seed, int threads = 1);
+KMeansResult kmeans(const DescriptorSet& set, const std::vector<uint32_t>& points, DescriptorType type, uint32_t k, int max_iterations,
+                    uint64_t seed, int threads = 1);
 
 // progress(fraction in [0,1], status)
 using ProgressFn = std::function<void(double, const std::string&)>;

@@ -24,10 +24,10 @@ struct QueryResult {
 };
 
 struct QueryOptions {
-  size_t max_results = 10;                   // top-k by score
-  ImageId max_image = 0xffffffffu;           // only images with id < max_image (e.g. not the last few frames)
+  size_t max_results = 10;                           // top-k by score
+  ImageId max_image = 0xffffffffu;                   // only images with id < max_image (e.g. not the last few frames)
   const std::vector<ImageId>* candidates = nullptr;  // when set: only these images (from the pose filter)
-  float min_score = 0.f;                     // results below are dropped
+  float min_score = 0.f;                             // results below are dropped
 };
 
 class ImageDatabase {

@@ -14,10 +14,10 @@ namespace urbanslam::vision_loop {
 constexpr const char* kDefaultVocabularyPath = "share/vision_loop/sift_k10_L4.usvoc";
 
 struct ImageLoopOptions {
-  std::string vocabulary;                // empty: share/vision_loop/sift_k10_L4.usvoc
+  std::string vocabulary;  // empty: share/vision_loop/sift_k10_L4.usvoc
   int max_features = 500;
   int max_image_side_px = 1024;
-  double min_normalized_score = 0.3;     // α
+  double min_normalized_score = 0.3;  // α
   int exclude_recent_frames = 10;
   int temporal_consistency = 1;
   int island_gap_frames = 3;

@@ -27,16 +27,16 @@
 namespace urbanslam::vision_loop {
 
 struct LoopDetectorOptions {
-  float min_normalized_score = 0.3f;  // α (DBoW2's default)
-  float min_prior_score = 0.005f;     // s(v_t, v_{t−1}) below this: nothing to normalise with, skip
-  int exclude_recent_frames = 10;     // the last frames are the current place, not a loop
-  size_t max_query_results = 50;      // top-k asked from the database
-  int island_gap_frames = 3;          // matches at most this far apart form one island
-  int temporal_consistency = 1;       // k: earlier consecutive queries whose islands must agree
-  int max_island_distance_frames = 3; // islands of consecutive queries agree when this close
-  int max_query_gap_frames = 2;       // queries further apart are not "consecutive"
+  float min_normalized_score = 0.3f;   // α (DBoW2's default)
+  float min_prior_score = 0.005f;      // s(v_t, v_{t−1}) below this: nothing to normalise with, skip
+  int exclude_recent_frames = 10;      // the last frames are the current place, not a loop
+  size_t max_query_results = 50;       // top-k asked from the database
+  int island_gap_frames = 3;           // matches at most this far apart form one island
+  int temporal_consistency = 1;        // k: earlier consecutive queries whose islands must agree
+  int max_island_distance_frames = 3;  // islands of consecutive queries agree when this close
+  int max_query_gap_frames = 2;        // queries further apart are not "consecutive"
   bool geometric_verification = true;
-  int verify_candidates = 3;          // best images of the winning island tried in turn
+  int verify_candidates = 3;  // best images of the winning island tried in turn
   VerificationOptions verification;
 };
 
@@ -54,9 +54,9 @@ const char* loopStatusName(LoopStatus s);
 struct LoopResult {
   LoopStatus status = LoopStatus::NoFeatures;
   ImageId query = 0;
-  ImageId match = 0;               // best image of the winning island (when there is one)
-  float score = 0;                 // s(v_t, v_match)
-  float normalized_score = 0;      // η of the match
+  ImageId match = 0;           // best image of the winning island (when there is one)
+  float score = 0;             // s(v_t, v_match)
+  float normalized_score = 0;  // η of the match
   VerificationResult verification;
   bool detected() const { return status == LoopStatus::Detected; }
 };
@@ -70,8 +70,7 @@ class LoopDetector {
  public:
   using VerificationCache = std::map<std::pair<ImageId, ImageId>, VerificationResult>;
 
-  LoopDetector(std::shared_ptr<const Vocabulary> vocabulary, const FeatureOptions& features,
-               const LoopDetectorOptions& options = {});
+  LoopDetector(std::shared_ptr<const Vocabulary> vocabulary, const FeatureOptions& features, const LoopDetectorOptions& options = {});
 
   // Extracts features, quantises, queries, then adds the frame to the database. `candidates`:
   // when given, only these earlier images are considered (from the filter's pose uncertainty).

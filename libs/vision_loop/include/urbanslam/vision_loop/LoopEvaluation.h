@@ -53,12 +53,12 @@ struct Detection {
 };
 
 struct SweepResult {
-  std::vector<PrPoint> curve;            // one point per threshold, in the order given
-  size_t positives = 0;                  // frames that close a loop in the ground truth
-  double recall_at_precision_1 = 0;      // best recall among points without false positives
-  double threshold_at_precision_1 = 0;   // the smallest α reaching it
+  std::vector<PrPoint> curve;           // one point per threshold, in the order given
+  size_t positives = 0;                 // frames that close a loop in the ground truth
+  double recall_at_precision_1 = 0;     // best recall among points without false positives
+  double threshold_at_precision_1 = 0;  // the smallest α reaching it
   std::vector<Detection> detections_at_precision_1;
-  PrPoint at_default;                    // at the detector's own α
+  PrPoint at_default;  // at the detector's own α
   std::vector<Detection> detections_at_default;
   double mean_query_ms = 0, mean_verification_ms = 0;  // at the detector's own α
 };

@@ -20,9 +20,9 @@ namespace urbanslam::vision_loop {
 // arrays. Node 0 is the root (its centre is unused).
 struct VocabularyData {
   DescriptorType type = DescriptorType::Sift;
-  uint32_t branching = 0;              // k
-  uint32_t depth = 0;                  // L (leaves may sit higher where data ran out)
-  uint64_t training_images = 0;        // N of the IDF weights
+  uint32_t branching = 0;        // k
+  uint32_t depth = 0;            // L (leaves may sit higher where data ran out)
+  uint64_t training_images = 0;  // N of the IDF weights
   uint64_t training_descriptors = 0;
   std::vector<uint32_t> first_child;   // per node; children are [first_child, first_child + child_count)
   std::vector<uint32_t> child_count;   // per node; 0 for a leaf
