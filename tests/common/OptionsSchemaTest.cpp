@@ -88,3 +88,23 @@ TEST(OptionsSchema, ResolvedIniReloadsToTheSameValues) {
   EXPECT_EQ(b.mode, "b");
   EXPECT_NE(text.find("[m]"), std::string::npos);  // units are documented
 }
+
+// An enum option: the ini's name sets the enum value, the resolved ini prints the name back, and
+// a name outside the list is an error naming file, line, section and key.
+TEST(OptionsSchema, EnumOptionsMapNamesToValues) {
+  enum class Kind { First, Second };
+  Kind kind = Kind::First;
+  OptionsSchema s;
+  s.section("s", "");
+  s.add<Kind>("kind", kind, {{"first", Kind::First}, {"second", Kind::Second}}, "which");
+  s.load(IniFile::parse("[s]\nkind = second\n", "e.ini"));
+  EXPECT_EQ(kind, Kind::Second);
+  EXPECT_NE(s.toIni().find("kind = second"), std::string::npos) << s.toIni();
+  try {
+    s.load(IniFile::parse("[s]\nkind = third\n", "e.ini"));
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("e.ini:2: [s] kind: 'third' is not one of first|second"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(kind, Kind::Second);
+}

@@ -15,7 +15,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-gui::MapSnapshot runExcerpt(const std::string& image_detector, std::vector<slam::LoopClosureRecord>* records = nullptr) {
+gui::MapSnapshot runExcerpt(slam::LoopClosureOptions::ImageDetector image_detector,
+                            std::vector<slam::LoopClosureRecord>* records = nullptr) {
   slam::PipelineOptions o;
   o.loop_closure.image_detector = image_detector;
   o.image_loop.vocabulary = test::repoPath("share/vision_loop/sift_k10_L4.usvoc");
@@ -34,7 +35,7 @@ std::string fileOf(const gui::CameraFrame& f) { return f.image ? fs::path(f.imag
 
 TEST(CameraView, ShowsTheMatchedFrameOfAProposal) {
   std::vector<slam::LoopClosureRecord> records;
-  const gui::MapSnapshot s = runExcerpt("tree_of_words", &records);
+  const gui::MapSnapshot s = runExcerpt(slam::LoopClosureOptions::ImageDetector::TreeOfWords, &records);
   ASSERT_FALSE(s.image_matches.empty());
   // Every proposal the pipeline recorded is in the model, with its fate.
   size_t image_records = 0;
@@ -67,7 +68,7 @@ TEST(CameraView, ShowsTheMatchedFrameOfAProposal) {
 }
 
 TEST(CameraView, WithoutTheDetectorFramesButNoMatch) {
-  const gui::MapSnapshot s = runExcerpt("none");
+  const gui::MapSnapshot s = runExcerpt(slam::LoopClosureOptions::ImageDetector::None);
   ASSERT_EQ(s.keyframes.size(), 32u);
   EXPECT_TRUE(s.image_matches.empty());
   const gui::CameraView v = gui::cameraView(s, 5);

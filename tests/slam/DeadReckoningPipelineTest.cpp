@@ -36,7 +36,7 @@ TEST(DeadReckoningPipeline, KeyframesSitAtTheOdometryOfTheirTime) {
       if (auto* o = std::get_if<io::OdometryReading>(&m)) odom_at[o->timestamp] = o->pose;
   }
   slam::PipelineOptions o;
-  o.estimator.type = "dead_reckoning";
+  o.estimator.type = slam::EstimatorOptions::Type::DeadReckoning;
   o.local.scan_matching = false;
   o.keyframes.min_translation_m = 0.3;
   o.keyframes.min_rotation_deg = 15;
@@ -66,7 +66,7 @@ TEST(DeadReckoningPipeline, KeyframesSitAtTheOdometryOfTheirTime) {
 
 TEST(DeadReckoningPipeline, LaserLabelsSelectSensors) {
   slam::PipelineOptions o;
-  o.estimator.type = "dead_reckoning";
+  o.estimator.type = slam::EstimatorOptions::Type::DeadReckoning;
   o.input.laser_labels = "RLASER, ROBOTLASER1";
   slam::Pipeline p(o);
   auto src = io::openDataSource(kExcerpt);
@@ -83,7 +83,7 @@ TEST(DeadReckoningPipeline, LaserLabelsSelectSensors) {
 
 TEST(DeadReckoningPipeline, RangeLimitsInvalidateBeams) {
   slam::PipelineOptions o;
-  o.estimator.type = "dead_reckoning";
+  o.estimator.type = slam::EstimatorOptions::Type::DeadReckoning;
   o.local.scan_matching = false;
   o.keyframes.min_translation_m = 0;  // every scan a keyframe
   o.input.max_range_m = 2.0;
@@ -118,7 +118,7 @@ TEST(DeadReckoningPipeline, OdometryTrajectoryIsInTimeOrder) {
   }
   ASSERT_GT(out_of_order, 0u) << "the excerpt no longer holds out-of-order readings: the test would prove nothing";
   slam::PipelineOptions o;
-  o.estimator.type = "dead_reckoning";
+  o.estimator.type = slam::EstimatorOptions::Type::DeadReckoning;
   o.local.scan_matching = false;
   slam::Pipeline p(o);
   auto src = io::openDataSource(kExcerpt);
@@ -152,7 +152,7 @@ TEST(DeadReckoningPipeline, ReadingsSharingAScanTimeGiveTheScanPose) {
     }
   }
   slam::PipelineOptions o;
-  o.estimator.type = "dead_reckoning";
+  o.estimator.type = slam::EstimatorOptions::Type::DeadReckoning;
   o.local.scan_matching = false;
   o.keyframes.min_translation_m = 0.5;
   slam::Pipeline p(o);

@@ -45,7 +45,7 @@ std::unique_ptr<esdf::Esdf> rebuild(const slam::Pipeline& p) {
 TEST(EsdfPipeline, BeatsDeadReckoningOnTheShippedRawlog) {
   const std::string log = test::repoPath("rawlogs/intel.rawlog");
   slam::PipelineOptions dr;
-  dr.estimator.type = "dead_reckoning";
+  dr.estimator.type = slam::EstimatorOptions::Type::DeadReckoning;
   dr.local.scan_matching = false;
   const double ate_dr = ateAgainstReference(*runOn(log, dr));
   const auto slam_run = runOn(log, slam::PipelineOptions{});

@@ -48,7 +48,7 @@ std::map<int, std::set<int>> groundTruth() {
   return gt;
 }
 
-std::unique_ptr<slam::Pipeline> runExcerpt(const std::string& image_detector) {
+std::unique_ptr<slam::Pipeline> runExcerpt(slam::LoopClosureOptions::ImageDetector image_detector) {
   slam::PipelineOptions o;
   o.loop_closure.image_detector = image_detector;
   o.image_loop.vocabulary = test::repoPath("share/vision_loop/sift_k10_L4.usvoc");
@@ -73,7 +73,7 @@ std::vector<slam::LoopClosureRecord> imageRecords(const slam::Pipeline& p) {
 // α = 0.3 rather than the sweep's best threshold, and the first loop frames cannot be found
 // (the temporal-consistency check needs one earlier agreeing query).
 TEST(ImagePipeline, ProposesTheGroundTruthLoopsOfTheRtabmapExcerpt) {
-  const auto p = runExcerpt("tree_of_words");
+  const auto p = runExcerpt(slam::LoopClosureOptions::ImageDetector::TreeOfWords);
   const std::vector<int> numbers = imageNumbers();
   ASSERT_EQ(numbers.size(), 32u);
   ASSERT_EQ(p->keyframes().size(), numbers.size());  // no laser, no motion: every image a keyframe
@@ -112,7 +112,7 @@ TEST(ImagePipeline, ProposesTheGroundTruthLoopsOfTheRtabmapExcerpt) {
 }
 
 TEST(ImagePipeline, DetectorOffMakesNoImageProposals) {
-  const auto p = runExcerpt("none");
+  const auto p = runExcerpt(slam::LoopClosureOptions::ImageDetector::None);
   EXPECT_EQ(p->keyframes().size(), 32u);
   EXPECT_TRUE(imageRecords(*p).empty());
   EXPECT_EQ(p->stats().image_proposals, 0u);
@@ -127,7 +127,8 @@ TEST(ImagePipeline, DetectorOffMakesNoImageProposals) {
 // camera) switching it on changes nothing.
 TEST(ImagePipeline, ImageDetectorOnALaserOnlyLogChangesNothing) {
   slam::PipelineOptions off, on;
-  on.loop_closure.image_detector = "tree_of_words";
+  off.loop_closure.image_detector = slam::LoopClosureOptions::ImageDetector::None;
+  on.loop_closure.image_detector = slam::LoopClosureOptions::ImageDetector::TreeOfWords;
   on.image_loop.vocabulary = test::repoPath("share/vision_loop/sift_k10_L4.usvoc");
   off.loop_closure.enabled = on.loop_closure.enabled = false;  // keeps the run short
   const std::string log = test::repoPath("rawlogs/intel.rawlog");

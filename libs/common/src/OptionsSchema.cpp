@@ -98,11 +98,15 @@ void OptionsSchema::add(const std::string& key, std::string& value, const std::v
     if (!choices.empty()) {
       bool ok = false;
       for (const auto& c : choices) ok = ok || c == s;
-      if (!ok) throw ConfigError(where + "'" + s + "' is not one of " + range);
+      if (!ok) throwNotOneOf(where, s, range);
     }
     value = s;
   };
   o.get = [&value] { return value; };
+}
+
+void OptionsSchema::throwNotOneOf(const std::string& where, const std::string& value, const std::string& range) {
+  throw ConfigError(where + "'" + value + "' is not one of " + range);
 }
 
 void OptionsSchema::load(const IniFile& ini) {

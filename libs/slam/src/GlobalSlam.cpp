@@ -17,7 +17,7 @@ constexpr double kDeg = M_PI / 180.0;
 
 GlobalSlam::GlobalSlam(const PipelineOptions& options, Map& map, PipelineStats& stats, const std::vector<PipelineObserver*>& observers)
     : options_(options), map_(map), stats_(stats), observers_(observers), closer_(options.loop_closure) {
-  if (options_.loop_closure.enabled && options_.loop_closure.detector == "laser") {
+  if (options_.loop_closure.enabled && options_.loop_closure.detector == LoopClosureOptions::Detector::Laser) {
     // The AdaBoost classifier screens candidates before the (costlier) alignment. Its score is
     // the margin above the model's decision factor (eq. 3.30), so laser_threshold = 0 is the
     // model's own operating point.

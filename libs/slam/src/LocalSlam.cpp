@@ -17,13 +17,13 @@ LocalSlam::LocalSlam(const PipelineOptions& options)
       submap_(options.local) {}
 
 bool LocalSlam::addOdometry(const io::OdometryReading& m) {
-  if (motion_model_ == "steering") return false;
+  if (motion_model_ == MotionOptions::Model::Steering) return false;
   motion_.addOdometry(m);
   return true;
 }
 
 bool LocalSlam::addDrive(const io::DriveReading& m) {
-  if (motion_model_ == "odometry") return false;
+  if (motion_model_ == MotionOptions::Model::Odometry) return false;
   motion_.addDrive(m);
   return true;
 }

@@ -14,7 +14,7 @@ namespace {
 
 // The filter behind the map (none in dead reckoning).
 std::unique_ptr<esdf::Esdf> makeFilter(const PipelineOptions& options) {
-  if (options.estimator.type != "esdf") return nullptr;
+  if (options.estimator.type != EstimatorOptions::Type::Esdf) return nullptr;
   esdf::EsdfOptions eo;
   eo.relinearise = options.estimator.relinearise;
   eo.chi2_gate_probability = options.loop_closure.chi2_gate_probability;

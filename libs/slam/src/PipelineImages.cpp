@@ -11,7 +11,7 @@
 namespace urbanslam::slam {
 
 void Pipeline::startImageDetector() {
-  if (image_detector_ || options_.loop_closure.image_detector != "tree_of_words") return;
+  if (image_detector_ || options_.loop_closure.image_detector != LoopClosureOptions::ImageDetector::TreeOfWords) return;
   // Tree of Words over the keyframe images (thesis §4.2); the vocabulary decides SIFT or ORB.
   // Loaded at the first image, so a log without a camera never reads it.
   const std::string path = options_.image_loop.vocabulary.empty() ? vision_loop::kDefaultVocabularyPath : options_.image_loop.vocabulary;

@@ -20,8 +20,10 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("wheelbase_m", o.vehicle.wheelbase_m, 0.1, 20.0, "m", "wheelbase L for speed + steering logs");
 
   s.section("motion", "Motion between keyframes: model and noise");
-  s.add("model", o.motion.model, {"auto", "odometry", "steering"},
-        "auto: steering model for speed+steering logs (Victoria Park), else odometry");
+  s.add<MotionOptions::Model>(
+      "model", o.motion.model,
+      {{"auto", MotionOptions::Model::Auto}, {"odometry", MotionOptions::Model::Odometry}, {"steering", MotionOptions::Model::Steering}},
+      "auto: steering model for speed+steering logs (Victoria Park), else odometry");
   s.add("odometry_sigma_xy_per_m", o.motion.odometry_sigma_xy_per_m, 0.0, 1.0, "m/m", "odometry position noise per metre travelled");
   s.add("odometry_sigma_xy_min_m", o.motion.odometry_sigma_xy_min_m, 1e-6, 1.0, "m", "odometry position noise floor per increment");
   s.add("odometry_sigma_phi_per_rad", o.motion.odometry_sigma_phi_per_rad, 0.0, 1.0, "rad/rad", "heading noise per radian turned");
@@ -64,12 +66,15 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
 
   s.section("loop_closure", "Global SLAM: loop-closure candidates, detection, alignment, gating");
   s.add("enabled", o.loop_closure.enabled, "search for loop closures");
-  s.add("detector", o.loop_closure.detector, {"none", "laser"},
-        "none: alignment + gating verify every candidate; laser: AdaBoost classifier first");
+  s.add<LoopClosureOptions::Detector>("detector", o.loop_closure.detector,
+                                      {{"none", LoopClosureOptions::Detector::None}, {"laser", LoopClosureOptions::Detector::Laser}},
+                                      "none: alignment + gating verify every candidate; laser: AdaBoost classifier first");
   s.add("laser_model", o.loop_closure.laser_model, {}, "laser classifier model; empty: share/laser_loop/default.model");
   s.add("laser_threshold", o.loop_closure.laser_threshold, -100.0, 100.0, "", "classifier decision offset (higher: fewer false alarms)");
-  s.add("image_detector", o.loop_closure.image_detector, {"none", "tree_of_words"},
-        "image loop closures: tree_of_words proposes pairs from keyframe images ([image_loop])");
+  s.add<LoopClosureOptions::ImageDetector>(
+      "image_detector", o.loop_closure.image_detector,
+      {{"none", LoopClosureOptions::ImageDetector::None}, {"tree_of_words", LoopClosureOptions::ImageDetector::TreeOfWords}},
+      "image loop closures: tree_of_words proposes pairs from keyframe images ([image_loop])");
   s.add("image_max_offset_s", o.loop_closure.image_max_offset_s, 0.0, 3600.0, "s",
         "an image belongs to the nearest keyframe in time only within this");
   s.add("min_keyframe_gap", o.loop_closure.min_keyframe_gap, 1, 100000, "keyframes",
@@ -111,7 +116,9 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   vision_loop::declareImageLoopOptions(s, o.image_loop);
 
   s.section("estimator", "The estimator behind the map");
-  s.add("type", o.estimator.type, {"esdf", "dead_reckoning"}, "esdf: the delayed-state information filter; dead_reckoning: odometry only");
+  s.add<EstimatorOptions::Type>("type", o.estimator.type,
+                                {{"esdf", EstimatorOptions::Type::Esdf}, {"dead_reckoning", EstimatorOptions::Type::DeadReckoning}},
+                                "esdf: the delayed-state information filter; dead_reckoning: odometry only");
   s.add("relinearise", o.estimator.relinearise, "relinearise moved factors after a loop closure (reaches the batch optimum)");
   s.add("recent_window", o.estimator.recent_window, 1, 100000, "poses", "poses recovered after each keyframe");
 
@@ -152,5 +159,7 @@ void resolveDefaultPaths(PipelineOptions& options, const std::string& home) {
   if (options.loop_closure.laser_model.empty()) options.loop_closure.laser_model = defaultLaserModelPath(home);
   if (options.image_loop.vocabulary.empty()) options.image_loop.vocabulary = defaultVocabularyPath(home);
 }
+
+std::string estimatorName(EstimatorOptions::Type type) { return type == EstimatorOptions::Type::Esdf ? "esdf" : "dead_reckoning"; }
 
 }  // namespace urbanslam::slam

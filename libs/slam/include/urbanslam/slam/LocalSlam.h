@@ -49,7 +49,7 @@ class LocalSlam {
 
   KeyframeOptions keyframes_;
   LocalOptions options_;
-  std::string motion_model_;
+  MotionOptions::Model motion_model_;
   MotionIntegrator motion_;
   LocalSubmap submap_;
   bool have_scan_keyframe_ = false;  // camera-only logs make a keyframe of every image until a scan comes

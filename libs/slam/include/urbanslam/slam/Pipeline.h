@@ -54,7 +54,7 @@ class Pipeline {
   const std::vector<GraphEdge>& graphEdges() const { return map_.edges(); }
   const PipelineStats& stats() const { return stats_; }
   const PipelineOptions& options() const { return options_; }
-  std::string estimatorName() const { return options_.estimator.type; }
+  std::string estimatorName() const { return slam::estimatorName(options_.estimator.type); }
   std::vector<io::PosedScan> posedKeyframes() const { return map_.posedKeyframes(); }
 
  private:

@@ -26,7 +26,8 @@ struct VehicleOptions {
 
 // How the motion between two keyframes is predicted, and how uncertain it is.
 struct MotionOptions {
-  std::string model = "auto";  // auto | odometry | steering: auto = steering for speed+steering logs
+  // auto: odometry readings, or the steering model for speed + steering logs.
+  enum class Model { Auto, Odometry, Steering } model = Model::Auto;
   // Odometry noise per increment (sigma grows with distance and turning).
   double odometry_sigma_xy_per_m = 0.1;
   double odometry_sigma_xy_min_m = 0.002;
@@ -67,23 +68,24 @@ struct LocalOptions {
 // Global SLAM: loop-closure search, verification and the ESDF update.
 struct LoopClosureOptions {
   bool enabled = true;
-  std::string detector = "none";  // none (alignment + gating only) | laser (AdaBoost classifier)
-  std::string laser_model;        // classifier model file; empty = share/laser_loop/default.model
-  double laser_threshold = 0.0;   // strong-classifier margin offset (higher: fewer false alarms)
+  // none: alignment + gating verify every candidate; laser: the AdaBoost classifier screens them first.
+  enum class Detector { None, Laser } detector = Detector::None;
+  std::string laser_model;       // classifier model file; empty = share/laser_loop/default.model
+  double laser_threshold = 0.0;  // strong-classifier margin offset (higher: fewer false alarms)
   // Image proposals (Tree of Words, [image_loop]) go through the same alignment, gating and
   // confirmation as the laser candidates; without scans they are only recorded.
-  std::string image_detector = "tree_of_words";  // none | tree_of_words
-  double image_max_offset_s = 0.5;               // an image is attached to the nearest keyframe only this close in time
-  int min_keyframe_gap = 30;                     // closures only with keyframes at least this much older
-  double search_radius_m = 4.0;                  // initial set: earlier keyframes this close (+ 3 sigma)
-  double mahalanobis_probability = 0.99;         // final set: chi2 (2 dof) gate on the relative position
-  int max_candidates = 3;                        // aligned per keyframe, nearest (Mahalanobis) first
-  int every_n_keyframes = 1;                     // search at every n-th keyframe
-  std::string method = "auto";                   // alignment of a candidate pair: auto | icp | plicp | crf | crf+icp
-  double auto_local_max_m = 1.0;                 // auto: PL-ICP when the relative pose is known to 3 sigma within this ...
-  double auto_local_max_deg = 15.0;              // ... and this; CRF-match + ICP otherwise
-  double max_rms_m = 0.08;                       // alignment accepted only below this residual ...
-  double min_matched_fraction = 0.5;             // ... and with this share of points matched
+  enum class ImageDetector { None, TreeOfWords } image_detector = ImageDetector::TreeOfWords;
+  double image_max_offset_s = 0.5;        // an image is attached to the nearest keyframe only this close in time
+  int min_keyframe_gap = 30;              // closures only with keyframes at least this much older
+  double search_radius_m = 4.0;           // initial set: earlier keyframes this close (+ 3 sigma)
+  double mahalanobis_probability = 0.99;  // final set: chi2 (2 dof) gate on the relative position
+  int max_candidates = 3;                 // aligned per keyframe, nearest (Mahalanobis) first
+  int every_n_keyframes = 1;              // search at every n-th keyframe
+  std::string method = "auto";            // alignment of a candidate pair: auto | icp | plicp | crf | crf+icp
+  double auto_local_max_m = 1.0;          // auto: PL-ICP when the relative pose is known to 3 sigma within this ...
+  double auto_local_max_deg = 15.0;       // ... and this; CRF-match + ICP otherwise
+  double max_rms_m = 0.08;                // alignment accepted only below this residual ...
+  double min_matched_fraction = 0.5;      // ... and with this share of points matched
   // ... and with the geometry constraining every direction: the weakest / strongest translation
   // eigenvalue of the alignment's information at least this. A closure along a corridor slides.
   double min_constraint_ratio = 0.15;
@@ -108,9 +110,10 @@ struct LoopClosureOptions {
 };
 
 struct EstimatorOptions {
-  std::string type = "esdf";  // esdf | dead_reckoning
-  bool relinearise = true;    // relinearise moved factors after a loop closure
-  int recent_window = 30;     // poses recovered after each keyframe (constant time)
+  // esdf: the delayed-state information filter; dead_reckoning: the constraints composed, no filter.
+  enum class Type { Esdf, DeadReckoning } type = Type::Esdf;
+  bool relinearise = true;  // relinearise moved factors after a loop closure
+  int recent_window = 30;   // poses recovered after each keyframe (constant time)
 };
 
 struct MapOptions {
@@ -144,6 +147,8 @@ void declareOptions(common::OptionsSchema& schema, PipelineOptions& options);
 
 // The options as JSON ({section: {key: value}}), for stats.json and check-ini --json.
 common::Json optionsToJson(const PipelineOptions& options);
+// The estimator's name as the ini spells it ("esdf", "dead_reckoning").
+std::string estimatorName(EstimatorOptions::Type type);
 
 // Defaults, overridden by the ini file when `ini_path` is not empty. Throws common::ConfigError.
 // `resolved_ini` (optional) receives the resolved configuration as ini text.
