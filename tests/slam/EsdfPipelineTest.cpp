@@ -91,8 +91,8 @@ TEST(EsdfPipeline, WrongPlaceClosureIsGatedOut) {
   ASSERT_LT(i, k) << "the excerpt has no keyframe 3 m away from the last one";
   keyframes[k].scan = keyframes[i].scan;
   slam::LoopClosureOptions lo;
-  lo.method = "crf+icp";        // finds the (wrong) perfect match from metres away
-  lo.min_constraint_ratio = 0;  // the other refusals off: this is about the gate
+  lo.method = slam::LoopClosureOptions::Method::CrfIcp;  // finds the (wrong) perfect match from metres away
+  lo.min_constraint_ratio = 0;                           // the other refusals off: this is about the gate
   lo.ambiguity_offset_m = 0;
   lo.max_free_space_conflict = 1;
   slam::LoopCloser closer(lo);

@@ -156,7 +156,7 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
   r.prior_sigma_m = largestPositionSigma(relativeCovariance(filter, earlier, current));
   alignment::AlignerOptions ao;
   ao.min_constraint_ratio = options_.min_constraint_ratio;
-  if (options_.method == "auto") {
+  if (options_.method == LoopClosureOptions::Method::Auto) {
     // A well-known relative pose needs only the fast local refinement (PL-ICP); a poorly known
     // one the global coarse alignment first (CRF-match, then ICP), as in the thesis.
     const Eigen::Matrix3d s = relativeCovariance(filter, earlier, current);
@@ -164,7 +164,12 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
     ao.method = 3 * sxy < options_.auto_local_max_m && 3 * sphi < options_.auto_local_max_deg * M_PI / 180 ? alignment::Method::PlIcp
                                                                                                            : alignment::Method::CrfIcp;
   } else {
-    ao.method = alignment::parseMethod(options_.method);
+    using M = LoopClosureOptions::Method;
+    const M m = options_.method;
+    ao.method = m == M::Icp     ? alignment::Method::Icp
+                : m == M::PlIcp ? alignment::Method::PlIcp
+                : m == M::Crf   ? alignment::Method::Crf
+                                : alignment::Method::CrfIcp;
   }
   const common::Pose2 guess = esdf::toPose(esdf::between(xi, xk));
   const auto good = [&](const alignment::AlignmentResult& a) {

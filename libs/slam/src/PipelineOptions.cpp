@@ -84,8 +84,14 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
         "final candidate set: chi2 (2 dof) probability");
   s.add("max_candidates", o.loop_closure.max_candidates, 1, 1000, "", "candidates aligned per keyframe");
   s.add("every_n_keyframes", o.loop_closure.every_n_keyframes, 1, 1000, "keyframes", "search at every n-th keyframe");
-  s.add("method", o.loop_closure.method, {"auto", "icp", "plicp", "crf", "crf+icp"},
-        "alignment of a candidate pair; auto: PL-ICP when the relative pose is well known, CRF-match + ICP otherwise");
+  s.add<LoopClosureOptions::Method>(
+      "method", o.loop_closure.method,
+      {{"auto", LoopClosureOptions::Method::Auto},
+       {"icp", LoopClosureOptions::Method::Icp},
+       {"plicp", LoopClosureOptions::Method::PlIcp},
+       {"crf", LoopClosureOptions::Method::Crf},
+       {"crf+icp", LoopClosureOptions::Method::CrfIcp}},
+      "alignment of a candidate pair; auto: PL-ICP when the relative pose is well known, CRF-match + ICP otherwise");
   s.add("auto_local_max_m", o.loop_closure.auto_local_max_m, 0.0, 100.0, "m",
         "auto: PL-ICP when 3 sigma of the relative position is below this");
   s.add("auto_local_max_deg", o.loop_closure.auto_local_max_deg, 0.0, 180.0, "deg",

@@ -81,11 +81,13 @@ struct LoopClosureOptions {
   double mahalanobis_probability = 0.99;  // final set: chi2 (2 dof) gate on the relative position
   int max_candidates = 3;                 // aligned per keyframe, nearest (Mahalanobis) first
   int every_n_keyframes = 1;              // search at every n-th keyframe
-  std::string method = "auto";            // alignment of a candidate pair: auto | icp | plicp | crf | crf+icp
-  double auto_local_max_m = 1.0;          // auto: PL-ICP when the relative pose is known to 3 sigma within this ...
-  double auto_local_max_deg = 15.0;       // ... and this; CRF-match + ICP otherwise
-  double max_rms_m = 0.08;                // alignment accepted only below this residual ...
-  double min_matched_fraction = 0.5;      // ... and with this share of points matched
+  // Alignment of a candidate pair: auto (PL-ICP when the relative pose is well known, else
+  // CRF-match + ICP) or one of the aligner's methods.
+  enum class Method { Auto, Icp, PlIcp, Crf, CrfIcp } method = Method::Auto;
+  double auto_local_max_m = 1.0;      // auto: PL-ICP when the relative pose is known to 3 sigma within this ...
+  double auto_local_max_deg = 15.0;   // ... and this; CRF-match + ICP otherwise
+  double max_rms_m = 0.08;            // alignment accepted only below this residual ...
+  double min_matched_fraction = 0.5;  // ... and with this share of points matched
   // ... and with the geometry constraining every direction: the weakest / strongest translation
   // eigenvalue of the alignment's information at least this. A closure along a corridor slides.
   double min_constraint_ratio = 0.15;
