@@ -36,13 +36,6 @@ struct StepRecorder : slam::PipelineObserver {
   }
 };
 
-double percentileOf(std::vector<double> v, double p) {
-  if (v.empty()) return 0;
-  const size_t k = static_cast<size_t>(p / 100.0 * static_cast<double>(v.size() - 1));
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
-  return v[k];
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -87,9 +80,9 @@ int main(int argc, char** argv) {
     for (size_t b = 0; b <= bins; ++b) {
       if (per[b].empty()) continue;
       const double x = static_cast<double>((b + 0.5) * width);
-      p50.x.push_back(x), p50.y.push_back(percentileOf(per[b], 50));
-      p99.x.push_back(x), p99.y.push_back(percentileOf(per[b], 99));
-      mx.x.push_back(x), mx.y.push_back(percentileOf(per[b], 100));
+      p50.x.push_back(x), p50.y.push_back(common::percentile(per[b], 50));
+      p99.x.push_back(x), p99.y.push_back(common::percentile(per[b], 99));
+      mx.x.push_back(x), mx.y.push_back(common::percentile(per[b], 100));
     }
     laser_loop::writePlotPng(out + "/step_time.png", {{"step time against map size", "keyframes", "ms", {p50, p99, mx}}});
     common::Json j = common::Json::object();

@@ -15,6 +15,7 @@
 #include "urbanslam/alignment/Aligner.h"
 #include "urbanslam/common/Error.h"
 #include "urbanslam/common/Json.h"
+#include "urbanslam/common/Timing.h"
 #include "urbanslam/io/DataSource.h"
 
 using namespace urbanslam;
@@ -27,19 +28,16 @@ double rms(const std::vector<double>& v) {
   return v.empty() ? 0 : std::sqrt(s / static_cast<double>(v.size()));
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
+double medianAbs(std::vector<double> v) {
   for (double& x : v) x = std::abs(x);
-  auto m = v.begin() + static_cast<long>(v.size() / 2);
-  std::nth_element(v.begin(), m, v.end());
-  return *m;
+  return common::percentile(std::move(v), 50);
 }
 
 common::Json summary(const std::vector<double>& v) {
   common::Json j = common::Json::object();
   j["n"] = v.size();
   j["rms"] = rms(v);
-  j["median_abs"] = median(v);
+  j["median_abs"] = medianAbs(v);
   return j;
 }
 
@@ -113,7 +111,7 @@ int main(int argc, char** argv) {
     j["odometry_heading_per_rad_turned"] = summary(heading_per_rad);
     j["laser_residual_rms_m"] = summary(residual);
     j["laser_no_return_fraction"] = beams ? static_cast<double>(no_return) / static_cast<double>(beams) : 0.0;
-    j["laser_median_range_m"] = median(ranges);
+    j["laser_median_range_m"] = common::percentile(ranges, 50);
     std::cout << j.dump() << "\n";
   } catch (const common::InputError& e) {
     std::cerr << "sensor_statistics: " << e.what() << "\n";

@@ -201,5 +201,5 @@ TEST(Cli, SimulatedDriveRunsFromFileAndStream) {
     return at == std::string::npos ? -1.0 : std::stod(e.out.substr(at + key.size() + 3));
   };
   EXPECT_GT(field("within_0_1_m"), 0.5) << e.out;
-  EXPECT_GE(field("recall"), 0.0) << e.out;
+  EXPECT_NE(e.out.find("\"loops_recall\":"), std::string::npos) << e.out;  // a 400 m drive has no revisit to score
 }

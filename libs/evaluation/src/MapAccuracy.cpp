@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "urbanslam/common/Error.h"
+#include "urbanslam/common/Timing.h"
 #include "urbanslam/evaluation/Evaluation.h"
 
 namespace urbanslam::evaluation {
@@ -121,13 +122,8 @@ MapAccuracyMetrics mapAccuracy(const std::vector<io::MapPoint>& points, const co
   m.mean_m = sum / n;
   m.within_0_1_m = near / n;
   m.beyond_1_m = far / n;
-  const auto quantile = [&](double q) {
-    auto it = d.begin() + static_cast<long>(q * (n - 1));
-    std::nth_element(d.begin(), it, d.end());
-    return *it;
-  };
-  m.median_m = quantile(0.5);
-  m.p95_m = quantile(0.95);
+  m.median_m = common::percentile(d, 50);
+  m.p95_m = common::percentile(std::move(d), 95);
   return m;
 }
 

@@ -10,7 +10,7 @@ constexpr double kDeg = M_PI / 180.0;
 }  // namespace
 
 LocalSlam::LocalSlam(const PipelineOptions& options)
-    : keyframes_(options.keyframes),
+    : keyframe_options_(options.keyframes),
       options_(options.local),
       motion_model_(options.motion.model),
       motion_(options.motion, options.vehicle),
@@ -30,8 +30,8 @@ bool LocalSlam::addDrive(const io::DriveReading& m) {
 
 bool LocalSlam::isKeyframe(const Map& map) const {
   const common::Pose2& d = motion_.increment();
-  return map.empty() || !have_scan_keyframe_ || std::hypot(d.x, d.y) >= keyframes_.min_translation_m ||
-         std::abs(d.phi) >= keyframes_.min_rotation_deg * kDeg;
+  return map.empty() || !have_scan_keyframe_ || std::hypot(d.x, d.y) >= keyframe_options_.min_translation_m ||
+         std::abs(d.phi) >= keyframe_options_.min_rotation_deg * kDeg;
 }
 
 KeyframeConstraint LocalSlam::keyframeConstraint(const io::LaserScan& scan, const Map& map) const {

@@ -47,7 +47,7 @@ class LocalSlam {
   alignment::PriorMatchResult matchSubmap(const io::LaserScan& scan, const common::Pose2& z, const Eigen::Matrix3d& cov,
                                           const Map& map) const;
 
-  KeyframeOptions keyframes_;
+  KeyframeOptions keyframe_options_;
   LocalOptions options_;
   MotionOptions::Model motion_model_;
   MotionIntegrator motion_;
