@@ -8,13 +8,15 @@
 #include <cmath>
 #include <unordered_set>
 
+#include "urbanslam/alignment/BeamFreeSpace.h"
 #include "urbanslam/alignment/CorrelativeSearch.h"
 #include "urbanslam/alignment/MotionPrior.h"
 
 namespace urbanslam::alignment {
 
-MatchReference::MatchReference(PointSet points, const Eigen::Vector2d& centre, const PriorMatcherOptions& options)
-    : indexed_(std::move(points)), grid_(indexed_.points(), centre, options.grid) {}
+MatchReference::MatchReference(PointSet points, const Eigen::Vector2d& centre, const PriorMatcherOptions& options,
+                               const std::vector<Eigen::Vector2d>& ray_origins)
+    : indexed_(std::move(points)), grid_(indexed_.points(), centre, options.grid, ray_origins) {}
 
 namespace {
 
@@ -61,10 +63,30 @@ PriorMatchResult matchWithPrior(const MatchReference& reference, const PointSet&
   window.half_angle_rad = std::min(o.max_search_window_deg, std::max(o.search_window_deg, 3 * sphi * 180 / M_PI)) * M_PI / 180;
   const double volume = 4 * window.half_width_m * window.half_width_m * 2 * window.half_angle_rad;
   const MotionPrior prior(prior_mean, prior_cov, o.odometry_outlier_probability, volume);
-  const CorrelativeResult coarse = correlativeSearch(reference.grid(), thinned, prior, window);
+  CorrelativeResult coarse = correlativeSearch(reference.grid(), thinned, prior, window);
+  out.search_nodes = coarse.nodes;
+  // When the scan outvotes the odometry, the reference's side of the free-space evidence decides
+  // between the best pose of each of the prior's two parts (odometry right / odometry wrong): a
+  // pose far from the odometry is taken only if it also explains the scan better once the
+  // reference points it puts where the scan's beams passed through are counted. The search scores
+  // only the scan's side (the grid's free space); this side needs the pose, so it is weighed here.
+  if (prior.gaussianWeight(prior.mahalanobis2(prior.difference(coarse.pose))) < 0.5) {
+    const BeamFreeSpace beams(scan, o.grid.free_margin_m, o.grid.free_margin_fraction);
+    const std::vector<Eigen::Vector2d> ref_thinned = thin(reference.indexed().points(), o.voxel_m);
+    const double per_conflict = std::log(o.grid.free_floor / o.grid.miss_floor);
+    const MotionPrior odometry_right(prior_mean, prior_cov, 0.0, volume);
+    const CorrelativeResult near = correlativeSearch(reference.grid(), thinned, odometry_right, window);
+    const auto full = [&](const CorrelativeResult& c) {
+      return c.scan_score + prior.logDensity(c.pose) + per_conflict * beams.conflicts(ref_thinned, c.pose);
+    };
+    if (beams.valid() && full(near) >= full(coarse)) {
+      coarse = near;
+      coarse.score = near.scan_score + prior.logDensity(near.pose);
+    }
+    out.search_nodes += near.nodes;
+  }
   out.search_pose = coarse.pose;
   out.scan_log_likelihood = coarse.scan_score;
-  out.search_nodes = coarse.nodes;
 
   // 2. Gauss-Newton on the point-to-line residuals and the prior.
   const PointSet& ref = reference.indexed().points();

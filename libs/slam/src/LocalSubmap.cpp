@@ -11,6 +11,7 @@ alignment::PriorMatcherOptions priorMatcherOptions(const LocalOptions& o) {
   m.grid.resolution_m = o.resolution_m;
   m.grid.hit_sigma_m = o.hit_sigma_m;
   m.grid.miss_floor = o.miss_floor;
+  m.grid.free_floor = o.free_floor;
   m.grid.max_radius_m = o.grid_radius_m;
   m.voxel_m = o.voxel_m;
   m.search_window_m = o.search_window_m;
@@ -30,7 +31,11 @@ alignment::PointSet LocalSubmap::points(const io::LaserScan& scan) const {
 
 void LocalSubmap::addKeyframe(const io::LaserScan& scan) {
   sets_.push_back(points(scan));
-  while (sets_.size() > capacity_) sets_.pop_front();
+  sensors_.emplace_back(scan.sensor_pose.x, scan.sensor_pose.y);
+  while (sets_.size() > capacity_) {
+    sets_.pop_front();
+    sensors_.pop_front();
+  }
   ++generation_;
 }
 
@@ -42,14 +47,17 @@ const alignment::MatchReference* LocalSubmap::reference(const std::vector<common
       std::equal(offsets.begin(), offsets.end(), cache_.offsets.begin(), same))
     return cache_.reference.get();
   alignment::PointSet points;
+  std::vector<Eigen::Vector2d> origins;  // where each point's beam started: the grid's free space
   for (size_t i = 0; i < sets_.size(); ++i) {
     const auto t = alignment::transformed(sets_[i], offsets[i]);
     points.insert(points.end(), t.begin(), t.end());
+    origins.insert(origins.end(), t.size(), alignment::Rigid2::fromPose(offsets[i]) * sensors_[i]);
   }
   cache_.generation = generation_;
   cache_.offsets = std::move(offsets);
-  cache_.reference =
-      points.empty() ? nullptr : std::make_unique<const alignment::MatchReference>(std::move(points), Eigen::Vector2d::Zero(), matcher_);
+  cache_.reference = points.empty()
+                         ? nullptr
+                         : std::make_unique<const alignment::MatchReference>(std::move(points), Eigen::Vector2d::Zero(), matcher_, origins);
   return cache_.reference.get();
 }
 

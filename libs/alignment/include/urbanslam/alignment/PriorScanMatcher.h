@@ -60,7 +60,9 @@ struct PriorMatchResult {
 // The reference prepared once for many matches (all the scans against one submap).
 class MatchReference {
  public:
-  MatchReference(PointSet points, const Eigen::Vector2d& centre, const PriorMatcherOptions& options);
+  // ray_origins: empty, or the sensor position of each point (the likelihood grid's free space).
+  MatchReference(PointSet points, const Eigen::Vector2d& centre, const PriorMatcherOptions& options,
+                 const std::vector<Eigen::Vector2d>& ray_origins = {});
   const IndexedReference& indexed() const { return indexed_; }
   const LikelihoodGrid& grid() const { return grid_; }
 

@@ -40,6 +40,7 @@ class LocalSubmap {
   alignment::ScanModelOptions scan_model_;
   size_t capacity_;
   std::deque<alignment::PointSet> sets_;  // each keyframe's points in its own frame
+  std::deque<Eigen::Vector2d> sensors_;   // each keyframe's sensor position in its own frame
   size_t generation_ = 0;                 // keyframes added so far
   struct Cache {
     size_t generation = static_cast<size_t>(-1);

@@ -1,0 +1,33 @@
+#pragma once
+// The space one scan's beams passed through, as a point set remembers it (each point keeps its
+// range and bearing): the shortest return per bearing bin. Used to ask how many points of a
+// reference lie where the scan saw through, i.e. the reference's side of the free-space
+// evidence that the likelihood grid gives the scan's side of (LikelihoodGrid.h).
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "urbanslam/alignment/PointSet.h"
+#include "urbanslam/common/Pose2.h"
+
+namespace urbanslam::alignment {
+
+class BeamFreeSpace {
+ public:
+  // scan: points in the scan's frame with their sensor-frame range and bearing. A point conflicts
+  // when it lies margin_m + margin_fraction * range in front of the returns of its bearing bin and
+  // both neighbouring bins (bins without a return say nothing: glass, sky, out of range).
+  BeamFreeSpace(const PointSet& scan, double margin_m, double margin_fraction);
+  bool valid() const { return valid_; }
+  // Of `points` (in the frame where the scan sits at `scan_pose`), how many the scan saw through.
+  int conflicts(const std::vector<Eigen::Vector2d>& points, const common::Pose2& scan_pose) const;
+
+ private:
+  bool valid_ = false;
+  common::Pose2 sensor_;  // the sensor in the scan's frame (fitted from the points' own polar coordinates)
+  double bin_rad_ = 0;
+  std::vector<double> free_m_;  // per bin: the shortest return, or 0 (none)
+  double margin_m_, margin_fraction_;
+};
+
+}  // namespace urbanslam::alignment

@@ -1,0 +1,55 @@
+#include "urbanslam/alignment/BeamFreeSpace.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "urbanslam/common/RigidFit.h"
+
+namespace urbanslam::alignment {
+
+BeamFreeSpace::BeamFreeSpace(const PointSet& scan, double margin_m, double margin_fraction)
+    : margin_m_(margin_m), margin_fraction_(margin_fraction) {
+  if (scan.size() < 3) return;
+  // The sensor's pose in the scan's frame: the rigid map from each point's polar coordinates to
+  // its position (the point set may have been moved into the vehicle frame).
+  std::vector<Eigen::Vector2d> polar, placed;
+  double step = HUGE_VAL;
+  for (size_t i = 0; i < scan.size(); ++i) {
+    polar.emplace_back(scan[i].range_m * std::cos(scan[i].bearing_rad), scan[i].range_m * std::sin(scan[i].bearing_rad));
+    placed.push_back(scan[i].p);
+    if (i > 0 && scan[i].beam != scan[i - 1].beam) {
+      const double d = std::abs(scan[i].bearing_rad - scan[i - 1].bearing_rad) / std::abs(scan[i].beam - scan[i - 1].beam);
+      if (d > 1e-6) step = std::min(step, d);
+    }
+  }
+  if (!std::isfinite(step) || !common::fitRigid2D(polar, placed, std::vector<double>(scan.size(), 1.0), &sensor_)) return;
+  // Bins of the beam spacing (at least a quarter degree, so a bin usually holds a return).
+  bin_rad_ = std::max(step, 0.25 * M_PI / 180);
+  free_m_.assign(static_cast<size_t>(std::ceil(2 * M_PI / bin_rad_)), 0.0);
+  for (const auto& sp : scan) {
+    double from_zero = std::remainder(sp.bearing_rad, 2 * M_PI);
+    if (from_zero < 0) from_zero += 2 * M_PI;
+    double& f = free_m_[static_cast<size_t>(from_zero / bin_rad_) % free_m_.size()];
+    f = f > 0 ? std::min(f, sp.range_m) : sp.range_m;
+  }
+  valid_ = true;
+}
+
+int BeamFreeSpace::conflicts(const std::vector<Eigen::Vector2d>& points, const common::Pose2& scan_pose) const {
+  if (!valid_) return 0;
+  const Rigid2 to_sensor = Rigid2::fromPose(common::inverse(common::compose(scan_pose, sensor_)));
+  const size_t n = free_m_.size();
+  int count = 0;
+  for (const auto& p : points) {
+    const Eigen::Vector2d q = to_sensor * p;
+    const double r = q.norm();
+    double from_zero = std::atan2(q.y(), q.x());
+    if (from_zero < 0) from_zero += 2 * M_PI;
+    const size_t b = static_cast<size_t>(from_zero / bin_rad_) % n;
+    const double f = std::min({free_m_[b], free_m_[(b + 1) % n], free_m_[(b + n - 1) % n]});
+    if (f > 0 && r < f - margin_m_ - margin_fraction_ * f) ++count;
+  }
+  return count;
+}
+
+}  // namespace urbanslam::alignment
