@@ -47,9 +47,12 @@ AlignmentResult alignWithPrior(const MatchReference& reference, const PointSet& 
 AlignmentResult alignPointSets(const PointSet& a, const PointSet& b, const Pose2& guess, const AlignerOptions& options) {
   common::Stopwatch sw;
   // (The prior method builds its kd-tree with its grid: no IndexedReference first.)
-  AlignmentResult r = options.method == Method::Prior && std::isfinite(guess.x) && std::isfinite(guess.y) && std::isfinite(guess.phi)
-                          ? alignWithPrior(MatchReference(a, Eigen::Vector2d(guess.x, guess.y), options.prior), b, guess, options)
-                          : alignPointSets(IndexedReference(a), b, guess, options);
+  AlignmentResult r =
+      options.method == Method::Prior && std::isfinite(guess.x) && std::isfinite(guess.y) && std::isfinite(guess.phi)
+          ? alignWithPrior(MatchReference(a, Eigen::Vector2d(guess.x, guess.y), options.prior,
+                                          {{BeamFreeSpace(a, options.prior.free_margin_m, options.prior.free_margin_fraction), {}}}),
+                           b, guess, options)
+          : alignPointSets(IndexedReference(a), b, guess, options);
   r.time_ms = sw.milliseconds();
   return r;
 }

@@ -36,20 +36,26 @@ BeamFreeSpace::BeamFreeSpace(const PointSet& scan, double margin_m, double margi
 }
 
 int BeamFreeSpace::conflicts(const std::vector<Eigen::Vector2d>& points, const common::Pose2& scan_pose) const {
-  if (!valid_) return 0;
+  std::vector<char> state(points.size(), kUnseen);
+  classify(points, scan_pose, state);
+  return static_cast<int>(std::count(state.begin(), state.end(), kSeenThrough));
+}
+
+void BeamFreeSpace::classify(const std::vector<Eigen::Vector2d>& points, const common::Pose2& scan_pose, std::vector<char>& state) const {
+  if (!valid_) return;
   const Rigid2 to_sensor = Rigid2::fromPose(common::inverse(common::compose(scan_pose, sensor_)));
   const size_t n = free_m_.size();
-  int count = 0;
-  for (const auto& p : points) {
-    const Eigen::Vector2d q = to_sensor * p;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector2d q = to_sensor * points[i];
     const double r = q.norm();
     double from_zero = std::atan2(q.y(), q.x());
     if (from_zero < 0) from_zero += 2 * M_PI;
     const size_t b = static_cast<size_t>(from_zero / bin_rad_) % n;
     const double f = std::min({free_m_[b], free_m_[(b + 1) % n], free_m_[(b + n - 1) % n]});
-    if (f > 0 && r < f - margin_m_ - margin_fraction_ * f) ++count;
+    if (f <= 0) continue;
+    const char s = r < f - margin_m_ - margin_fraction_ * f ? kSeenThrough : kInView;
+    state[i] = std::max(state[i], s);
   }
-  return count;
 }
 
 }  // namespace urbanslam::alignment

@@ -5,8 +5,7 @@
 
 namespace urbanslam::alignment {
 
-LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d& centre, const LikelihoodGridOptions& o,
-                               const std::vector<Eigen::Vector2d>& ray_origins)
+LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d& centre, const LikelihoodGridOptions& o)
     : resolution_(o.resolution_m), floor_(static_cast<float>(std::log(o.miss_floor))) {
   const double reach = 3.0 * o.hit_sigma_m;  // beyond 3σ a hit adds nothing to the floor
   Eigen::Vector2d lo = centre, hi = centre;
@@ -37,52 +36,6 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
   for (int k = 0; k <= kTable; ++k)
     table[static_cast<size_t>(k)] = static_cast<float>(std::log(std::exp(-(max_d2 * k / kTable) * inv2s2) + o.miss_floor));
   const double to_index = kTable / max_d2;
-  // Free space first, so that the hits stamped next take precedence near every return. The space
-  // between two neighbouring beams of one scan is swept too (rays fanned out at one per cell of
-  // their far ends): far from the sensor, single rays leave cells unmarked between them.
-  if (ray_origins.size() == reference.size() && o.free_floor < o.miss_floor) {
-    const float free_value = static_cast<float>(std::log(o.free_floor));
-    const auto inside = [&](const Eigen::Vector2d& p) {
-      return std::abs(p.x() - centre.x()) <= o.max_radius_m && std::abs(p.y() - centre.y()) <= o.max_radius_m;
-    };
-    // Where a beam's seen-empty space ends: the margin before its return (none: too short).
-    const auto freeEnd = [&](size_t k, Eigen::Vector2d* end) {
-      const Eigen::Vector2d d = reference[k].p - ray_origins[k];
-      const double range = d.norm(), length = range - o.free_margin_m - o.free_margin_fraction * range;
-      if (length <= 0 || !inside(reference[k].p)) return false;
-      *end = ray_origins[k] + d * (length / range);
-      return true;
-    };
-    const auto march = [&](const Eigen::Vector2d& from, const Eigen::Vector2d& to) {
-      const int n = static_cast<int>(std::ceil((to - from).norm() / (0.5 * resolution_)));  // half a cell apart
-      const Eigen::Vector2d step = (to - from) / std::max(1, n);
-      Eigen::Vector2d q = from;
-      for (int s = 0; s <= n; ++s, q += step) {
-        const Eigen::Vector2i c = cellOf(q);
-        const int a = c.x() + pad_, b = c.y() + pad_;
-        if (a >= 0 && b >= 0 && a < width_ && b < height_)
-          base[static_cast<size_t>(b) * static_cast<size_t>(width_) + static_cast<size_t>(a)] = free_value;
-      }
-    };
-    for (size_t k = 0; k < reference.size(); ++k) {
-      Eigen::Vector2d end, next_end;
-      if (!freeEnd(k, &end)) continue;
-      const bool fan = k + 1 < reference.size() && ray_origins[k + 1] == ray_origins[k] &&
-                       std::abs(reference[k + 1].beam - reference[k].beam) == 1 && freeEnd(k + 1, &next_end);
-      if (!fan) {
-        march(ray_origins[k], end);
-        continue;
-      }
-      // Between the two beams only as far as the shorter one: at a depth step (a box in front of a
-      // wall) the space behind the near return is unseen.
-      march(ray_origins[k], end);
-      const Eigen::Vector2d& o0 = ray_origins[k];
-      const double length = std::min((end - o0).norm(), (next_end - o0).norm());
-      const Eigen::Vector2d u0 = (end - o0).normalized(), u1 = (next_end - o0).normalized();
-      const int rays = static_cast<int>(std::ceil(length * (u1 - u0).norm() / resolution_));
-      for (int r = 1; r < rays; ++r) march(o0, o0 + length * (u0 + (u1 - u0) * (static_cast<double>(r) / rays)).normalized());
-    }
-  }
   for (const auto& sp : reference) {
     if (std::abs(sp.p.x() - centre.x()) > o.max_radius_m || std::abs(sp.p.y() - centre.y()) > o.max_radius_m) continue;
     const Eigen::Vector2i c = cellOf(sp.p);

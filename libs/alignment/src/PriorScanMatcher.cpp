@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
+#include <tuple>
 #include <cmath>
 #include <unordered_set>
 
@@ -13,10 +14,6 @@
 #include "urbanslam/alignment/MotionPrior.h"
 
 namespace urbanslam::alignment {
-
-MatchReference::MatchReference(PointSet points, const Eigen::Vector2d& centre, const PriorMatcherOptions& options,
-                               const std::vector<Eigen::Vector2d>& ray_origins)
-    : indexed_(std::move(points)), grid_(indexed_.points(), centre, options.grid, ray_origins) {}
 
 namespace {
 
@@ -33,6 +30,13 @@ std::vector<Eigen::Vector2d> thin(const PointSet& scan, double voxel_m) {
 }
 
 }  // namespace
+
+MatchReference::MatchReference(PointSet points, const Eigen::Vector2d& centre, const PriorMatcherOptions& options,
+                               std::vector<ReferenceView> views)
+    : indexed_(std::move(points)),
+      grid_(indexed_.points(), centre, options.grid),
+      views_(std::move(views)),
+      thinned_(thin(indexed_.points(), options.voxel_m)) {}
 
 PriorMatchResult matchWithPrior(const MatchReference& reference, const PointSet& scan, const common::Pose2& prior_mean,
                                 const Eigen::Matrix3d& prior_cov, const PriorMatcherOptions& o) {
@@ -65,25 +69,42 @@ PriorMatchResult matchWithPrior(const MatchReference& reference, const PointSet&
   const MotionPrior prior(prior_mean, prior_cov, o.odometry_outlier_probability, volume);
   CorrelativeResult coarse = correlativeSearch(reference.grid(), thinned, prior, window);
   out.search_nodes = coarse.nodes;
-  // When the scan outvotes the odometry, the reference's side of the free-space evidence decides
-  // between the best pose of each of the prior's two parts (odometry right / odometry wrong): a
-  // pose far from the odometry is taken only if it also explains the scan better once the
-  // reference points it puts where the scan's beams passed through are counted. The search scores
-  // only the scan's side (the grid's free space); this side needs the pose, so it is weighed here.
-  if (prior.gaussianWeight(prior.mahalanobis2(prior.difference(coarse.pose))) < 0.5) {
-    const BeamFreeSpace beams(scan, o.grid.free_margin_m, o.grid.free_margin_fraction);
-    const std::vector<Eigen::Vector2d> ref_thinned = thin(reference.indexed().points(), o.voxel_m);
-    const double per_conflict = std::log(o.grid.free_floor / o.grid.miss_floor);
+  // Free space of both sides at a pose: points in view and seen through (reference points in the
+  // scan's beams, the scan's points in the reference scans' beams).
+  const BeamFreeSpace scan_beams(scan, o.free_margin_m, o.free_margin_fraction);
+  const auto freeSpace = [&](const common::Pose2& pose) {
+    std::vector<char> ref_state(reference.thinned().size(), BeamFreeSpace::kUnseen);
+    scan_beams.classify(reference.thinned(), pose, ref_state);
+    std::vector<Eigen::Vector2d> placed;
+    const Rigid2 to_ref = Rigid2::fromPose(pose);
+    for (const auto& p : thinned) placed.push_back(to_ref * p);
+    std::vector<char> scan_state(placed.size(), BeamFreeSpace::kUnseen);
+    for (const ReferenceView& v : reference.views()) v.beams.classify(placed, v.pose, scan_state);
+    std::pair<int, int> n{0, 0};  // in view, seen through
+    for (const auto* states : {&ref_state, &scan_state})
+      for (char c : *states) {
+        n.first += c != BeamFreeSpace::kUnseen;
+        n.second += c == BeamFreeSpace::kSeenThrough;
+      }
+    return n;
+  };
+  // 2'. The scan outvotes the odometry: the best pose the odometry allows, and both weighed again
+  // with the free space of both sides (each point in view, independently, seen through or not at
+  // the rates of a right and of a displaced pose).
+  if (o.seen_through_rate > 0 && scan_beams.valid() && prior.gaussianWeight(prior.mahalanobis2(prior.difference(coarse.pose))) < 0.5) {
+    // "The odometry is right": its Gaussian alone, over the same window.
     const MotionPrior odometry_right(prior_mean, prior_cov, 0.0, volume);
     const CorrelativeResult near = correlativeSearch(reference.grid(), thinned, odometry_right, window);
-    const auto full = [&](const CorrelativeResult& c) {
-      return c.scan_score + prior.logDensity(c.pose) + per_conflict * beams.conflicts(ref_thinned, c.pose);
-    };
-    if (beams.valid() && full(near) >= full(coarse)) {
-      coarse = near;
-      coarse.score = near.scan_score + prior.logDensity(near.pose);
-    }
     out.search_nodes += near.nodes;
+    // Per point in view: log p(what it shows | right pose) / p(... | wrong pose).
+    const double right = std::clamp(o.seen_through_rate, 1e-6, 0.5);
+    const double wrong = std::clamp(o.seen_through_rate_displaced, right, 1 - 1e-6);
+    const auto full = [&](const CorrelativeResult& c) {
+      const auto [in_view, seen] = freeSpace(c.pose);
+      return c.scan_score + prior.logDensity(c.pose) + seen * std::log(right / wrong) +
+             (in_view - seen) * std::log((1 - right) / (1 - wrong));
+    };
+    if (full(near) >= full(coarse)) coarse = near;
   }
   out.search_pose = coarse.pose;
   out.scan_log_likelihood = coarse.scan_score;
@@ -153,6 +174,17 @@ PriorMatchResult matchWithPrior(const MatchReference& reference, const PointSet&
   out.cov = 0.5 * (cov + cov.transpose());
   out.matched = matched;
   out.rms_residual_m = matched > 0 ? std::sqrt(sum_d2 / matched) : 0.0;
+  out.odometry_outvoted = out.prior_weight < 0.5;
+  if (scan_beams.valid()) {
+    std::tie(out.in_view, out.seen_through) = freeSpace(x);
+    const double d = o.displacement_m, a = o.displacement_deg * M_PI / 180;
+    for (const common::Pose2& delta :
+         {common::Pose2{d, 0, a}, common::Pose2{-d, 0, -a}, common::Pose2{0, d, -a}, common::Pose2{0, -d, a}}) {
+      const auto [in_view, seen] = freeSpace(common::compose(x, delta));
+      out.displaced_in_view += in_view;
+      out.displaced_seen_through += seen;
+    }
+  }
   return finish();
 }
 

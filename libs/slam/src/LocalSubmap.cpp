@@ -11,7 +11,6 @@ alignment::PriorMatcherOptions priorMatcherOptions(const LocalOptions& o) {
   m.grid.resolution_m = o.resolution_m;
   m.grid.hit_sigma_m = o.hit_sigma_m;
   m.grid.miss_floor = o.miss_floor;
-  m.grid.free_floor = o.free_floor;
   m.grid.max_radius_m = o.grid_radius_m;
   m.voxel_m = o.voxel_m;
   m.search_window_m = o.search_window_m;
@@ -31,10 +30,10 @@ alignment::PointSet LocalSubmap::points(const io::LaserScan& scan) const {
 
 void LocalSubmap::addKeyframe(const io::LaserScan& scan) {
   sets_.push_back(points(scan));
-  sensors_.emplace_back(scan.sensor_pose.x, scan.sensor_pose.y);
+  beams_.emplace_back(sets_.back(), matcher_.free_margin_m, matcher_.free_margin_fraction);
   while (sets_.size() > capacity_) {
     sets_.pop_front();
-    sensors_.pop_front();
+    beams_.pop_front();
   }
   ++generation_;
 }
@@ -47,17 +46,17 @@ const alignment::MatchReference* LocalSubmap::reference(const std::vector<common
       std::equal(offsets.begin(), offsets.end(), cache_.offsets.begin(), same))
     return cache_.reference.get();
   alignment::PointSet points;
-  std::vector<Eigen::Vector2d> origins;  // where each point's beam started: the grid's free space
+  std::vector<alignment::ReferenceView> views;
   for (size_t i = 0; i < sets_.size(); ++i) {
     const auto t = alignment::transformed(sets_[i], offsets[i]);
     points.insert(points.end(), t.begin(), t.end());
-    origins.insert(origins.end(), t.size(), alignment::Rigid2::fromPose(offsets[i]) * sensors_[i]);
+    views.push_back({beams_[i], offsets[i]});
   }
   cache_.generation = generation_;
   cache_.offsets = std::move(offsets);
-  cache_.reference = points.empty()
-                         ? nullptr
-                         : std::make_unique<const alignment::MatchReference>(std::move(points), Eigen::Vector2d::Zero(), matcher_, origins);
+  cache_.reference = points.empty() ? nullptr
+                                    : std::make_unique<const alignment::MatchReference>(std::move(points), Eigen::Vector2d::Zero(),
+                                                                                        matcher_, std::move(views));
   return cache_.reference.get();
 }
 
@@ -75,7 +74,15 @@ alignment::PriorMatchResult LocalSubmap::match(const io::LaserScan& scan, const 
     none.failure_reason = "empty submap";
     return none;
   }
-  return alignment::matchWithPrior(*ref, points(scan), prior, prior_cov, matcher_);
+  alignment::PriorMatcherOptions options = matcher_;
+  options.seen_through_rate = seen_through_.rate();
+  options.seen_through_rate_displaced = seen_through_displaced_.rate();
+  const alignment::PriorMatchResult r = alignment::matchWithPrior(*ref, points(scan), prior, prior_cov, options);
+  if (r.valid && !r.odometry_outvoted) {
+    seen_through_.add(r.in_view, r.seen_through);
+    seen_through_displaced_.add(r.displaced_in_view, r.displaced_seen_through);
+  }
+  return r;
 }
 
 }  // namespace urbanslam::slam

@@ -42,9 +42,6 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("resolution_m", o.local.resolution_m, 0.01, 1.0, "m", "likelihood grid cell of the correlative search");
   s.add("hit_sigma_m", o.local.hit_sigma_m, 0.005, 1.0, "m", "spread of a return about the surface it hit (likelihood grid)");
   s.add("miss_floor", o.local.miss_floor, 1e-6, 1.0, "", "density of a return the submap does not explain, relative to a hit's peak");
-  s.add("free_floor", o.local.free_floor, 1e-9, 1.0, "",
-        "density of a return where the submap's beams passed through (seen empty: a moving object), relative to a hit's peak; at or above "
-        "miss_floor free space counts as unseen");
   s.add("match_min_interval_s", o.local.match_min_interval_s, 0.0, 10.0, "s",
         "a scan between keyframes is matched only this long after the last matched scan (a fast scanner's trajectory needs no node per "
         "scan)");

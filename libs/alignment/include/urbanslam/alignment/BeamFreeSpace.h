@@ -1,8 +1,8 @@
 #pragma once
 // The space one scan's beams passed through, as a point set remembers it (each point keeps its
-// range and bearing): the shortest return per bearing bin. Used to ask how many points of a
-// reference lie where the scan saw through, i.e. the reference's side of the free-space
-// evidence that the likelihood grid gives the scan's side of (LikelihoodGrid.h).
+// range and bearing): the shortest return per bearing bin. Used to ask which points of another
+// scan or submap lie where this scan saw through (negative information, as FreeSpace.h gives it
+// for loop closures on whole scans).
 #include <vector>
 
 #include <Eigen/Core>
@@ -21,6 +21,10 @@ class BeamFreeSpace {
   bool valid() const { return valid_; }
   // Of `points` (in the frame where the scan sits at `scan_pose`), how many the scan saw through.
   int conflicts(const std::vector<Eigen::Vector2d>& points, const common::Pose2& scan_pose) const;
+  // Per point (sized like points): raised to kInView where the scan's beams reach its bearing, to
+  // kSeenThrough where they passed it. Never lowered, so several scans can judge one point set.
+  static constexpr char kUnseen = 0, kInView = 1, kSeenThrough = 2;
+  void classify(const std::vector<Eigen::Vector2d>& points, const common::Pose2& scan_pose, std::vector<char>& state) const;
 
  private:
   bool valid_ = false;

@@ -25,24 +25,14 @@ struct LikelihoodGridOptions {
   double resolution_m = 0.05;  // cell size
   double hit_sigma_m = 0.05;   // spread of a return about the surface it hit (noise + cell size)
   double miss_floor = 0.05;    // κ: the density of an unexplained return relative to a hit's peak
-  // κ_free: the density of a return where the reference's beams passed (space seen empty: only a
-  // moving object returns there), relative to a hit's peak. Used where the reference's sensor
-  // origins are given; at or above miss_floor the grid does not tell free from unseen space.
-  double free_floor = 0.001;
-  // A beam's space counts as seen empty up to free_margin_m + free_margin_fraction * range before
-  // its return (range noise, beam width, the submap's own pose errors).
-  double free_margin_m = 0.3;
-  double free_margin_fraction = 0.05;
   double max_radius_m = 40.0;  // cells farther than this from the centre (along x or y) are left out
   int levels = 5;              // pyramid levels above the base (blocks of 2^levels cells; wider windows get more root blocks)
 };
 
 class LikelihoodGrid {
  public:
-  // The reference points (in the reference's frame) around `centre`. ray_origins: empty, or the
-  // position of the sensor that saw each point (the cells its beam crossed are free space).
-  LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d& centre, const LikelihoodGridOptions& options,
-                 const std::vector<Eigen::Vector2d>& ray_origins = {});
+  // The reference points (in the reference's frame) around `centre`.
+  LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d& centre, const LikelihoodGridOptions& options);
 
   double resolution() const { return resolution_; }
   int levels() const { return static_cast<int>(level_.size()) - 1; }

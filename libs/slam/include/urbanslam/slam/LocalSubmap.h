@@ -9,9 +9,11 @@
 #include <memory>
 #include <vector>
 
+#include "urbanslam/alignment/BeamFreeSpace.h"
 #include "urbanslam/alignment/PointSet.h"
 #include "urbanslam/alignment/PriorScanMatcher.h"
 #include "urbanslam/alignment/ScanModel.h"
+#include "urbanslam/alignment/SeenThroughRate.h"
 #include "urbanslam/io/LaserScan.h"
 #include "urbanslam/slam/PipelineOptions.h"
 
@@ -39,15 +41,18 @@ class LocalSubmap {
   alignment::PriorMatcherOptions matcher_;
   alignment::ScanModelOptions scan_model_;
   size_t capacity_;
-  std::deque<alignment::PointSet> sets_;  // each keyframe's points in its own frame
-  std::deque<Eigen::Vector2d> sensors_;   // each keyframe's sensor position in its own frame
-  size_t generation_ = 0;                 // keyframes added so far
+  std::deque<alignment::PointSet> sets_;        // each keyframe's points in its own frame
+  std::deque<alignment::BeamFreeSpace> beams_;  // the space each keyframe's beams passed through
+  size_t generation_ = 0;                       // keyframes added so far
   struct Cache {
     size_t generation = static_cast<size_t>(-1);
     std::vector<common::Pose2> offsets;  // each keyframe in the newest one's frame
     std::unique_ptr<const alignment::MatchReference> reference;
   };
   mutable Cache cache_;
+  // Learnt from the matches as they come (what the free-space evidence weighs: the matcher's
+  // seen_through_rate); it changes what the submap matches, not the submap itself.
+  mutable alignment::SeenThroughRate seen_through_{0.05}, seen_through_displaced_{0.3};
 };
 
 }  // namespace urbanslam::slam

@@ -52,7 +52,6 @@ struct LocalOptions {
   double resolution_m = 0.05;    // likelihood grid cell
   double hit_sigma_m = 0.05;     // spread of a return about the surface it hit
   double miss_floor = 0.05;      // density of an unexplained return relative to a hit's peak
-  double free_floor = 0.001;     // ... of a return where the submap's beams passed (only a moving object)
   double voxel_m = 0.2;          // the correlative search scores one scan point per voxel
   double grid_radius_m = 40.0;   // the likelihood grid covers the submap this far around its last keyframe
   double search_window_m = 0.3;  // the search reaches at least this far from the odometry

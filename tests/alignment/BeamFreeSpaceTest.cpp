@@ -1,6 +1,6 @@
-// Free space in local matching, against the world the scans were ray-cast in: the likelihood
-// grid's cells that the reference's beams crossed, and the cells of a scan's own beams
-// (BeamFreeSpace), each decided independently by casting a ray from the sensor in the world.
+// The space a scan's beams passed through (BeamFreeSpace), against the world the scan was
+// ray-cast in: whether a point is seen through is decided independently by casting rays from the
+// sensor to it in the world.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,8 +9,8 @@
 
 #include "SyntheticScan.h"
 #include "urbanslam/alignment/BeamFreeSpace.h"
-#include "urbanslam/alignment/LikelihoodGrid.h"
 #include "urbanslam/alignment/ScanModel.h"
+#include "urbanslam/alignment/SeenThroughRate.h"
 
 namespace urbanslam::alignment {
 namespace {
@@ -53,34 +53,7 @@ test::ScanSpec fullTurn() {
   return spec;
 }
 
-TEST(FreeSpaceGrid, CellsTheBeamsCrossedScoreTheFreeFloor) {
-  const test::World world = test::roomWorld();
-  const PointSet ref = pointSetFromScan(test::simulateScan(world, {0, 0, 0}, fullTurn()), ScanModelOptions{}, false);
-  LikelihoodGridOptions o;
-  const LikelihoodGrid with(ref, Eigen::Vector2d::Zero(), o, std::vector<Eigen::Vector2d>(ref.size(), Eigen::Vector2d::Zero()));
-  const LikelihoodGrid without(ref, Eigen::Vector2d::Zero(), o);
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> ux(-12, 12), uy(-8, 8);
-  int seen_free = 0, behind = 0;
-  for (int k = 0; k < 4000; ++k) {
-    const Eigen::Vector2d p(ux(rng), uy(rng));
-    if (distanceToWalls(world, p) < 0.3 || p.norm() < 0.3) continue;  // near a hit, or at the sensor
-    const auto [near, far] = wallRange(world, Eigen::Vector2d::Zero(), p, 1.5 * M_PI / 180);
-    const double r = p.norm();
-    if (r < 0.8 * (near - o.free_margin_m - o.free_margin_fraction * near)) {
-      ++seen_free;
-      EXPECT_FLOAT_EQ(with.score(p), std::log(o.free_floor)) << p.transpose();
-      EXPECT_FLOAT_EQ(without.score(p), std::log(o.miss_floor)) << p.transpose();
-    } else if (r > far + 0.3) {
-      ++behind;  // never seen: an unexplained return, not a return in free space
-      EXPECT_FLOAT_EQ(with.score(p), std::log(o.miss_floor)) << p.transpose();
-    }
-  }
-  EXPECT_GT(seen_free, 500);
-  EXPECT_GT(behind, 200);
-}
-
-TEST(FreeSpaceGrid, ScanBeamsCountReferencePointsTheyPassedThrough) {
+TEST(BeamFreeSpace, CountsThePointsTheBeamsPassedThrough) {
   // A scan taken by a sensor mounted off the vehicle's centre, its points in the vehicle frame.
   const test::World world = test::roomWorld();
   const common::Pose2 vehicle{1.0, -0.5, 0.4}, mount{0.3, 0.1, 0.2};
@@ -105,6 +78,18 @@ TEST(FreeSpaceGrid, ScanBeamsCountReferencePointsTheyPassedThrough) {
   // in the world frame, where the scan sits at the vehicle pose).
   EXPECT_EQ(beams.conflicts(in_front, vehicle), 300);
   EXPECT_EQ(beams.conflicts(hidden, vehicle), 0);
+}
+
+TEST(SeenThroughRate, StartsAtItsPriorLearnsAndForgets) {
+  SeenThroughRate rate(0.05, 200, 10000);
+  EXPECT_DOUBLE_EQ(rate.rate(), 0.05);
+  rate.add(800, 8);  // (10 + 8) / (200 + 800)
+  EXPECT_DOUBLE_EQ(rate.rate(), 18.0 / 1000.0);
+  rate.add(0, 0);  // nothing in view says nothing
+  EXPECT_DOUBLE_EQ(rate.rate(), 18.0 / 1000.0);
+  // Outdoors: a long run at 30 % takes over; the indoor counts fade out.
+  for (int k = 0; k < 200; ++k) rate.add(500, 150);
+  EXPECT_NEAR(rate.rate(), 0.3, 0.01);
 }
 
 }  // namespace
