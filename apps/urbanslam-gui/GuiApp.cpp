@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
+#include <string>
 
 #include "MainFrame.h"
 
@@ -95,4 +96,17 @@ class GuiApp : public wxApp {
 
 wxIMPLEMENT_APP_NO_MAIN(GuiApp);
 
-int main(int argc, char** argv) { return wxEntry(argc, argv); }
+int main(int argc, char** argv) {
+  // --help before wx starts: wx's GTK initialisation fails without a display (exit 255), and the
+  // help must not need one.
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--ini" || a == "--screenshot" || a == "--speed" || a == "--snapshot-at") {
+      ++i;  // a value, even one spelled "--help"
+    } else if (a == "--help" || a == "-h") {
+      std::cout << kUsage;
+      return 0;
+    }
+  }
+  return wxEntry(argc, argv);
+}

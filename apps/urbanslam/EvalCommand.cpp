@@ -26,7 +26,11 @@ namespace {
 std::vector<io::StampedPose> loadReference(const std::string& path, bool& positions_only) {
   positions_only = false;
   const auto ext = fs::path(path).extension().string();
-  if (ext == ".tum" || ext == ".txt") return io::readTum(path);
+  if (ext == ".tum" || ext == ".txt") {
+    auto poses = io::readTum(path);
+    if (poses.empty()) throw common::InputError(path + ": no poses (an empty trajectory cannot be a reference)");
+    return poses;
+  }
   auto src = io::openDataSource(path);
   std::vector<io::StampedPose> ref, gps;
   io::Measurement m;
@@ -143,6 +147,7 @@ int evalCommand(const Argv& args) {
   const fs::path traj_path = dir / "trajectory_odometry.tum", nodes_path = dir / "trajectory_scans.tum";
   if (!fs::exists(traj_path)) throw common::InputError(traj_path.string() + ": missing (not a run folder?)");
   const auto estimate = io::readTum(traj_path.string());
+  if (estimate.empty()) throw common::InputError(traj_path.string() + ": no poses (the run mapped nothing)");
   // The relations score the run's nodes, the scans it placed (as Cartographer scores its own),
   // interpolated at each relation time; a folder without them (a peer's) is scored on its one
   // trajectory.
@@ -235,6 +240,9 @@ int evalCommand(const Argv& args) {
   }
   if (!reference_path.empty()) {
     const auto tm = evaluation::trajectoryMetrics(estimate, reference, positions_only, positions_only ? 2.0 : 1.0);
+    if (tm.matched == 0)
+      throw common::InputError(reference_path + ": no reference pose falls inside the run's time span (" + traj_path.string() +
+                               "): wrong dataset?");
     j["reference"] = reference_path;
     if (ap.has("truth")) evaluateAgainstSimulation(dir, truth_dir, tm.alignment, j);
     j["positions_only"] = positions_only;

@@ -47,8 +47,9 @@ int runCommand(const Argv& args) {
       "outputs in DIR: trajectory_keyframes.tum, trajectory_odometry.tum, trajectory_scans.tum (every\n"
       "scan placed by matching), reference.tum (when the log has one), map.ply/.pcd/.xyz,\n"
       "map.simplemap, grid.png + grid.yaml, pose_graph.g2o,\n"
-      "loop_closures.csv (every hypothesis, laser or image, and its fate), config.ini, stats.json\n"
-      "(written last: its presence marks a complete run).");
+      "loop_closures.csv (every hypothesis, laser or image, and its fate), config.ini, stats.json.\n"
+      "DIR appears complete at the end (written beside it, then swapped in): it is replaced only when\n"
+      "it is empty or holds an earlier run.");
   if (!ap.parse(args)) return 0;
 
   if (ap.has("simulate") && !ap.positional("LOG").empty())
@@ -71,6 +72,12 @@ int runCommand(const Argv& args) {
   pipeline.addObserver(&progress);
   pipeline.run(*source);
   bar.finish();
+  // A log without a single keyframe has nothing to map: outputs would only look like a run.
+  if (pipeline.keyframes().empty()) {
+    const size_t scans = pipeline.stats().scans;
+    throw common::InputError(log + (scans == 0 ? ": no laser scans (nor images) in the log: nothing to map"
+                                               : ": none of its " + std::to_string(scans) + " laser scans could be used: nothing to map"));
+  }
 
   const std::string out = ap.option("out");
   const common::Json stats = slam::writeRunOutputs(pipeline, out, {log, source->format(), ini, resolved});

@@ -69,9 +69,16 @@ TEST(Cli, RunOnTheShippedRawlogWritesEveryOutput) {
   for (const char* f : {"trajectory_keyframes.tum", "trajectory_odometry.tum", "trajectory_scans.tum", "reference.tum", "map.ply",
                         "map.pcd", "map.simplemap", "grid.png", "grid.yaml", "config.ini", "stats.json"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
-  // No temporary files left behind.
+  // No temporary files left behind, in the folder or beside it.
   for (const auto& e : fs::directory_iterator(out))
     EXPECT_EQ(e.path().filename().string().find(".partial-"), std::string::npos) << e.path();
+  for (const auto& e : fs::directory_iterator(out.parent_path()))
+    EXPECT_NE(e.path().filename().string().rfind(".cli_run.", 0), 0u) << e.path();
+  // Every TUM file is a time series (the log itself has scans out of time order).
+  for (const char* f : {"trajectory_keyframes.tum", "trajectory_odometry.tum", "trajectory_scans.tum", "reference.tum"}) {
+    const auto t = io::readTum((out / f).string());
+    for (size_t i = 1; i < t.size(); ++i) ASSERT_LE(t[i - 1].timestamp, t[i].timestamp) << f << " line " << i + 1;
+  }
   // The resolved config written beside the outputs is itself a valid ini.
   EXPECT_EQ(runCli("check-ini " + (out / "config.ini").string()).code, 0);
   for (const char* f : {"pose_graph.g2o", "loop_closures.csv"}) EXPECT_TRUE(fs::exists(out / f)) << f;

@@ -33,3 +33,13 @@ TEST(IniFile, RejectsMalformedLinesWithFileAndLine) {
   EXPECT_THROW(IniFile::parse("[a\nx=1\n", "t.ini"), ConfigError);        // broken header
   EXPECT_THROW(IniFile::load("/nonexistent/file.ini"), ConfigError);
 }
+
+// An ifstream reads a directory as an empty file: that must not pass as an ini of defaults.
+TEST(IniFile, ADirectoryIsNotAnIni) {
+  try {
+    IniFile::load(URBANSLAM_SOURCE_DIR "/ini");
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("/ini: is a directory"), std::string::npos) << e.what();
+  }
+}

@@ -79,3 +79,15 @@ TEST(GuiSmoke, CameraPanelShowsBothFramesOnTheImageSequence) {
   EXPECT_NE(json.find("\"camera_match_fate\":\"no_scans\""), std::string::npos) << json;
   EXPECT_TRUE(fs::exists(shot));
 }
+
+// The help needs no display: it is printed before wx initialises GTK (which fails without one).
+TEST(GuiSmoke, HelpWithoutADisplay) {
+  const fs::path d = test::scratchDir("gui_help");
+  const std::string out = (d / "out.txt").string(), err = (d / "err.txt").string();
+  for (const char* flag : {"--help", "-h"}) {
+    const std::string cmd = "env -u DISPLAY -u WAYLAND_DISPLAY " + std::string(URBANSLAM_GUI) + " " + flag + " >" + out + " 2>" + err;
+    const int status = std::system(cmd.c_str());
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << flag << ": " << test::slurp(err);
+    EXPECT_EQ(test::slurp(out).rfind("usage: urbanslam-gui", 0), 0u) << test::slurp(out);
+  }
+}

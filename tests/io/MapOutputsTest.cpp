@@ -178,3 +178,35 @@ TEST(MapOutputs, TumRoundTripAndGridYaml) {
   EXPECT_NE(all.find("resolution: 0.05"), std::string::npos);
   EXPECT_TRUE(std::filesystem::exists(d / "grid.png"));
 }
+
+// Logs are not always in time order (the Intel log has scans stamped earlier than the scan
+// before them); a TUM file is a time series, so it is written sorted, keeping every pose.
+TEST(MapOutputs, TumIsWrittenInTimeOrder) {
+  const auto d = test::scratchDir("tum_order");
+  io::writeTum((d / "t.tum").string(), {{2.0, {2, 0, 0}}, {1.0, {1, 0, 0}}, {3.0, {3, 0, 0}}, {1.0, {1.5, 0, 0}}});
+  const auto back = io::readTum((d / "t.tum").string());
+  ASSERT_EQ(back.size(), 4u);
+  EXPECT_EQ(back[0].timestamp, 1.0);
+  EXPECT_EQ(back[0].pose.x, 1.0);  // equal times keep their order
+  EXPECT_EQ(back[1].pose.x, 1.5);
+  EXPECT_EQ(back[2].timestamp, 2.0);
+  EXPECT_EQ(back[3].timestamp, 3.0);
+}
+
+TEST(MapOutputs, TumValuesMustBeFiniteDecimalsInRange) {
+  const auto d = test::scratchDir("tum_bad");
+  const auto expectError = [&](const std::string& line, const std::string& fragment) {
+    const std::string path = (d / "bad.tum").string();
+    std::ofstream(path) << "# t x y z qx qy qz qw\n0 0 0 0 0 0 0 1\n" << line << "\n";
+    try {
+      io::readTum(path);
+      ADD_FAILURE() << "no error for " << line;
+    } catch (const common::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+  };
+  expectError("1 inf 0 0 0 0 0 1", "bad.tum:3: position 'inf' is not a number");
+  expectError("1 0x10 0 0 0 0 0 1", "bad.tum:3: position '0x10' is not a number");
+  expectError("1 0 1e8 0 0 0 0 1", "bad.tum:3: position 1e8 is out of range");
+  expectError("nan 0 0 0 0 0 0 1", "bad.tum:3: timestamp 'nan'");
+}

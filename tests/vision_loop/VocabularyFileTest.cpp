@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <random>
@@ -96,4 +97,19 @@ TEST(VocabularyFile, CorruptTruncatedOrForeignFilesAreRefused) {
   expectRefused((dir / "text.voc").string(), "not an urbanslam vocabulary");
 
   expectRefused((dir / "missing.voc").string(), "cannot open");
+}
+
+// A corrupt node count in the header is refused before the arrays are allocated (2^32 - 1
+// nodes of a SIFT vocabulary would be 2.5 TB).
+TEST(VocabularyFile, HeaderCountsMustMatchTheFileSize) {
+  const auto dir = urbanslam::test::scratchDir("vocabulary_counts");
+  const std::string good = (dir / "good.voc").string();
+  saveVocabulary(randomVocabulary(DescriptorType::Sift), good);
+  std::string bytes = readAll(good);
+  const uint64_t nodes = (1ull << 32) - 1;
+  std::memcpy(&bytes[8 + 4 * 4], &nodes, sizeof nodes);  // magic, version, type, branching, depth, then nodes
+  writeAll((dir / "nodes.voc").string(), bytes);
+  expectRefused((dir / "nodes.voc").string(), "nodes.voc: vocabulary file is truncated: its header declares 4294967295 nodes");
+  writeAll((dir / "longer.voc").string(), readAll(good) + "extra");
+  expectRefused((dir / "longer.voc").string(), "longer.voc: vocabulary file is corrupt: its header declares");
 }

@@ -1,6 +1,7 @@
 #include "urbanslam/common/IniFile.h"
 
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -32,10 +33,14 @@ std::string stripComment(const std::string& s) {
 }  // namespace
 
 IniFile IniFile::load(const std::string& path) {
+  // An ifstream opens a directory and reads it as empty: that would be an ini of defaults.
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw ConfigError(path + ": is a directory, not an ini file");
   std::ifstream in(path);
   if (!in) throw ConfigError(path + ": cannot open the ini file");
   std::stringstream ss;
   ss << in.rdbuf();
+  if (in.bad()) throw ConfigError(path + ": cannot read the ini file");
   return parse(ss.str(), path);
 }
 

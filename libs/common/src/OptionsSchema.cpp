@@ -1,12 +1,11 @@
 #include "urbanslam/common/OptionsSchema.h"
 
-#include <cerrno>
 #include <cmath>
-#include <cstdlib>
 #include <sstream>
 
 #include "urbanslam/common/Error.h"
 #include "urbanslam/common/IniFile.h"
+#include "urbanslam/common/Numbers.h"
 
 namespace urbanslam::common {
 
@@ -20,20 +19,15 @@ std::string formatDouble(double v) {
 }
 
 double parseDouble(const std::string& s, const std::string& where) {
-  errno = 0;
-  char* end = nullptr;
-  const double v = std::strtod(s.c_str(), &end);
-  if (s.empty() || end != s.c_str() + s.size() || errno == ERANGE || !std::isfinite(v))
-    throw ConfigError(where + "'" + s + "' is not a number");
-  return v;
+  const auto v = parseDecimal(s);
+  if (!v) throw ConfigError(where + "'" + s + "' is not a number (plain decimal; hex, inf and NaN are not accepted)");
+  return *v;
 }
 
 long parseInt(const std::string& s, const std::string& where) {
-  errno = 0;
-  char* end = nullptr;
-  const long v = std::strtol(s.c_str(), &end, 10);
-  if (s.empty() || end != s.c_str() + s.size() || errno == ERANGE) throw ConfigError(where + "'" + s + "' is not a whole number");
-  return v;
+  const auto v = parseWholeNumber(s);
+  if (!v) throw ConfigError(where + "'" + s + "' is not a whole number");
+  return *v;
 }
 
 }  // namespace

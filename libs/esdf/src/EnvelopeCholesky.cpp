@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "urbanslam/esdf/Recovery.h"
+
 namespace urbanslam::esdf {
 
 void EnvelopeCholesky::factorize(const InformationState& s, int first, int last) {
@@ -41,7 +43,7 @@ void EnvelopeCholesky::factorize(const InformationState& s, int first, int last)
     Mat3 d = l(p, p);
     for (int k = lo_[p]; k < p; ++k) d.noalias() -= l(p, k) * l(p, k).transpose();
     Eigen::LLT<Mat3> llt(d);
-    if (llt.info() != Eigen::Success) throw std::runtime_error("information matrix is not positive definite (window)");
+    if (llt.info() != Eigen::Success) throw NotPositiveDefinite("information matrix is not positive definite (window)");
     l(p, p) = llt.matrixL();
     // The 3x3 triangular inverses once per pose: the block products above and the solves then
     // stay fixed-size products (a 3x3 triangular solve goes through Eigen's generic kernel).

@@ -7,6 +7,7 @@
 
 #include "urbanslam/common/Error.h"
 #include "urbanslam/common/Timing.h"
+#include "urbanslam/esdf/Recovery.h"
 
 namespace urbanslam::esdf {
 namespace {
@@ -24,9 +25,8 @@ RecoveryStats incrementalRecovery(Esdf& filter, const PoseGraphBackendOptions& o
   return st;
 }
 
-}  // namespace
-
-PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBackendOptions& opt) {
+// The backend; `current` follows the edge being added, for errors.
+PoseGraphBackendResult runBackend(const PoseGraph& g, const PoseGraphBackendOptions& opt, const PoseGraphEdge** current) {
   PoseGraphBackendResult res;
   // Vertex ids: those declared plus those only named by edges (edges-only files).
   std::vector<long> ids;
@@ -38,7 +38,7 @@ PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBa
   }
   std::sort(ids.begin(), ids.end());
   ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-  if (ids.empty()) throw common::InputError("pose graph has no vertices");
+  if (ids.empty()) throw common::InputError(g.name + ": pose graph has no vertices");
   std::unordered_map<long, int> index;
   index.reserve(ids.size());
   for (size_t k = 0; k < ids.size(); ++k) index.emplace(ids[k], static_cast<int>(k));
@@ -86,7 +86,7 @@ PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBa
       if (aug < 0) aug = q;
     }
     if (aug < 0)
-      throw common::InputError("pose graph: vertex " + std::to_string(ids[k]) + " has no edge to an earlier vertex (disconnected graph)");
+      throw common::InputError(g.name + ": vertex " + std::to_string(ids[k]) + " has no edge to an earlier vertex (disconnected graph)");
     double max_chi2 = 0;
     int closures = 0;
     // The augmenting edge first (the new pose must exist before it is observed).
@@ -95,6 +95,7 @@ PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBa
     for (int q = b0; q < b1; ++q) {
       common::Stopwatch sw;
       const auto& e = g.edges[static_cast<size_t>(order[q])];
+      *current = &e;
       const int a = index[e.from], b = index[e.to];
       if (q == aug) {
         if (b == k)
@@ -188,6 +189,26 @@ PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBa
   }
   res.chi2 = poseGraphChi2(g, res.poses, ids);
   return res;
+}
+
+}  // namespace
+
+PoseGraphBackendResult runPoseGraphBackend(const PoseGraph& g, const PoseGraphBackendOptions& opt) {
+  const PoseGraphEdge* current = nullptr;
+  try {
+    return runBackend(g, opt, &current);
+  } catch (const NotPositiveDefinite& ex) {
+    // Information matrices that are each positive definite can still sum to a Lambda that is not
+    // numerically so (entries many orders of magnitude apart, measurements that contradict the
+    // rest by far): name the edge after which the filter found it.
+    std::string where = g.name;
+    if (current) {
+      if (current->line > 0) where += ":" + std::to_string(current->line);
+      where += ": edge " + std::to_string(current->from) + " -> " + std::to_string(current->to);
+    }
+    throw common::InputError(where + ": the filter's " + ex.what() +
+                             " after this edge (an extreme or inconsistent information matrix or measurement)");
+  }
 }
 
 PoseGraph withPoses(const PoseGraph& graph, const PoseGraphBackendResult& r) {

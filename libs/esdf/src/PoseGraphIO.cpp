@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cctype>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -16,6 +15,7 @@
 
 #include "urbanslam/common/AtomicFile.h"
 #include "urbanslam/common/Error.h"
+#include "urbanslam/common/Numbers.h"
 
 namespace urbanslam::esdf {
 namespace {
@@ -56,17 +56,14 @@ class Tokens {
   std::string_view rest_;
 };
 
-// Parses numbers strictly (no trailing junk inside a token, finite values only).
+// Parses numbers strictly (common::parseDecimal: decimal, finite, the whole token).
 bool parseNumbers(Tokens& in, double* out, int count) {
   std::string_view tok;
   for (int k = 0; k < count; ++k) {
     if (!in.next(&tok)) return false;
-    // from_chars rejects a leading '+' that strtod took; skip one, but only before the number
-    // itself ("+-1" stays malformed).
-    const bool plus = tok.front() == '+' && tok.size() > 1 && tok[1] != '-' && tok[1] != '+';
-    const char* first = tok.data() + (plus ? 1 : 0);
-    const auto [end, ec] = std::from_chars(first, tok.data() + tok.size(), out[k]);
-    if (ec != std::errc() || end != tok.data() + tok.size() || !std::isfinite(out[k])) return false;
+    const auto v = common::parseDecimal(tok);
+    if (!v) return false;
+    out[k] = *v;
   }
   return true;
 }
@@ -74,14 +71,26 @@ bool parseNumbers(Tokens& in, double* out, int count) {
 bool parseId(Tokens& in, long* id) {
   std::string_view tok;
   if (!in.next(&tok)) return false;
-  const auto [end, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), *id);
-  return ec == std::errc() && end == tok.data() + tok.size() && *id >= 0;
+  const auto v = common::parseWholeNumber(tok);
+  if (!v || *v < 0) return false;
+  *id = *v;
+  return true;
+}
+
+// The first of `count` values beyond max_abs, or -1.
+int firstBeyond(const double* v, int count, double max_abs) {
+  for (int k = 0; k < count; ++k)
+    if (std::abs(v[k]) > max_abs) return k;
+  return -1;
 }
 
 }  // namespace
 
+constexpr double kMaxInformation = 1e12;
+
 PoseGraph parsePoseGraph(const std::string& text, const std::string& name) {
   PoseGraph g;
+  g.name = name;
   bool seen_g2o = false, seen_toro = false;
   std::string_view rest(text);
   long lineno = 0;
@@ -99,6 +108,7 @@ PoseGraph parsePoseGraph(const std::string& text, const std::string& name) {
       PoseGraphVertex v;
       double p[3];
       if (!parseId(in, &v.id) || !parseNumbers(in, p, 3)) fail("malformed " + std::string(tag) + " line (want: id x y theta)");
+      if (firstBeyond(p, 3, common::kMaxCoordinate) >= 0) fail("vertex pose out of range (|value| > 1e7)");
       v.pose = {p[0], p[1], p[2]};
       g.vertices.push_back(v);
     } else if (tag == "EDGE_SE2" || tag == "EDGE2") {
@@ -111,7 +121,12 @@ PoseGraph parsePoseGraph(const std::string& text, const std::string& name) {
       std::string_view extra;
       if (in.next(&extra)) fail("trailing data on " + std::string(tag) + " line");
       if (e.from == e.to) fail("edge from a vertex to itself");
+      if (firstBeyond(p, 3, common::kMaxCoordinate) >= 0) fail("edge measurement out of range (|value| > 1e7)");
+      // Information 1/sigma^2 beyond 1e12 (sigma < 1 micrometre) only adds rounding error: next
+      // to the other factors such an entry leaves Lambda numerically singular.
+      if (firstBeyond(p + 3, 6, kMaxInformation) >= 0) fail("information entry out of range (|value| > 1e12)");
       e.measurement = {p[0], p[1], p[2]};
+      e.line = lineno;
       // g2o: upper triangle row-major, i11 i12 i13 i22 i23 i33. TORO: ff fs ss rr fr sr.
       double xx, xy, xt, yy, yt, tt;
       if (toro) {

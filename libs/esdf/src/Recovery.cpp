@@ -128,7 +128,7 @@ void SparseCholesky::factorize(const InformationState& s, int first, int last) {
   if (cm->status != CHOLMOD_OK || impl_->factor->minor < n) {
     cholmod_free_factor(&impl_->factor, cm);
     impl_->last_p.clear();
-    throw std::runtime_error("information matrix is not positive definite (CHOLMOD status " + std::to_string(cm->status) + ")");
+    throw NotPositiveDefinite("information matrix is not positive definite (CHOLMOD status " + std::to_string(cm->status) + ")");
   }
   first_ = first;
   last_ = last;

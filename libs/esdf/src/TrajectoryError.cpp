@@ -9,6 +9,7 @@
 #include <unordered_map>
 
 #include "urbanslam/common/Error.h"
+#include "urbanslam/common/Numbers.h"
 #include "urbanslam/common/RigidFit.h"
 
 namespace urbanslam::esdf {
@@ -71,11 +72,17 @@ std::vector<PoseGraphVertex> readReferencePoses(const std::string& path) {
     ++lineno;
     std::istringstream ls(line);
     std::vector<double> v;
-    double d;
-    while (ls >> d) v.push_back(d);
-    if (v.empty() && line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    if (!ls.eof() || (v.size() != 3 && v.size() != 4))
-      throw common::InputError(path + ":" + std::to_string(lineno) + ": want 'id x y theta' or 'x y theta'");
+    std::string tok;
+    bool numbers = true;
+    while (ls >> tok) {
+      const auto d = common::parseDecimal(tok);
+      numbers = numbers && d && std::abs(*d) <= common::kMaxCoordinate;
+      v.push_back(d ? *d : 0.0);
+    }
+    if (v.empty()) continue;
+    if (!numbers || (v.size() != 3 && v.size() != 4))
+      throw common::InputError(path + ":" + std::to_string(lineno) +
+                               ": want 'id x y theta' or 'x y theta' (decimal numbers, |value| <= 1e7)");
     if (v.size() == 4)
       out.push_back({static_cast<long>(v[0]), Vec3(v[1], v[2], v[3])});
     else

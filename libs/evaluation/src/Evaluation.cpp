@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "urbanslam/common/Error.h"
+#include "urbanslam/common/Numbers.h"
 #include "urbanslam/common/RigidFit.h"
 
 namespace urbanslam::evaluation {
@@ -52,9 +53,14 @@ std::vector<Relation> readRelations(const std::string& path) {
     if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
     std::istringstream is(line);
     double v[8];
-    for (double& x : v)
-      if (!(is >> x) || !std::isfinite(x))
-        throw common::InputError(path + ":" + std::to_string(n) + ": expected 't1 t2 x y z roll pitch yaw'");
+    std::string tok;
+    for (int k = 0; k < 8; ++k) {
+      const auto x = is >> tok ? common::parseDecimal(tok) : std::nullopt;
+      if (!x) throw common::InputError(path + ":" + std::to_string(n) + ": expected 't1 t2 x y z roll pitch yaw' (decimal numbers)");
+      if (std::abs(*x) > (k < 2 ? common::kMaxMagnitude : common::kMaxCoordinate))
+        throw common::InputError(path + ":" + std::to_string(n) + ": value " + tok + " is out of range");
+      v[k] = *x;
+    }
     out.push_back({v[0], v[1], {v[2], v[3], v[7]}});
   }
   if (out.empty()) throw common::InputError(path + ": no relations");
@@ -282,16 +288,23 @@ std::vector<LoopRow> readLoopClosuresCsv(const std::string& path) {
     std::string cell;
     while (std::getline(ss, cell, ',')) f.push_back(cell);
     if (f.size() < 11) throw common::InputError(path + ":" + std::to_string(n) + ": expected 14 columns");
-    try {
-      out.push_back({std::stol(f[0]),
-                     std::stol(f[1]),
-                     std::stod(f[2]),
-                     std::stod(f[3]),
-                     f[6] == "1",
-                     {std::stod(f[8]), std::stod(f[9]), std::stod(f[10])}});
-    } catch (const std::exception&) {
-      throw common::InputError(path + ":" + std::to_string(n) + ": malformed number");
-    }
+    const auto whole = [&](const std::string& c) {
+      const auto v = common::parseWholeNumber(c);
+      if (!v || *v < 0) throw common::InputError(path + ":" + std::to_string(n) + ": malformed keyframe index '" + c + "'");
+      return *v;
+    };
+    const auto number = [&](const std::string& c, double max_abs) {
+      const auto v = common::parseDecimal(c);
+      if (!v || std::abs(*v) > max_abs)
+        throw common::InputError(path + ":" + std::to_string(n) + ": malformed or out-of-range number '" + c + "'");
+      return *v;
+    };
+    out.push_back({whole(f[0]),
+                   whole(f[1]),
+                   number(f[2], common::kMaxMagnitude),
+                   number(f[3], common::kMaxMagnitude),
+                   f[6] == "1",
+                   {number(f[8], common::kMaxCoordinate), number(f[9], common::kMaxCoordinate), number(f[10], common::kMaxCoordinate)}});
   }
   return out;
 }

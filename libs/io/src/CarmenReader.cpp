@@ -13,6 +13,7 @@ namespace urbanslam::io {
 
 using common::InputError;
 using common::Pose2;
+using detail::parseCoordinate;
 using detail::parseInteger;
 using detail::parseNumber;
 using detail::resolutionForBeams;
@@ -87,7 +88,7 @@ void CarmenReader::prescan() {
     if (f[0] == "PARAM" && f.size() >= 3) handleParam(f);
     if (f[0] == "ODOM" && f.size() >= 4) {
       any_odom_lines_ = true;
-      const Pose2 p{parseNumber(f[1], where, "x"), parseNumber(f[2], where, "y"), parseNumber(f[3], where, "theta")};
+      const Pose2 p{parseCoordinate(f[1], where, "x"), parseCoordinate(f[2], where, "y"), parseCoordinate(f[3], where, "theta")};
       // An anchor that differs from the odometry just before it is a corrected pose.
       if (after_scan && samePose(p, scan_pose) && have_prev_odom && !samePose(p, prev_odom)) info_.corrected = true;
       prev_odom = p;
@@ -99,8 +100,8 @@ void CarmenReader::prescan() {
       const long n = parseInteger(f[1], where, "beam count");
       if (n >= 0 && f.size() >= static_cast<size_t>(n) + 9) {
         any_scan = true;
-        scan_pose = {parseNumber(f[static_cast<size_t>(n) + 2], where, "x"), parseNumber(f[static_cast<size_t>(n) + 3], where, "y"),
-                     parseNumber(f[static_cast<size_t>(n) + 4], where, "theta")};
+        scan_pose = {parseCoordinate(f[static_cast<size_t>(n) + 2], where, "x"), parseCoordinate(f[static_cast<size_t>(n) + 3], where, "y"),
+                     parseCoordinate(f[static_cast<size_t>(n) + 4], where, "theta")};
         after_scan = f[0] == "FLASER";
         const std::string& token = f[static_cast<size_t>(n) + 8];
         const double ts = parseNumber(token, where, "timestamp");
@@ -122,9 +123,7 @@ void CarmenReader::prescan() {
 void CarmenReader::handleParam(const std::vector<std::string>& f) {
   // Only the geometry we need; the many other PARAMs are robot/simulator settings.
   const auto num = [&](double& dst) {
-    char* end = nullptr;
-    const double v = std::strtod(f[2].c_str(), &end);
-    if (end != f[2].c_str() && std::isfinite(v)) dst = v;
+    if (const auto v = common::parseDecimal(f[2]); v && std::abs(*v) <= common::kMaxCoordinate) dst = *v;
   };
   if (f[1] == "robot_front_laser_max")
     num(info_.front_max_range_m);
@@ -242,7 +241,8 @@ bool CarmenReader::parseLine(const std::string& line) {
 void CarmenReader::handleOdom(const std::vector<std::string>& f, const std::string& where) {
   // ODOM x y theta tv rv accel timestamp hostname logger_timestamp
   if (f.size() < 8) throw InputError(where + ": truncated ODOM line (" + std::to_string(f.size()) + " fields, need 8)");
-  const Pose2 p{parseNumber(f[1], where, "x"), parseNumber(f[2], where, "y"), common::wrapToPi(parseNumber(f[3], where, "theta"))};
+  const Pose2 p{parseCoordinate(f[1], where, "x"), parseCoordinate(f[2], where, "y"),
+                common::wrapToPi(parseCoordinate(f[3], where, "theta"))};
   const double ts = lineStamp(f[7], where, false);
   const bool anchor = last_was_scan_ && samePose(p, last_scan_pose_);
   last_was_scan_ = false;
@@ -284,10 +284,10 @@ void CarmenReader::handleLaser(const std::vector<std::string>& f, const std::str
   scan.label = rear ? "RLASER" : "FLASER";
   scan.max_range_m = rear ? info_.rear_max_range_m : info_.front_max_range_m;
   detail::parseRanges(f, 2, nn, scan.max_range_m, where, scan.ranges, scan.valid);
-  const Pose2 pose{parseNumber(f[nn + 2], where, "x"), parseNumber(f[nn + 3], where, "y"),
-                   common::wrapToPi(parseNumber(f[nn + 4], where, "theta"))};
-  const Pose2 odom{parseNumber(f[nn + 5], where, "odom_x"), parseNumber(f[nn + 6], where, "odom_y"),
-                   common::wrapToPi(parseNumber(f[nn + 7], where, "odom_theta"))};
+  const Pose2 pose{parseCoordinate(f[nn + 2], where, "x"), parseCoordinate(f[nn + 3], where, "y"),
+                   common::wrapToPi(parseCoordinate(f[nn + 4], where, "theta"))};
+  const Pose2 odom{parseCoordinate(f[nn + 5], where, "odom_x"), parseCoordinate(f[nn + 6], where, "odom_y"),
+                   common::wrapToPi(parseCoordinate(f[nn + 7], where, "odom_theta"))};
   ++scans_;
   scan.timestamp = lineStamp(f[nn + 8], where, true);
   const Pose2 mount = rear ? Pose2{info_.rear_offset_m, 0, M_PI} : Pose2{info_.front_offset_m, 0, 0};
@@ -313,13 +313,14 @@ void CarmenReader::handleRobotLaser(const std::vector<std::string>& f, const std
   scan.label = "ROBOTLASER1";
   scan.max_range_m = parseNumber(f[5], where, "maximum_range");
   detail::parseRanges(f, 9, nn, scan.max_range_m, where, scan.ranges, scan.valid);
-  const Pose2 laser{parseNumber(f[k], where, "laser_x"), parseNumber(f[k + 1], where, "laser_y"),
-                    parseNumber(f[k + 2], where, "laser_theta")};
-  const Pose2 robot{parseNumber(f[k + 3], where, "robot_x"), parseNumber(f[k + 4], where, "robot_y"),
-                    common::wrapToPi(parseNumber(f[k + 5], where, "robot_theta"))};
+  const Pose2 laser{parseCoordinate(f[k], where, "laser_x"), parseCoordinate(f[k + 1], where, "laser_y"),
+                    parseCoordinate(f[k + 2], where, "laser_theta")};
+  const Pose2 robot{parseCoordinate(f[k + 3], where, "robot_x"), parseCoordinate(f[k + 4], where, "robot_y"),
+                    common::wrapToPi(parseCoordinate(f[k + 5], where, "robot_theta"))};
   ++scans_;
   scan.timestamp = lineStamp(f[k + 12], where, true);
-  setBeamGeometry(scan, parseNumber(f[2], where, "start_angle"), parseNumber(f[4], where, "resolution"), common::between(robot, laser));
+  setBeamGeometry(scan, parseCoordinate(f[2], where, "start_angle"), parseCoordinate(f[4], where, "resolution"),
+                  common::between(robot, laser));
   emitScan(std::move(scan), robot, robot);
   last_was_scan_ = true;
   last_scan_pose_ = robot;

@@ -10,6 +10,7 @@ namespace urbanslam::io {
 
 using common::InputError;
 using common::Pose2;
+using detail::parseCoordinate;
 using detail::parseInteger;
 using detail::parseNumber;
 
@@ -51,7 +52,8 @@ bool GfsReader::parseLine(const std::string& line) {
     if (r > 0) max_range_m_ = r;
   } else if (f[0] == "ODOM") {
     if (f.size() < 5) throw InputError(where + ": truncated ODOM line (" + std::to_string(f.size()) + " fields, need 5)");
-    const Pose2 p{parseNumber(f[1], where, "x"), parseNumber(f[2], where, "y"), common::wrapToPi(parseNumber(f[3], where, "theta"))};
+    const Pose2 p{parseCoordinate(f[1], where, "x"), parseCoordinate(f[2], where, "y"),
+                  common::wrapToPi(parseCoordinate(f[3], where, "theta"))};
     const double t = parseNumber(f[4], where, "timestamp");
     // This line's pose was measured at the previous line's time.
     if (!any_odometry_)
@@ -75,8 +77,8 @@ bool GfsReader::parseLine(const std::string& line) {
     detail::setBeamGeometry(scan, -M_PI / 2, detail::resolutionForBeams(n), Pose2{});
     scan.timestamp = parseNumber(f[nn + 5], where, "timestamp");
     // The scan's pose is the odometry at its time: it completes the held ODOM line of that time.
-    const Pose2 pose{parseNumber(f[nn + 2], where, "x"), parseNumber(f[nn + 3], where, "y"),
-                     common::wrapToPi(parseNumber(f[nn + 4], where, "theta"))};
+    const Pose2 pose{parseCoordinate(f[nn + 2], where, "x"), parseCoordinate(f[nn + 3], where, "y"),
+                     common::wrapToPi(parseCoordinate(f[nn + 4], where, "theta"))};
     emitOdometry(scan.timestamp, pose);
     if (have_held_ && held_time_ <= scan.timestamp) have_held_ = false;
     pending_.emplace_back(std::move(scan));

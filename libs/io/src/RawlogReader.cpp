@@ -14,9 +14,17 @@
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/serialization/CArchive.h>
 
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cstdio>
+#include <cstring>
 #include <deque>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
+#include "AllocationLimit.h"
 #include "MrptConversions.h"
 #include "TextScanner.h"
 #include "urbanslam/common/Error.h"
@@ -29,6 +37,7 @@ namespace fs = std::filesystem;
 namespace {
 
 // An MRPT read-only stream over our zlib reader, so we control truncation errors and progress.
+// It keeps the first bytes of each entry: the class name of the object being read, for errors.
 class GzMrptStream : public mrpt::io::CStream {
  public:
   explicit GzMrptStream(const std::string& path) : in_(detail::openGzFile(path)) {}
@@ -39,6 +48,9 @@ class GzMrptStream : public mrpt::io::CStream {
       if (k == 0) break;
       got += k;
     }
+    const size_t keep = std::min(got, head_.size() - std::min(head_.size(), static_cast<size_t>(pos_ - entry_start_)));
+    head_len_ = std::max<size_t>(head_len_, static_cast<size_t>(pos_ - entry_start_) + keep);
+    if (keep > 0) std::memcpy(head_.data() + (pos_ - entry_start_), buf, keep);
     pos_ += got;
     return got;
   }
@@ -48,10 +60,76 @@ class GzMrptStream : public mrpt::io::CStream {
   uint64_t getPosition() const override { return pos_; }
   double progress() const { return in_->progress(); }
 
+  void startEntry() {
+    entry_start_ = pos_;
+    head_len_ = 0;
+  }
+  // Class name of the entry's object as MRPT writes it (length | 0x80, then the name), or "".
+  std::string entryClass() const {
+    if (head_len_ < 1 || !(head_[0] & 0x80)) return {};
+    const size_t len = static_cast<unsigned char>(head_[0]) & 0x7f;
+    if (len == 0 || head_len_ < 1 + len) return {};
+    std::string name(head_.data() + 1, len);
+    for (char c : name)
+      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != ':') return {};
+    return name;
+  }
+
  private:
   std::unique_ptr<detail::ByteStream> in_;
-  uint64_t pos_ = 0;
+  uint64_t pos_ = 0, entry_start_ = 0;
+  std::array<char, 130> head_{};
+  size_t head_len_ = 0;
 };
+
+bool isGzipFile(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  char magic[2] = {0, 0};
+  f.read(magic, 2);
+  return f.gcount() == 2 && static_cast<unsigned char>(magic[0]) == 0x1f && static_cast<unsigned char>(magic[1]) == 0x8b;
+}
+
+// MRPT's messages are a banner, "Message: ...", the location and a backtrace, nested once per
+// layer that rethrew: the innermost "Message:" line names the cause ("unknown serialization
+// version number: '99'"). Bytes of a corrupt file that it quotes are shown as '?'.
+std::string mrptMessage(const std::string& what) {
+  std::istringstream in(what);
+  std::string line, first, innermost;
+  while (std::getline(in, line)) {
+    const bool message = line.rfind("Message:", 0) == 0;
+    if (message) line.erase(0, 8);
+    const auto b = line.find_first_not_of(" \t\r");
+    const auto e = line.find_last_not_of(" \t\r");
+    if (b == std::string::npos || line.compare(b, 4, "====") == 0 || line.compare(b, 5, "(====") == 0) continue;
+    line = line.substr(b, e - b + 1);
+    if (message) innermost = line;
+    if (first.empty()) first = line;
+  }
+  std::string out = innermost.empty() ? first : innermost;
+  if (out.empty()) out = "unreadable data";
+  if (out.size() > 200) out = out.substr(0, 200) + "...";
+  for (char& c : out)
+    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
+  return out;
+}
+
+// Bounds on what deserialising one entry may allocate (see AllocationLimit.h). The largest
+// single block a sane entry needs is an image or a point cloud of some MB (a 100 000-beam scan
+// is 0.9 MB, a 4K colour image 25 MB); in a plain file a block also cannot exceed the bytes left
+// to fill it (a few times that: MRPT widens some fields as it reads them).
+constexpr size_t kMaxBlockBytes = size_t{64} << 20;
+constexpr size_t kMaxEntryBytes = size_t{256} << 20;
+constexpr size_t kPlainSlackBytes = size_t{1} << 20;
+constexpr size_t kPlainExpansion = 4;
+
+std::string formatBytes(uint64_t n) {
+  char buf[48];
+  if (n >= (uint64_t{1} << 20))
+    std::snprintf(buf, sizeof buf, "%.1f MB", static_cast<double>(n) / (1 << 20));
+  else
+    std::snprintf(buf, sizeof buf, "%llu bytes", static_cast<unsigned long long>(n));
+  return buf;
+}
 
 }  // namespace
 
@@ -64,9 +142,23 @@ struct RawlogReader::Impl {
   common::Pose2 odom;  // chained from action increments
   bool ended = false;
 
-  explicit Impl(const std::string& p) : path(p), stream(p) {}
+  bool gzip = false;
+  uint64_t file_bytes = 0;
+
+  explicit Impl(const std::string& p) : path(p), stream(p) {
+    gzip = isGzipFile(p);
+    std::error_code ec;
+    file_bytes = fs::file_size(p, ec);
+  }
 
   std::string where() const { return path + ": entry " + std::to_string(entries); }
+
+  // The largest block the next entry may allocate: gzip hides how much data is left.
+  size_t maxBlockBytes() const {
+    if (gzip) return kMaxBlockBytes;
+    const uint64_t left = file_bytes > stream.getPosition() ? file_bytes - stream.getPosition() : 0;
+    return static_cast<size_t>(std::min<uint64_t>(kMaxBlockBytes, kPlainSlackBytes + kPlainExpansion * left));
+  }
 
   void addObservation(const mrpt::obs::CObservation::Ptr& obs) {
     using namespace mrpt::obs;
@@ -113,6 +205,23 @@ struct RawlogReader::Impl {
     auto arch = mrpt::serialization::archiveFrom(stream);
     mrpt::serialization::CSerializable::Ptr obj;
     const uint64_t before = stream.getPosition();
+    stream.startEntry();
+    const size_t max_block = maxBlockBytes();
+    detail::ScopedAllocationLimit limit(max_block, kMaxEntryBytes);
+    const auto object = [&] {
+      const std::string c = stream.entryClass();
+      return c.empty() ? std::string("its object") : "its " + c;
+    };
+    const auto refusal = [&] {
+      const size_t refused = limit.refusedBytes();
+      const uint64_t left = file_bytes > before ? file_bytes - before : 0;
+      const std::string why =
+          refused > max_block
+              ? "a block of " + formatBytes(refused) + " (limit " + formatBytes(max_block) +
+                    (gzip ? ", the most any sensor reading needs)" : ": the file has " + formatBytes(left) + " left)")
+              : formatBytes(limit.allocatedBytes() + refused) + " in all (limit " + formatBytes(kMaxEntryBytes) + " per entry)";
+      return InputError(where() + ": corrupt rawlog: " + object() + " declares " + why);
+    };
     try {
       obj = arch.ReadObject();
     } catch (const mrpt::serialization::CExceptionEOF&) {
@@ -123,11 +232,13 @@ struct RawlogReader::Impl {
     } catch (const InputError&) {
       throw;
     } catch (const std::exception& e) {
-      std::string msg = e.what();
-      if (const auto nl = msg.find('\n'); nl != std::string::npos) msg = msg.substr(0, nl);
+      if (limit.refusedBytes() > 0) throw refusal();
+      const std::string msg = mrptMessage(e.what());
       throw InputError(entries == 0 ? path + ": not an MRPT rawlog (" + msg + ")"
-                                    : where() + ": corrupt or truncated rawlog (" + msg + ")");
+                                    : where() + ": corrupt or truncated rawlog (" + object() + ": " + msg + ")");
     }
+    if (limit.refusedBytes() > 0) throw refusal();  // MRPT caught the refusal and read on
+    limit.end();                                    // the conversions below are ours, and bounded
     ++entries;
     using namespace mrpt::obs;
     if (auto sf = std::dynamic_pointer_cast<CSensoryFrame>(obj)) {

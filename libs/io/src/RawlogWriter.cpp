@@ -67,9 +67,11 @@ RawlogWriter::RawlogWriter(const std::string& path, RawlogLayout layout, int gz_
     : impl_(std::make_unique<Impl>()) {
   impl_->path = path;
   impl_->images = images;
+  common::removeStaleTemporaries(path);  // of writers that were killed
   if (images == ImageStorage::External) {
     const std::filesystem::path p(path);
     impl_->images_dir = (p.parent_path() / (p.stem().string() + "_Images")).string();
+    common::removeStaleTemporaries(impl_->images_dir);
     // A folder of its own until close(): an interrupted run leaves no images that look like a
     // finished run's, and a rerun never mixes its images with an earlier run's.
     impl_->images_temp = common::temporaryPathFor(impl_->images_dir);

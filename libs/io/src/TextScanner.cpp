@@ -3,13 +3,14 @@
 #include <zip.h>
 #include <zlib.h>
 
-#include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 
 #include "urbanslam/common/Error.h"
+#include "urbanslam/common/Numbers.h"
 
 namespace urbanslam::io::detail {
 
@@ -103,6 +104,12 @@ class ZipEntryStream : public ByteStream {
   uint64_t size_ = 0, done_ = 0;
 };
 
+std::string formatLimit(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
 }  // namespace
 
 std::unique_ptr<ByteStream> openGzFile(const std::string& path) { return std::make_unique<GzFileStream>(path); }
@@ -173,22 +180,22 @@ void splitFields(const std::string& line, std::vector<std::string>& fields) {
   }
 }
 
-double parseNumber(const std::string& field, const std::string& where, const char* what) {
-  errno = 0;
-  char* end = nullptr;
-  const double v = std::strtod(field.c_str(), &end);
-  if (field.empty() || end != field.c_str() + field.size()) throw InputError(where + ": " + what + " '" + field + "' is not a number");
-  if (!std::isfinite(v)) throw InputError(where + ": " + what + " is " + field + " (NaN or infinite)");
-  return v;
+double parseNumber(const std::string& field, const std::string& where, const char* what, double max_abs) {
+  const auto v = common::parseDecimal(field);
+  if (!v) throw InputError(where + ": " + what + " '" + field + "' is not a number (plain decimal; hex, inf and NaN are not accepted)");
+  if (std::abs(*v) > max_abs)
+    throw InputError(where + ": " + what + " " + field + " is out of range (|value| > " + formatLimit(max_abs) + ")");
+  return *v;
+}
+
+double parseCoordinate(const std::string& field, const std::string& where, const char* what) {
+  return parseNumber(field, where, what, common::kMaxCoordinate);
 }
 
 long parseInteger(const std::string& field, const std::string& where, const char* what) {
-  errno = 0;
-  char* end = nullptr;
-  const long v = std::strtol(field.c_str(), &end, 10);
-  if (field.empty() || end != field.c_str() + field.size() || errno == ERANGE)
-    throw InputError(where + ": " + what + " '" + field + "' is not a whole number");
-  return v;
+  const auto v = common::parseWholeNumber(field);
+  if (!v) throw InputError(where + ": " + what + " '" + field + "' is not a whole number");
+  return *v;
 }
 
 void parseRanges(const std::vector<std::string>& f, size_t first, size_t n, double max_range, const std::string& where,

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "urbanslam/common/Numbers.h"
+
 namespace urbanslam::io::detail {
 
 class ByteStream {
@@ -44,9 +46,11 @@ class TextScanner {
 
 // Splits a line on white space.
 void splitFields(const std::string& line, std::vector<std::string>& fields);
-// Strict numeric parsing: the whole field must be a finite number. Throws common::InputError
-// with "where: what".
-double parseNumber(const std::string& field, const std::string& where, const char* what);
+// Strict numeric parsing (common::parseDecimal: decimal only, finite). Throws
+// common::InputError with "where: what ..." for anything else or a value beyond max_abs.
+double parseNumber(const std::string& field, const std::string& where, const char* what, double max_abs = common::kMaxMagnitude);
+// A position (m) or an angle (rad): |value| <= common::kMaxCoordinate.
+double parseCoordinate(const std::string& field, const std::string& where, const char* what);
 long parseInteger(const std::string& field, const std::string& where, const char* what);
 
 // n laser ranges from fields[first..]: NaN, infinite and negative ranges are corrupt input (an

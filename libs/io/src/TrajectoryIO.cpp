@@ -1,4 +1,5 @@
 // TUM trajectories: the format evo, the TUM tools and Cartographer's evaluation read.
+#include <algorithm>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
@@ -11,7 +12,12 @@
 
 namespace urbanslam::io {
 
-void writeTum(const std::string& path, const std::vector<StampedPose>& poses) {
+void writeTum(const std::string& path, const std::vector<StampedPose>& unordered) {
+  // TUM files are read as time series (evo, the TUM tools, our eval interpolate in them), but
+  // logs are not always in time order: the Intel log holds scans whose time is earlier than the
+  // scan before them. Every pose is kept (they are all estimates); equal times keep their order.
+  std::vector<StampedPose> poses = unordered;
+  std::stable_sort(poses.begin(), poses.end(), [](const StampedPose& a, const StampedPose& b) { return a.timestamp < b.timestamp; });
   common::AtomicFile f(path);
   auto& os = f.stream();
   os << "# timestamp x y z qx qy qz qw\n";
@@ -35,7 +41,8 @@ std::vector<StampedPose> readTum(const std::string& path) {
     const std::string where = path + ":" + std::to_string(t.lineNumber());
     if (f.size() != 8) throw common::InputError(where + ": expected 8 fields (timestamp x y z qx qy qz qw)");
     double v[8];
-    for (int i = 0; i < 8; ++i) v[i] = detail::parseNumber(f[static_cast<size_t>(i)], where, "value");
+    v[0] = detail::parseNumber(f[0], where, "timestamp");
+    for (size_t i = 1; i < 8; ++i) v[i] = detail::parseCoordinate(f[i], where, i < 4 ? "position" : "quaternion component");
     // Yaw of a general quaternion (the 2D part of a 3D trajectory).
     const double qx = v[4], qy = v[5], qz = v[6], qw = v[7];
     const double yaw = std::atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz));

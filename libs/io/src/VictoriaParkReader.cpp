@@ -74,16 +74,16 @@ struct VictoriaParkReader::Impl {
     next_drs.reset();
     if (!readFields(*drs, 3, "DRS")) return;
     const std::string where = drs->name() + ":" + std::to_string(drs->lineNumber());
-    next_drs = DriveReading{detail::parseNumber(fields[0], where, "time"), detail::parseNumber(fields[1], where, "speed"),
-                            detail::parseNumber(fields[2], where, "steering")};
+    next_drs = DriveReading{detail::parseNumber(fields[0], where, "time"), detail::parseCoordinate(fields[1], where, "speed"),
+                            detail::parseCoordinate(fields[2], where, "steering")};
   }
 
   void readGps() {
     next_gps.reset();
     if (!readFields(*gps, 3, "GPS")) return;
     const std::string where = gps->name() + ":" + std::to_string(gps->lineNumber());
-    next_gps = GpsFix{detail::parseNumber(fields[0], where, "time"), detail::parseNumber(fields[2], where, "x"),
-                      detail::parseNumber(fields[1], where, "y")};
+    next_gps = GpsFix{detail::parseNumber(fields[0], where, "time"), detail::parseCoordinate(fields[2], where, "x"),
+                      detail::parseCoordinate(fields[1], where, "y")};
   }
 };
 

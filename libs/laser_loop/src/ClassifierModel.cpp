@@ -9,6 +9,7 @@
 
 #include "urbanslam/common/AtomicFile.h"
 #include "urbanslam/common/Error.h"
+#include "urbanslam/common/Numbers.h"
 
 namespace urbanslam::laser_loop {
 
@@ -35,11 +36,10 @@ class Parser {
     throw common::InputError(source_ + ":" + std::to_string(line) + ": " + msg);
   }
   double number(const std::string& s, size_t line, const std::string& what) const {
-    errno = 0;
-    char* end = nullptr;
-    const double v = std::strtod(s.c_str(), &end);
-    if (s.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(v)) fail(line, what + ": '" + s + "' is not a finite number");
-    return v;
+    const auto v = common::parseDecimal(s);
+    if (!v) fail(line, what + ": '" + s + "' is not a finite number");
+    if (std::abs(*v) > common::kMaxMagnitude) fail(line, what + ": " + s + " is out of range (|value| > 1e12)");
+    return *v;
   }
   long integer(const std::string& s, size_t line, const std::string& what) const {
     const double v = number(s, line, what);

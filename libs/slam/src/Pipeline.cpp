@@ -4,8 +4,10 @@
 #include <cmath>
 #include <sstream>
 
+#include "urbanslam/common/Error.h"
 #include "urbanslam/common/Timing.h"
 #include "urbanslam/esdf/Esdf.h"
+#include "urbanslam/esdf/Recovery.h"
 #include "urbanslam/vision_loop/LoopDetector.h"
 
 namespace urbanslam::slam {
@@ -73,7 +75,18 @@ bool Pipeline::step(io::DataSource& source) {
   // Processing time (reading included) accumulates here, so a paused GUI run reports the same
   // real-time factor as a batch run.
   common::Stopwatch sw;
-  const bool more = stepOnce(source);
+  bool more = false;
+  try {
+    more = stepOnce(source);
+  } catch (const esdf::NotPositiveDefinite& e) {
+    // Values that are each in range can still be too extreme together for the filter's
+    // arithmetic (an odometry jump of thousands of km): that is the log's fault, not a bug.
+    std::ostringstream where;
+    where.precision(15);
+    where << source.path() << ": measurement " << stats_.measurements << " (t = " << stats_.last_timestamp << " s)";
+    throw common::InputError(where.str() + ": the filter's " + e.what() +
+                             " after it (a pose, odometry or range far out of line with the rest of the log?)");
+  }
   stats_.wall_s += sw.seconds();
   return more;
 }
@@ -113,7 +126,12 @@ bool Pipeline::stepOnce(io::DataSource& source) {
 void Pipeline::run(io::DataSource& source) {
   while (step(source)) {
   }
-  finish();
+  try {
+    finish();
+  } catch (const esdf::NotPositiveDefinite& e) {
+    throw common::InputError(source.path() + ": the filter's " + e.what() +
+                             " at the end of the log (a pose, odometry or range far out of line with the rest?)");
+  }
 }
 
 void Pipeline::finish() {

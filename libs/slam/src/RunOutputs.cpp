@@ -2,8 +2,10 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 
 #include "urbanslam/common/AtomicFile.h"
+#include "urbanslam/common/AtomicFolder.h"
 #include "urbanslam/common/Error.h"
 #include "urbanslam/common/Timing.h"
 #include "urbanslam/esdf/PoseGraphIO.h"
@@ -15,16 +17,24 @@ namespace fs = std::filesystem;
 
 namespace {
 
-void ensureWritableDir(const std::string& dir) {
+constexpr const char* kConfigHeader = "// Resolved configuration of this run";
+
+// Whether an existing folder may be replaced by a new run's outputs: it is empty or holds an
+// earlier run (its config.ini says so; extra files a bench added belong to that run). Anything
+// else may be a user's folder, and is never deleted.
+bool isRunFolder(const std::string& dir) {
   std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir)) throw common::InputError(dir + ": cannot create the output folder");
-  const fs::path probe = fs::path(dir) / ".urbanslam-write-test";
-  {
-    std::ofstream f(probe);
-    if (!f) throw common::InputError(dir + ": output folder is not writable");
+  if (fs::is_empty(dir, ec) && !ec) return true;
+  std::ifstream config(fs::path(dir) / "config.ini");
+  std::string first;
+  std::getline(config, first);
+  if (first.rfind(kConfigHeader, 0) == 0) return true;
+  // A folder an interrupted run (or a killed writer) left with only its hidden temporaries.
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name != ".urbanslam-write-test" && (name.empty() || name[0] != '.' || name.find(".partial-") == std::string::npos)) return false;
   }
-  fs::remove(probe, ec);
+  return !ec;
 }
 
 }  // namespace
@@ -39,15 +49,17 @@ void writePoseGraphG2o(const Pipeline& p, const std::string& path) {
 
 common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const RunInfo& info) {
   using common::Json;
-  ensureWritableDir(dir);
-  const auto path = [&](const std::string& name) { return (fs::path(dir) / name).string(); };
+  // Everything goes into a staging folder that replaces `dir` at the end in one step: a run
+  // folder never mixes two runs, and one killed while writing leaves the earlier run intact.
+  common::AtomicFolder folder(dir, isRunFolder);
+  const auto path = [&](const std::string& name) { return (fs::path(folder.stagingPath()) / name).string(); };
   const PipelineOptions& o = p.options();
   common::Stopwatch sw;
 
   // config.ini first: whoever looks at the outputs can see how they were made.
   {
     common::AtomicFile f(path("config.ini"));
-    f.stream() << "// Resolved configuration of this run (input: " << info.input_path
+    f.stream() << kConfigHeader << " (input: " << info.input_path
                << ", ini: " << (info.ini_path.empty() ? "built-in defaults" : info.ini_path) << ")\n"
                << info.resolved_ini;
     f.commit();
@@ -167,6 +179,7 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   common::AtomicFile f(path("stats.json"));
   f.stream() << j.dump(2) << "\n";
   f.commit();
+  folder.commit();
   return j;
 }
 

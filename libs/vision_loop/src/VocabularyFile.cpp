@@ -1,6 +1,7 @@
 #include "urbanslam/vision_loop/VocabularyFile.h"
 
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <vector>
 
@@ -165,6 +166,18 @@ Vocabulary loadVocabulary(const std::string& path) {
     throw common::InputError(path + ": corrupt vocabulary header (" + std::to_string(nodes) + " nodes, " + std::to_string(words) +
                              " words)");
   const size_t bytes = static_cast<size_t>(descriptorBytes(d.type));
+  // The arrays the header declares must fill the file exactly: checked before allocating them,
+  // so a corrupt count is this error and not gigabytes of zeroed memory.
+  const uint64_t per_node = sizeof(d.first_child[0]) + sizeof(d.child_count[0]) + sizeof(d.word_of_node[0]) + bytes * sizeof(d.centres[0]) +
+                            (d.type == DescriptorType::Sift ? sizeof(d.inverse_norms[0]) : 0);
+  const uint64_t per_word = sizeof(d.node_of_word[0]) + sizeof(d.idf[0]);
+  const uint64_t declared = static_cast<uint64_t>(in.tellg()) + nodes * per_node + words * per_word + sizeof(uint64_t);
+  std::error_code ec;
+  const uint64_t actual = std::filesystem::file_size(path, ec);
+  if (!ec && declared != actual)
+    throw common::InputError(path + ": vocabulary file is " + (declared > actual ? "truncated" : "corrupt") + ": its header declares " +
+                             std::to_string(nodes) + " nodes and " + std::to_string(words) + " words (" + std::to_string(declared) +
+                             " bytes), the file has " + std::to_string(actual) + " bytes");
   r.array(d.first_child, nodes, "child indices");
   r.array(d.child_count, nodes, "child counts");
   r.array(d.word_of_node, nodes, "node words");

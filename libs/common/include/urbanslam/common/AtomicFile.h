@@ -34,4 +34,11 @@ void writeAtomically(const std::string& path, const std::function<void(const std
 // Temporary name for `path`: same folder, same extension, unique per process.
 std::string temporaryPathFor(const std::string& path);
 
+// Removes the temporaries that killed processes left for `path` (".name.partial-PID.ext" whose
+// process no longer exists; folders too). Those of live processes are left alone.
+void removeStaleTemporaries(const std::string& path);
+
+// True while a process with this id exists.
+bool processAlive(long pid);
+
 }  // namespace urbanslam::common

@@ -21,12 +21,14 @@ struct PoseGraphEdge {
   long from, to;
   Vec3 measurement;  // pose of `to` in the frame of `from`
   Mat3 information;  // in (x, y, phi) order, symmetric
+  long line = 0;     // of the file it was read from (0: not read from a file)
 };
 
 struct PoseGraph {
   std::vector<PoseGraphVertex> vertices;  // may be empty (edges-only files)
   std::vector<PoseGraphEdge> edges;
   PoseGraphFormat format = PoseGraphFormat::G2o;  // format of the file it was read from
+  std::string name = "pose graph";                // the file it was read from, for messages
 };
 
 PoseGraph readPoseGraph(const std::string& path);

@@ -7,10 +7,19 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
+#include <stdexcept>
 
 #include "urbanslam/esdf/InformationState.h"
 
 namespace urbanslam::esdf {
+
+// Lambda (or the factorised block of it) is not numerically positive definite: the information
+// added so far is inconsistent or too extreme for double precision. Callers that fed the filter
+// from a file turn it into an error naming the measurement.
+class NotPositiveDefinite : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 enum class FillReducingOrdering {
   Amd,     // approximate minimum degree
@@ -26,7 +35,7 @@ class SparseCholesky {
   SparseCholesky(const SparseCholesky&) = delete;
   SparseCholesky& operator=(const SparseCholesky&) = delete;
 
-  // Factorises Lambda restricted to poses [first, last). Throws std::runtime_error when the
+  // Factorises Lambda restricted to poses [first, last). Throws NotPositiveDefinite when the
   // block is not positive definite (an unanchored or inconsistent problem).
   void factorize(const InformationState& state, int first, int last);
   bool valid() const;

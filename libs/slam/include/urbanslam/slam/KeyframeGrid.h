@@ -2,6 +2,7 @@
 // The map's spatial index: a uniform grid over keyframe positions, so the keyframes near a pose
 // (the loop-closure candidates' initial set) are found in constant time however large the map.
 #include <cstddef>
+#include <cstdint>
 #include <unordered_map>
 #include <vector>
 
@@ -13,12 +14,19 @@ class KeyframeGrid {
   void clear() { cells_.clear(); }
   void insert(size_t index, double x, double y);
   // Indices of keyframes whose cell lies within `radius` of (x, y) (a superset of the disk).
+  // Costs at most the number of occupied cells, however large the radius.
   void query(double x, double y, double radius, std::vector<size_t>& out) const;
 
  private:
-  long long key(long cx, long cy) const { return (static_cast<long long>(cx) << 32) ^ (cy & 0xffffffffLL); }
+  // Cell indices are clamped to +-2^30 so that any double (huge, infinite, NaN) has a cell and a
+  // key: positions that far out share the border cells, which only costs the index precision.
+  static constexpr int64_t kMaxCell = int64_t{1} << 30;
+  int64_t cell(double v) const;
+  static uint64_t key(int64_t cx, int64_t cy) {
+    return (static_cast<uint64_t>(cx + kMaxCell) << 32) | static_cast<uint64_t>(cy + kMaxCell);
+  }
   double cell_m_;
-  std::unordered_map<long long, std::vector<size_t>> cells_;
+  std::unordered_map<uint64_t, std::vector<size_t>> cells_;
 };
 
 }  // namespace urbanslam::slam

@@ -1,7 +1,9 @@
 #pragma once
 // Writes everything `urbanslam run` produces into one folder: trajectories (TUM), map point
-// clouds, .simplemap, occupancy grid, stats.json and the resolved config.ini. Each file is
-// written atomically; stats.json comes last, so its presence marks a complete run.
+// clouds, .simplemap, occupancy grid, stats.json and the resolved config.ini. The folder is
+// replaced as a whole (common::AtomicFolder): it appears complete, holding one run, or not at
+// all; an existing folder that is neither empty nor a run's is refused (InputError), never
+// deleted. stats.json still comes last.
 #include <string>
 
 #include "urbanslam/common/Json.h"
