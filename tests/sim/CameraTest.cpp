@@ -13,9 +13,12 @@
 #include "urbanslam/sim/CityModel.h"
 #include "urbanslam/sim/Driver.h"
 #include "urbanslam/sim/SurfaceTexture.h"
+#include "StreetViews.h"
 
 using namespace urbanslam;
 using namespace urbanslam::sim;
+using test::city1km;
+using test::streetView;
 
 namespace {
 
@@ -57,25 +60,6 @@ SurfaceLook darkWall(double height) {
     const SurfaceTexture t({id, SurfaceKind::Featureless, static_cast<float>(height)});
     if (t.sample(0.5, 2.0) < 74) return {id, SurfaceKind::Featureless, static_cast<float>(height)};
   }
-}
-
-CityOptions city1km() {
-  CityOptions o;
-  o.seed = 1;
-  o.area_km2 = 1.0;
-  return o;
-}
-
-// Camera pose on the drive of a 1 km2 city after t seconds, looking left (as ini/city-camera.ini).
-common::Pose2 streetView(const StreetGrid& grid, double t, double forward_m = 0) {
-  SimOptions o;
-  o.city = grid.options();
-  Driver driver(grid, o);
-  driver.advanceTo(t);
-  common::Pose2 p = driver.state().pose;
-  p.x += forward_m * std::cos(p.phi);
-  p.y += forward_m * std::sin(p.phi);
-  return common::compose(p, {1.0, 0.0, M_PI / 2});
 }
 
 }  // namespace

@@ -5,9 +5,9 @@
 
 namespace urbanslam::vision_loop {
 
-VerificationResult verifyPair(const ImageFeatures& a, const ImageFeatures& b, DescriptorType type, const VerificationOptions& options) {
-  VerificationResult r;
-  if (a.descriptors.rows < 2 || b.descriptors.rows < 2) return r;
+PointMatches matchFeatures(const ImageFeatures& a, const ImageFeatures& b, DescriptorType type, double ratio) {
+  PointMatches out;
+  if (a.descriptors.rows < 2 || b.descriptors.rows < 2) return out;
   cv::Mat da = a.descriptors, db = b.descriptors;
   int norm = cv::NORM_HAMMING;
   if (type == DescriptorType::Sift) {
@@ -23,16 +23,22 @@ VerificationResult verifyPair(const ImageFeatures& a, const ImageFeatures& b, De
   std::vector<int> best_for_b(db.rows, -1);
   std::vector<float> best_dist(db.rows, 0.f);
   for (const auto& m : knn) {
-    if (m.size() < 2 || m[0].distance >= options.ratio * m[1].distance) continue;
+    if (m.size() < 2 || m[0].distance >= ratio * m[1].distance) continue;
     const int j = m[0].trainIdx;
     if (best_for_b[j] < 0 || m[0].distance < best_dist[j]) best_for_b[j] = m[0].queryIdx, best_dist[j] = m[0].distance;
   }
-  std::vector<cv::Point2f> pa, pb;
   for (int j = 0; j < db.rows; ++j) {
     if (best_for_b[j] < 0) continue;
-    pa.push_back(a.keypoints[best_for_b[j]].pt);
-    pb.push_back(b.keypoints[j].pt);
+    out.a.push_back(a.keypoints[best_for_b[j]].pt);
+    out.b.push_back(b.keypoints[j].pt);
   }
+  return out;
+}
+
+VerificationResult verifyPair(const ImageFeatures& a, const ImageFeatures& b, DescriptorType type, const VerificationOptions& options) {
+  VerificationResult r;
+  const PointMatches m = matchFeatures(a, b, type, options.ratio);
+  const std::vector<cv::Point2f>&pa = m.a, &pb = m.b;
   r.matches = static_cast<int>(pa.size());
   if (r.matches < 8 || r.matches < options.min_inliers) return r;
   std::vector<uchar> mask;

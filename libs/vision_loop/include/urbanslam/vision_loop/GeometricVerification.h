@@ -23,6 +23,13 @@ struct VerificationResult {
   int inliers = 0;  // of the fundamental matrix
 };
 
+// Descriptor matches of a to b that pass Lowe's ratio test, each feature of b kept at most once
+// (its best), as pixel positions in each image.
+struct PointMatches {
+  std::vector<cv::Point2f> a, b;
+};
+PointMatches matchFeatures(const ImageFeatures& a, const ImageFeatures& b, DescriptorType type, double ratio);
+
 VerificationResult verifyPair(const ImageFeatures& a, const ImageFeatures& b, DescriptorType type, const VerificationOptions& options = {});
 
 }  // namespace urbanslam::vision_loop

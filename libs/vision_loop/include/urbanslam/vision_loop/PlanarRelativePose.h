@@ -1,0 +1,48 @@
+#pragma once
+// The relative pose of two images of a calibrated, level camera on a ground vehicle, reduced to
+// the plane: matched features -> essential matrix (five-point RANSAC, OpenCV) -> rotation and
+// the direction of the translation -> the heading change and the bearing of the second camera
+// seen from the first. A single camera cannot see the length of the translation; the filter
+// takes that from the odometry (esdf/BearingHeading.h).
+//
+// The covariance of (bearing, heading) is estimated by resampling the inliers (bootstrap): the
+// spread of the estimates from resampled correspondence sets, which follows the inliers'
+// residuals and their layout in the image (few, clustered or distant points give a wide spread).
+#include <string>
+
+#include <Eigen/Core>
+
+#include "urbanslam/vision_loop/FeatureExtractor.h"
+
+namespace urbanslam::vision_loop {
+
+struct PinholeCamera {
+  double fx = 500, fy = 500, cx = 320, cy = 240;  // pixels
+};
+
+struct PlanarRelativePoseOptions {
+  double ratio = 0.8;                // Lowe's ratio test
+  double ransac_threshold_px = 1.0;  // distance to the epipolar line of an inlier
+  double ransac_confidence = 0.999;
+  int min_inliers = 20;
+  int bootstrap_samples = 40;  // resampled inlier sets for the covariance
+  unsigned seed = 1;           // of the resampling (the result is reproducible)
+};
+
+struct PlanarRelativePose {
+  bool valid = false;
+  std::string failure_reason;
+  double bearing_rad = 0;  // direction of camera b's position in camera a's frame (x forward, y left, counter-clockwise)
+  double heading_rad = 0;  // heading of camera b minus heading of camera a (counter-clockwise)
+  Eigen::Matrix2d cov = Eigen::Matrix2d::Identity();  // of (bearing, heading)
+  int matches = 0, inliers = 0;
+};
+
+// From pixel correspondences (point i of `a` and of `b` are one feature).
+PlanarRelativePose planarRelativePose(const std::vector<cv::Point2f>& a, const std::vector<cv::Point2f>& b, const PinholeCamera& camera,
+                                      const PlanarRelativePoseOptions& options = {});
+// From the two images' features (ratio-test matches first).
+PlanarRelativePose planarRelativePose(const ImageFeatures& a, const ImageFeatures& b, DescriptorType type, const PinholeCamera& camera,
+                                      const PlanarRelativePoseOptions& options = {});
+
+}  // namespace urbanslam::vision_loop
