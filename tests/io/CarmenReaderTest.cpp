@@ -259,3 +259,34 @@ TEST(CarmenReader, FixedPointTimesKeepTheirOwnStep) {
   EXPECT_NEAR(r.odometry[1].timestamp, 5.2475, 1e-9);
   EXPECT_NEAR(r.odometry[2].timestamp, 5.2525, 1e-9);
 }
+
+// ROBOTLASER1 as CARMEN's logger writes it: after the remissions, the laser and robot poses and
+// tv rv forward_safety_dist side_safety_dist turn_axis, then timestamp, hostname, logger time.
+TEST(CarmenReader, RobotLaserCarriesItsGeometryAndMount) {
+  const std::string line =
+      "ROBOTLASER1 0 -2.0 4.0 0.5 30.0 0.01 0 9 1 2 3 4 30 6 7 8 9 0 "
+      "1.2 2.1 0.8 1.0 2.0 0.3 0 0 0 0 0 12.345678 host 12.345678\n";
+  io::CarmenReader reader(writeText("robotlaser", line));
+  const ReadBack r = readAll(reader);
+  ASSERT_EQ(r.scans.size(), 1u);
+  const auto& s = r.scans[0];
+  EXPECT_EQ(s.label, "ROBOTLASER1");
+  EXPECT_DOUBLE_EQ(s.timestamp, 12.345678);
+  EXPECT_EQ(s.size(), 9u);
+  EXPECT_EQ(s.validCount(), 8u);  // the 30 m reading is the sensor's maximum: no return
+  EXPECT_NEAR(s.angle_increment_rad, 0.5, 1e-12);
+  // Beam 0 points at start_angle in the laser frame; the laser sits at robot^-1 * laser pose.
+  const Pose2 mount = common::between(Pose2{1.0, 2.0, 0.3}, Pose2{1.2, 2.1, 0.8});
+  EXPECT_NEAR(s.sensor_pose.x, mount.x, 1e-12);
+  EXPECT_NEAR(s.sensor_pose.y, mount.y, 1e-12);
+  EXPECT_NEAR(common::wrapToPi(s.sensor_pose.phi + s.bearing(0) - (0.5 - 2.0)), 0, 1e-12);
+  ASSERT_EQ(r.odometry.size(), 1u);  // no ODOM lines: the robot pose is the odometry
+  EXPECT_NEAR(r.odometry[0].pose.phi, 0.3, 1e-12);
+  try {
+    io::CarmenReader short_reader(writeText("robotlaser_short", line.substr(0, line.find(" host"))));
+    readAll(short_reader);
+    ADD_FAILURE() << "a ROBOTLASER1 line without hostname and logger time was read";
+  } catch (const common::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("truncated ROBOTLASER1"), std::string::npos) << e.what();
+  }
+}

@@ -80,6 +80,18 @@ void CarmenReader::prescan() {
   double last_scan_ts = -1;
   Pose2 scan_pose, prev_odom;
   bool have_prev_odom = false;
+  // Front and rear scans of one instant legitimately share a time: only front scans count repeats.
+  const auto noteScanStamp = [&](const std::string& token, const std::string& where, bool front) {
+    any_scan = true;
+    const double ts = parseNumber(token, where, "timestamp");
+    if (ts != 0) any_ts = true;
+    noteStampFormat(token);
+    if (front) {
+      repeated_ts += ts == last_scan_ts ? 1 : 0;
+      last_scan_ts = ts;
+      ++scans_seen;
+    }
+  };
   for (int k = 0; k < 50000 && t.nextLine(line); ++k) {
     detail::splitFields(line, f);
     if (f.empty()) continue;
@@ -99,18 +111,23 @@ void CarmenReader::prescan() {
     if ((f[0] == "FLASER" || f[0] == "RLASER") && f.size() >= 2) {
       const long n = parseInteger(f[1], where, "beam count");
       if (n >= 0 && f.size() >= static_cast<size_t>(n) + 9) {
-        any_scan = true;
         scan_pose = {parseCoordinate(f[static_cast<size_t>(n) + 2], where, "x"), parseCoordinate(f[static_cast<size_t>(n) + 3], where, "y"),
                      parseCoordinate(f[static_cast<size_t>(n) + 4], where, "theta")};
         after_scan = f[0] == "FLASER";
-        const std::string& token = f[static_cast<size_t>(n) + 8];
-        const double ts = parseNumber(token, where, "timestamp");
-        if (ts != 0) any_ts = true;
-        noteStampFormat(token);
-        if (f[0] == "FLASER") {  // front and rear scans of one instant legitimately share a time
-          repeated_ts += ts == last_scan_ts ? 1 : 0;
-          last_scan_ts = ts;
-          ++scans_seen;
+        noteScanStamp(f[static_cast<size_t>(n) + 8], where, f[0] == "FLASER");
+      }
+    }
+    // ROBOTLASER1 type start fov res max acc mode n r1..rn m rem1..remm laser(3) robot(3) 5 more, time
+    if (f[0] == "ROBOTLASER1" && f.size() >= 9) {
+      const long n = parseInteger(f[8], where, "beam count");
+      if (n >= 0 && f.size() >= static_cast<size_t>(n) + 10) {
+        const long m = parseInteger(f[9 + static_cast<size_t>(n)], where, "remission count");
+        const size_t k = 10 + static_cast<size_t>(n) + static_cast<size_t>(std::max(m, 0L));
+        if (m >= 0 && f.size() >= k + 14) {
+          scan_pose = {parseCoordinate(f[k + 3], where, "robot_x"), parseCoordinate(f[k + 4], where, "robot_y"),
+                       parseCoordinate(f[k + 5], where, "robot_theta")};
+          after_scan = true;
+          noteScanStamp(f[k + 11], where, true);
         }
       }
     }
@@ -307,7 +324,9 @@ void CarmenReader::handleRobotLaser(const std::vector<std::string>& f, const std
   const size_t nn = static_cast<size_t>(n);
   if (f.size() < 9 + nn + 1) throw InputError(where + ": truncated ROBOTLASER1 line");
   const long m = parseInteger(f[9 + nn], where, "remission count");
-  if (m < 0 || f.size() < 10 + nn + static_cast<size_t>(m) + 13) throw InputError(where + ": truncated ROBOTLASER1 line");
+  // Eleven numbers follow the remissions (laser pose, robot pose, tv rv fwd side turn), then the
+  // timestamp, hostname and logger timestamp.
+  if (m < 0 || f.size() < 10 + nn + static_cast<size_t>(m) + 14) throw InputError(where + ": truncated ROBOTLASER1 line");
   const size_t k = 10 + nn + static_cast<size_t>(m);
   LaserScan scan;
   scan.label = "ROBOTLASER1";
@@ -318,7 +337,7 @@ void CarmenReader::handleRobotLaser(const std::vector<std::string>& f, const std
   const Pose2 robot{parseCoordinate(f[k + 3], where, "robot_x"), parseCoordinate(f[k + 4], where, "robot_y"),
                     common::wrapToPi(parseCoordinate(f[k + 5], where, "robot_theta"))};
   ++scans_;
-  scan.timestamp = lineStamp(f[k + 12], where, true);
+  scan.timestamp = lineStamp(f[k + 11], where, true);
   setBeamGeometry(scan, parseCoordinate(f[2], where, "start_angle"), parseCoordinate(f[4], where, "resolution"),
                   common::between(robot, laser));
   emitScan(std::move(scan), robot, robot);
