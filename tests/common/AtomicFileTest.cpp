@@ -5,18 +5,14 @@
 #include <stdexcept>
 
 #include "urbanslam/common/AtomicFile.h"
+#include "TestPaths.h"
 #include "urbanslam/common/Error.h"
 
 namespace fs = std::filesystem;
 using namespace urbanslam::common;
 
 namespace {
-fs::path freshDir(const char* name) {
-  const fs::path d = fs::path(URBANSLAM_BINARY_DIR) / "test_tmp" / name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path freshDir(const char* name) { return urbanslam::test::scratchDir(name); }
 }  // namespace
 
 TEST(AtomicFile, NothingVisibleUntilCommit) {

@@ -7,6 +7,7 @@
 
 #include "urbanslam/common/AtomicFile.h"
 #include "urbanslam/common/AtomicFolder.h"
+#include "TestPaths.h"
 #include "urbanslam/common/Error.h"
 
 namespace fs = std::filesystem;
@@ -14,12 +15,7 @@ using namespace urbanslam::common;
 
 namespace {
 
-fs::path freshDir(const char* name) {
-  const fs::path d = fs::path(URBANSLAM_BINARY_DIR) / "test_tmp" / name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path freshDir(const char* name) { return urbanslam::test::scratchDir(name); }
 
 void touch(const fs::path& p, const std::string& text = "x") { std::ofstream(p) << text; }
 

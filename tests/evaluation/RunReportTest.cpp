@@ -7,12 +7,15 @@
 #include <filesystem>
 #include <fstream>
 
+#include "TestPaths.h"
 #include "urbanslam/common/Error.h"
 #include "urbanslam/evaluation/RunReport.h"
 #include "urbanslam/io/MapOutputs.h"
 
 namespace urbanslam::evaluation {
 namespace {
+
+namespace test = urbanslam::test;
 
 namespace fs = std::filesystem;
 
@@ -32,9 +35,7 @@ std::vector<io::StampedPose> square(const common::Pose2& frame) {
 }
 
 fs::path runFolder(const std::string& name, const std::vector<io::StampedPose>& poses) {
-  const fs::path dir = fs::temp_directory_path() / ("urbanslam_runreport_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = test::scratchDir("runreport_" + name);
   io::writeTum((dir / "trajectory_odometry.tum").string(), poses);
   io::writeTum((dir / "trajectory_scans.tum").string(), poses);
   return dir;
