@@ -1,10 +1,8 @@
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
-#include <memory>
 #include <set>
 
 #include "TestPaths.h"
@@ -41,7 +39,6 @@ TEST(DeadReckoningPipeline, KeyframesSitAtTheOdometryOfTheirTime) {
   o.estimator.type = slam::EstimatorOptions::Type::DeadReckoning;
   o.local.scan_matching = false;
   o.keyframes.min_translation_m = 0.3;
-  o.keyframes.min_translation_range_fraction = 0;
   o.keyframes.min_rotation_deg = 15;
   slam::Pipeline p(o);
   CountingObserver obs;
@@ -65,38 +62,6 @@ TEST(DeadReckoningPipeline, KeyframesSitAtTheOdometryOfTheirTime) {
     EXPECT_TRUE(std::hypot(d.x, d.y) >= 0.3 || std::abs(d.phi) >= 15 * M_PI / 180) << "keyframe " << i;
   }
   EXPECT_EQ(p.referenceTrajectory().size(), 80u);
-}
-
-// The travel between keyframes scales with how far the scans see: at least the fraction of the
-// new keyframe's median range (computed here from its returns), unless it turned enough.
-TEST(DeadReckoningPipeline, KeyframeSpacingFollowsTheViewsDepth) {
-  const auto run = [](double fraction) {
-    slam::PipelineOptions o;
-    o.estimator.type = slam::EstimatorOptions::Type::DeadReckoning;
-    o.local.scan_matching = false;
-    o.keyframes.min_translation_m = 0.1;
-    o.keyframes.min_translation_range_fraction = fraction;
-    o.keyframes.min_rotation_deg = 30;
-    auto p = std::make_unique<slam::Pipeline>(o);
-    auto src = io::openDataSource(kExcerpt);
-    p->run(*src);
-    return p;
-  };
-  const auto near = run(0.0), far = run(0.5);
-  ASSERT_GT(near->keyframes().size(), 15u);
-  EXPECT_LT(far->keyframes().size(), near->keyframes().size());
-  for (size_t i = 1; i < far->keyframes().size(); ++i) {
-    const auto& k = far->keyframes()[i];
-    std::vector<float> r;
-    for (size_t b = 0; b < k.scan.size(); ++b)
-      if (k.scan.valid[b]) r.push_back(k.scan.ranges[b]);
-    ASSERT_FALSE(r.empty());
-    std::sort(r.begin(), r.end());
-    const double median = r[r.size() / 2];
-    const auto d = common::between(far->keyframes()[i - 1].pose, k.pose);
-    EXPECT_TRUE(std::hypot(d.x, d.y) >= 0.5 * median - 1e-9 || std::abs(d.phi) >= 30 * M_PI / 180)
-        << "keyframe " << i << ": " << std::hypot(d.x, d.y) << " m, median range " << median << " m";
-  }
 }
 
 TEST(DeadReckoningPipeline, LaserLabelsSelectSensors) {
@@ -190,7 +155,6 @@ TEST(DeadReckoningPipeline, ReadingsSharingAScanTimeGiveTheScanPose) {
   o.estimator.type = slam::EstimatorOptions::Type::DeadReckoning;
   o.local.scan_matching = false;
   o.keyframes.min_translation_m = 0.5;
-  o.keyframes.min_translation_range_fraction = 0;
   slam::Pipeline p(o);
   auto src = io::openDataSource(log);
   p.run(*src);

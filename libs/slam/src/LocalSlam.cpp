@@ -7,17 +7,6 @@ namespace urbanslam::slam {
 
 namespace {
 constexpr double kDeg = M_PI / 180.0;
-
-// The median of the scan's returns (0: none).
-double medianRange(const io::LaserScan& scan) {
-  std::vector<float> r;
-  for (size_t i = 0; i < scan.ranges.size(); ++i)
-    if ((scan.valid.size() != scan.ranges.size() || scan.valid[i]) && std::isfinite(scan.ranges[i]) && scan.ranges[i] > 0)
-      r.push_back(scan.ranges[i]);
-  if (r.empty()) return 0.0;
-  std::nth_element(r.begin(), r.begin() + static_cast<long>(r.size() / 2), r.end());
-  return r[r.size() / 2];
-}
 }  // namespace
 
 LocalSlam::LocalSlam(const PipelineOptions& options)
@@ -39,12 +28,10 @@ bool LocalSlam::addDrive(const io::DriveReading& m) {
   return true;
 }
 
-bool LocalSlam::isKeyframe(const Map& map, const io::LaserScan& scan) const {
+bool LocalSlam::isKeyframe(const Map& map) const {
   const common::Pose2& d = motion_.increment();
-  if (map.empty() || !have_scan_keyframe_ || std::abs(d.phi) >= keyframe_options_.min_rotation_deg * kDeg) return true;
-  const double travel = std::hypot(d.x, d.y);
-  if (travel < keyframe_options_.min_translation_m) return false;
-  return keyframe_options_.min_translation_range_fraction <= 0 || travel >= keyframe_options_.min_translation_range_fraction * medianRange(scan);
+  return map.empty() || !have_scan_keyframe_ || std::hypot(d.x, d.y) >= keyframe_options_.min_translation_m ||
+         std::abs(d.phi) >= keyframe_options_.min_rotation_deg * kDeg;
 }
 
 KeyframeConstraint LocalSlam::keyframeConstraint(const io::LaserScan& scan, const Map& map) const {

@@ -148,7 +148,7 @@ void Pipeline::onScan(io::LaserScan scan, double progress) {
   if (!acceptLabel(scan.label)) return;
   ++stats_.scans_used;
   applyRangeLimits(scan);
-  if (local_.isKeyframe(map_, scan)) {
+  if (local_.isKeyframe(map_)) {
     common::Stopwatch kw;
     addKeyframe(std::move(scan));
     stats_.keyframe_ms.push_back(kw.milliseconds());

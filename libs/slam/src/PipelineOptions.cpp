@@ -14,8 +14,6 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
 
   s.section("keyframes", "When a scan becomes a keyframe (a delayed pose of the map)");
   s.add("min_translation_m", o.keyframes.min_translation_m, 0.0, 100.0, "m", "new keyframe after this much travel");
-  s.add("min_translation_range_fraction", o.keyframes.min_translation_range_fraction, 0.0, 1.0, "",
-        "... and at least this share of the scan's median range (how much of the view a drive changes depends on how far the view is)");
   s.add("min_rotation_deg", o.keyframes.min_rotation_deg, 0.0, 180.0, "deg", "new keyframe after this much turning");
 
   s.section("vehicle", "Vehicle geometry");

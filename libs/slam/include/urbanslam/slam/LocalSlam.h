@@ -34,7 +34,7 @@ class LocalSlam {
 
   // Has the vehicle moved or turned enough since the last keyframe for this scan to be one?
   // (The first scan after camera-only keyframes starts the laser map.)
-  bool isKeyframe(const Map& map, const io::LaserScan& scan) const;
+  bool isKeyframe(const Map& map) const;
   // The constraint for a new keyframe at `scan` from the last one in `map`.
   KeyframeConstraint keyframeConstraint(const io::LaserScan& scan, const Map& map) const;
   // A scan between keyframes placed by its submap match, relative to the last keyframe; none

@@ -17,9 +17,6 @@ struct InputOptions {
 
 struct KeyframeOptions {
   double min_translation_m = 0.5;  // a new keyframe once the vehicle moved this far ...
-  // ... and at least this share of the scan's median range: how much of the view a drive changes
-  // depends on how far away the view is (a street's facades 10 m off, an office's walls 2 m)
-  double min_translation_range_fraction = 0.2;
   double min_rotation_deg = 10.0;  // ... or turned this much since the last keyframe
 };
 
