@@ -136,3 +136,49 @@ TEST(RawlogReader, ImagesEmbeddedExternalAndStereo) {
   EXPECT_EQ(images[2].label, "STEREO");
   EXPECT_DOUBLE_EQ(images[1].timestamp, 11.0);
 }
+
+// MRPT segfaults while it reads a robot movement whose estimation method is not odometry and
+// whose pose change is not a pose PDF; the reader refuses those fields as MRPT reads them.
+TEST(RawlogReader, RobotMovementWithoutAPosePdfIsAClearError) {
+  const std::string path = test::repoPath("fuzz/regressions/rawlog/movement-estimation-method-not-odometry.rawlog");
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), {});
+  const size_t method = bytes.find("CActionRobotMovement2D") + 22 + 1;  // after the name and the version byte
+  const auto readAll = [](const std::string& p) {
+    io::RawlogReader reader(p);
+    io::Measurement m;
+    while (reader.next(m)) {
+    }
+  };
+  const auto expectError = [&](const std::string& p, const std::string& fragment) {
+    try {
+      readAll(p);
+      ADD_FAILURE() << p << " read without error";
+    } catch (const common::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+      EXPECT_EQ(std::string(e.what()).rfind(p + ": entry ", 0), 0u) << e.what();
+    }
+  };
+  expectError(path, "unknown estimation method 6815744");
+  // Method 1 (scan matching) followed by a CPose2D instead of a pose PDF.
+  const auto d = test::scratchDir("rawlog_movement");
+  bytes.replace(method, 4, std::string("\x01\x00\x00\x00", 4));
+  const std::string pose2d = (d / "pose2d.rawlog").string();
+  std::ofstream(pose2d, std::ios::binary) << bytes;
+  expectError(pose2d, "its pose change is a CPose2D, not a pose PDF");
+}
+
+// MRPT stores a flag's byte as it is in the file; a byte other than 0 or 1 is a corrupt entry (a
+// bool holding it is undefined behaviour).
+TEST(RawlogReader, AFlagByteOtherThanZeroOrOneIsACorruptEntry) {
+  const std::string path = test::repoPath("fuzz/regressions/rawlog/scan-right-to-left-byte-254.rawlog");
+  try {
+    io::RawlogReader reader(path);
+    io::Measurement m;
+    while (reader.next(m)) {
+    }
+    ADD_FAILURE() << path << " read without error";
+  } catch (const common::InputError& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": entry 1: corrupt entry: laser scan rightToLeft flag byte is 254");
+  }
+}

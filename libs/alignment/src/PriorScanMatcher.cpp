@@ -24,7 +24,9 @@ std::vector<Eigen::Vector2d> thin(const PointSet& scan, double voxel_m) {
   for (const auto& sp : scan) {
     const long long vx = static_cast<long long>(std::floor(sp.p.x() / voxel_m));
     const long long vy = static_cast<long long>(std::floor(sp.p.y() / voxel_m));
-    if (seen.insert((vx << 32) ^ (vy & 0xffffffffLL)).second) out.push_back(sp.p);
+    // Shifted unsigned: a left shift of a negative value is undefined behaviour.
+    const auto key = static_cast<long long>(static_cast<unsigned long long>(vx) << 32) ^ (vy & 0xffffffffLL);
+    if (seen.insert(key).second) out.push_back(sp.p);
   }
   return out;
 }

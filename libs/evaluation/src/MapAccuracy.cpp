@@ -86,7 +86,10 @@ class WallIndex {
 
  private:
   long long cellOf(double v) const { return static_cast<long long>(std::floor(v / cell_)); }
-  static long long keyOf(long long i, long long j) { return (i << 32) ^ (j & 0xffffffffLL); }
+  // Shifted unsigned: a left shift of a negative value is undefined behaviour.
+  static long long keyOf(long long i, long long j) {
+    return static_cast<long long>(static_cast<unsigned long long>(i) << 32) ^ (j & 0xffffffffLL);
+  }
 
   const std::vector<WallSegment>& walls_;
   double cell_;

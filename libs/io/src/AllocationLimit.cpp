@@ -58,7 +58,9 @@ size_t ScopedAllocationLimit::allocatedBytes() const { return t_limit.total; }
 }  // namespace urbanslam::io::detail
 
 // Replacements of the global allocation functions (the C++ standard allows a program to
-// replace them); the deallocation functions stay the library's, which call free().
+// replace them), with the matching deallocation functions: both sides go through malloc/free.
+// The library's operator delete also calls free(), but AddressSanitizer's tells the two
+// apart, and a pair from one place keeps new and delete matched for any runtime.
 using urbanslam::io::detail::allocate;
 using urbanslam::io::detail::allocateAligned;
 
@@ -80,8 +82,35 @@ void* operator new[](size_t n, const std::nothrow_t&) noexcept {
 }
 void* operator new(size_t n, std::align_val_t a) { return allocateAligned(n, static_cast<size_t>(a)); }
 void* operator new[](size_t n, std::align_val_t a) { return allocateAligned(n, static_cast<size_t>(a)); }
+void* operator new(size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
+  try {
+    return allocateAligned(n, static_cast<size_t>(a));
+  } catch (...) {
+    return nullptr;
+  }
+}
+void* operator new[](size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
+  try {
+    return allocateAligned(n, static_cast<size_t>(a));
+  } catch (...) {
+    return nullptr;
+  }
+}
 
 // MRPT's aligned containers allocate through this. libmrpt-core's own version returns null on
 // failure, which the containers do not check (they write through it); this one throws
 // std::bad_alloc instead, as an allocator should, and applies the limit.
 void* mrpt::aligned_malloc(size_t size, size_t alignment) { return allocateAligned(size, alignment); }
+
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, size_t) noexcept { std::free(p); }
+void operator delete[](void* p, size_t) noexcept { std::free(p); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }

@@ -8,8 +8,11 @@
 #include <mrpt/poses/CPose3D.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 #include "urbanslam/common/Error.h"
+#include "urbanslam/common/Numbers.h"
 
 namespace urbanslam::io::detail {
 
@@ -38,7 +41,40 @@ mrpt::obs::CObservation2DRangeScan::Ptr toMrptScan(const LaserScan& s) {
   return o;
 }
 
+namespace {
+
+[[noreturn]] void throwBadValue(const std::string& where, const char* what, double v) {
+  throw InputError(where + ": corrupt entry: " + what + " is " + std::to_string(v));
+}
+
+}  // namespace
+
+double checkedCoordinate(double v, const std::string& where, const char* what) {
+  if (!(std::abs(v) <= common::kMaxCoordinate)) throwBadValue(where, what, v);
+  return v;
+}
+
+double checkedMagnitude(double v, const std::string& where, const char* what) {
+  if (!(std::abs(v) <= common::kMaxMagnitude)) throwBadValue(where, what, v);
+  return v;
+}
+
+bool checkedFlag(const bool& flag, const std::string& where, const char* what) {
+  uint8_t byte = 0;
+  std::memcpy(&byte, &flag, 1);
+  if (byte > 1) throw InputError(where + ": corrupt entry: " + what + " flag byte is " + std::to_string(byte));
+  return byte == 1;
+}
+
 LaserScan fromMrptScan(const mrpt::obs::CObservation2DRangeScan& o, const std::string& where) {
+  const bool right_to_left = checkedFlag(o.rightToLeft, where, "laser scan rightToLeft");
+  const double aperture = o.aperture;
+  if (!(aperture >= 0 && aperture <= 2 * M_PI + 1e-3)) throwBadValue(where, "laser scan aperture", aperture);
+  if (!(o.maxRange > 0 && o.maxRange <= common::kMaxMagnitude)) throwBadValue(where, "laser scan maximum range", o.maxRange);
+  const auto& sp = o.sensorPose;
+  checkedCoordinate(sp.x(), where, "laser sensor pose x");
+  checkedCoordinate(sp.y(), where, "laser sensor pose y");
+  checkedCoordinate(sp.yaw(), where, "laser sensor pose yaw");
   LaserScan s;
   s.timestamp = fromMrptTime(o.timestamp);
   s.label = o.sensorLabel;
@@ -54,9 +90,9 @@ LaserScan fromMrptScan(const mrpt::obs::CObservation2DRangeScan& o, const std::s
     s.ranges[i] = std::isfinite(r) ? r : 0.f;
     s.valid[i] = ok && r > 0 && r < o.maxRange ? 1 : 0;
   }
-  const double step = n > 1 ? o.aperture / static_cast<double>(n - 1) : 0.0;
-  s.angle_increment_rad = o.rightToLeft ? step : -step;
-  s.angle_min_rad = o.rightToLeft ? -o.aperture / 2.0 : o.aperture / 2.0;
+  const double step = n > 1 ? aperture / static_cast<double>(n - 1) : 0.0;
+  s.angle_increment_rad = right_to_left ? step : -step;
+  s.angle_min_rad = right_to_left ? -aperture / 2.0 : aperture / 2.0;
   s.max_range_m = o.maxRange;
   s.sensor_pose = {o.sensorPose.x(), o.sensorPose.y(), o.sensorPose.yaw()};
   return s;

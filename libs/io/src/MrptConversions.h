@@ -18,7 +18,14 @@ mrpt::Clock::time_point toMrptTime(double t);
 double fromMrptTime(const mrpt::Clock::time_point& t);
 
 mrpt::obs::CObservation2DRangeScan::Ptr toMrptScan(const LaserScan& s);
-// Throws common::InputError (with `where`) for an empty scan or a NaN/negative valid range.
+// MRPT deserialises numbers and flags as raw bytes, so a corrupt entry holds NaN, huge values or
+// a bool whose byte is neither 0 nor 1 (reading it is undefined behaviour). These apply the text
+// readers' bounds (common/Numbers.h) and throw common::InputError naming `where` and `what`.
+double checkedCoordinate(double v, const std::string& where, const char* what);  // |v| <= kMaxCoordinate
+double checkedMagnitude(double v, const std::string& where, const char* what);   // |v| <= kMaxMagnitude
+bool checkedFlag(const bool& flag, const std::string& where, const char* what);
+// Throws common::InputError (with `where`) for an empty scan, a NaN/negative valid range, or a
+// non-finite or out-of-range aperture, maximum range or sensor pose.
 LaserScan fromMrptScan(const mrpt::obs::CObservation2DRangeScan& o, const std::string& where);
 
 // Any measurement as an MRPT observation.

@@ -53,8 +53,8 @@ std::vector<KeyframeScan> readSimpleMap(const std::string& path) {
   return out;
 }
 
-std::pair<int, int> writeOccupancyGrid(const std::string& prefix, const std::vector<PosedScan>& scans,
-                                       const OccupancyGridOptions& options) {
+std::pair<int, int> writeOccupancyGrid(const std::string& prefix, const std::vector<PosedScan>& scans, const OccupancyGridOptions& options,
+                                       double* resolution_used) {
   // Bounds first, so the grid is allocated once instead of growing scan by scan.
   double x0 = 0, x1 = 0, y0 = 0, y1 = 0;
   bool first = true;
@@ -76,8 +76,17 @@ std::pair<int, int> writeOccupancyGrid(const std::string& prefix, const std::vec
     y1 = std::max(y1, ps.pose.y);
   }
   const double margin = 1.0;
+  const double width_m = x1 - x0 + 2 * margin, height_m = y1 - y0 + 2 * margin;
+  double resolution = options.resolution_m;
+  // Cells as MRPT counts them (rounded up, one extra per side), grown by 1% steps until they fit.
+  const auto cells = [&](double r) { return (std::ceil(width_m / r) + 1) * (std::ceil(height_m / r) + 1); };
+  if (cells(resolution) > options.max_cells) {
+    resolution = std::max(resolution, std::sqrt(width_m * height_m / options.max_cells));
+    while (cells(resolution) > options.max_cells) resolution *= 1.01;
+  }
+  if (resolution_used) *resolution_used = resolution;
   mrpt::maps::COccupancyGridMap2D grid(static_cast<float>(x0 - margin), static_cast<float>(x1 + margin), static_cast<float>(y0 - margin),
-                                       static_cast<float>(y1 + margin), static_cast<float>(options.resolution_m));
+                                       static_cast<float>(y1 + margin), static_cast<float>(resolution));
   grid.insertionOptions.maxDistanceInsertion = 80.f;
   grid.insertionOptions.wideningBeamsWithDistance = false;
   for (const auto& ps : scans) {

@@ -36,6 +36,82 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// MRPT dereferences the pose change of a CActionRobotMovement2D without checking it: unless the
+// estimation method is odometry (0), the object read next must be a pose PDF, and when it is of
+// another class or a null object, MRPT segfaults while it reads. There is no size prefix to look
+// ahead with, so the stream checks those fields as MRPT reads them (each field is one Read): the
+// object's header, the estimation method (0 or 1), and the class of the pose PDF that follows.
+class MovementGuard {
+ public:
+  // Throws std::runtime_error on a field that would crash MRPT; MRPT wraps it in its own
+  // exception, so the cause is also kept for the error message.
+  const std::string& failure() const { return failure_; }
+  void check(const unsigned char* data, size_t n) {
+    switch (state_) {
+      case State::Idle:
+        break;
+      case State::Method: {
+        state_ = State::Idle;
+        if (n != 4) break;
+        uint32_t method = 0;
+        for (int b = 3; b >= 0; --b) method = method << 8 | data[b];
+        if (method == 1) state_ = State::PdfHeader;
+        if (method > 1) fail("unknown estimation method " + std::to_string(method) + " (0 odometry, 1 scan matching)");
+        return;
+      }
+      case State::PdfHeader:
+        state_ = State::Idle;
+        if (n != 1) break;
+        if (data[0] & 0x80) {
+          name_length_ = data[0] & 0x7f;
+          state_ = State::PdfName;
+        } else {  // the old header: a 4-byte name length
+          name_length_ = data[0];
+          state_ = State::PdfOldLength;
+        }
+        return;
+      case State::PdfOldLength:
+        state_ = State::Idle;
+        if (n != 3) break;
+        name_length_ |= size_t{data[0]} << 8 | size_t{data[1]} << 16 | size_t{data[2]} << 24;
+        state_ = State::PdfName;
+        return;
+      case State::PdfName: {
+        state_ = State::Idle;
+        const std::string name(reinterpret_cast<const char*>(data), n);
+        if (n != name_length_ || !(name.rfind("CPosePDF", 0) == 0 || name.rfind("mrpt::poses::CPosePDF", 0) == 0))
+          fail("its pose change is a " + printable(name) + ", not a pose PDF");
+        return;
+      }
+    }
+    // The object's header: its name (one Read), then its version (one byte).
+    if (n == 1 && (tail_ == kName || tail_ == kFullName)) {
+      const unsigned version = data[0];
+      state_ = version <= 1 ? State::PdfHeader : version <= 7 ? State::Method : State::Idle;
+    }
+    tail_.assign(reinterpret_cast<const char*>(data), std::min<size_t>(n, 64));
+  }
+
+ private:
+  enum class State { Idle, Method, PdfHeader, PdfOldLength, PdfName };
+  [[noreturn]] void fail(const std::string& why) {
+    failure_ = "CActionRobotMovement2D: " + why;
+    throw std::runtime_error(failure_);
+  }
+  static std::string printable(std::string s) {
+    if (s.size() > 40) s = s.substr(0, 40) + "...";
+    for (char& c : s)
+      if (!std::isalnum(static_cast<unsigned char>(c)) && c != ':' && c != '_') c = '?';
+    return s;
+  }
+  static inline const std::string kName = "CActionRobotMovement2D";
+  static inline const std::string kFullName = "mrpt::obs::CActionRobotMovement2D";
+  State state_ = State::Idle;
+  size_t name_length_ = 0;
+  std::string tail_;  // the previous Read
+  std::string failure_;
+};
+
 // An MRPT read-only stream over our zlib reader, so we control truncation errors and progress.
 // It keeps the first bytes of each entry: the class name of the object being read, for errors.
 class GzMrptStream : public mrpt::io::CStream {
@@ -52,12 +128,15 @@ class GzMrptStream : public mrpt::io::CStream {
     head_len_ = std::max<size_t>(head_len_, static_cast<size_t>(pos_ - entry_start_) + keep);
     if (keep > 0) std::memcpy(head_.data() + (pos_ - entry_start_), buf, keep);
     pos_ += got;
+    if (got == n) movement_.check(static_cast<const unsigned char*>(buf), n);
     return got;
   }
   size_t Write(const void*, size_t) override { throw std::logic_error("read-only stream"); }
   uint64_t Seek(int64_t, TSeekOrigin) override { throw std::logic_error("stream cannot seek"); }
   uint64_t getTotalBytesCount() const override { return 0; }
   uint64_t getPosition() const override { return pos_; }
+  // Why the last Read refused a field (MovementGuard), or "".
+  const std::string& refusal() const { return movement_.failure(); }
   double progress() const { return in_->progress(); }
 
   void startEntry() {
@@ -80,6 +159,7 @@ class GzMrptStream : public mrpt::io::CStream {
   uint64_t pos_ = 0, entry_start_ = 0;
   std::array<char, 130> head_{};
   size_t head_len_ = 0;
+  MovementGuard movement_;
 };
 
 bool isGzipFile(const std::string& path) {
@@ -162,39 +242,60 @@ struct RawlogReader::Impl {
 
   void addObservation(const mrpt::obs::CObservation::Ptr& obs) {
     using namespace mrpt::obs;
+    using detail::checkedCoordinate;
+    using detail::checkedMagnitude;
+    if (!obs) throw InputError(where() + ": corrupt rawlog: a sensory frame holds a null observation");
+    const std::string w = where();
     const double t = detail::fromMrptTime(obs->timestamp);
     if (auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(obs)) {
-      pending.emplace_back(detail::fromMrptScan(*scan, where()));
+      pending.emplace_back(detail::fromMrptScan(*scan, w));
     } else if (auto od = std::dynamic_pointer_cast<CObservationOdometry>(obs)) {
-      pending.emplace_back(OdometryReading{t, {od->odometry.x(), od->odometry.y(), od->odometry.phi()}});
+      odom = {checkedCoordinate(od->odometry.x(), w, "odometry x"), checkedCoordinate(od->odometry.y(), w, "odometry y"),
+              checkedCoordinate(od->odometry.phi(), w, "odometry phi")};
+      pending.emplace_back(OdometryReading{t, odom});
       have_odom = true;
-      odom = {od->odometry.x(), od->odometry.y(), od->odometry.phi()};
     } else if (auto im = std::dynamic_pointer_cast<CObservationImage>(obs)) {
       pending.emplace_back(detail::toGray(im->image, t, im->sensorLabel, where()));
     } else if (auto st = std::dynamic_pointer_cast<CObservationStereoImages>(obs)) {
       pending.emplace_back(detail::toGray(st->imageLeft, t, st->sensorLabel, where()));
     } else if (auto daq = std::dynamic_pointer_cast<CObservationRawDAQ>(obs);
                daq && daq->sensorLabel == detail::kDriveLabel && daq->AIN_double.size() == 2) {
-      pending.emplace_back(DriveReading{t, daq->AIN_double[0], daq->AIN_double[1]});
+      pending.emplace_back(DriveReading{t, checkedMagnitude(daq->AIN_double[0], w, "drive speed"),
+                                        checkedMagnitude(daq->AIN_double[1], w, "drive steering")});
     } else if (auto rp = std::dynamic_pointer_cast<CObservationRobotPose>(obs);
                rp && (rp->sensorLabel == detail::kGpsLabel || rp->sensorLabel == detail::kReferenceLabel)) {
+      const auto& m = rp->pose.mean;
       if (rp->sensorLabel == detail::kGpsLabel)
-        pending.emplace_back(GpsFix{t, rp->pose.mean.x(), rp->pose.mean.y()});
+        pending.emplace_back(GpsFix{t, checkedCoordinate(m.x(), w, "GPS x"), checkedCoordinate(m.y(), w, "GPS y")});
       else
-        pending.emplace_back(ReferencePose{t, {rp->pose.mean.x(), rp->pose.mean.y(), rp->pose.mean.yaw()}});
+        pending.emplace_back(
+            ReferencePose{t,
+                          {checkedCoordinate(m.x(), w, "reference pose x"), checkedCoordinate(m.y(), w, "reference pose y"),
+                           checkedCoordinate(m.yaw(), w, "reference pose yaw")}});
     } else {
       ++skipped;
     }
   }
 
   void addAction(const mrpt::obs::CActionCollection& acts) {
+    // MRPT's getBestMovementEstimation dereferences every action and every movement's PDF.
+    for (const auto& a : acts) {
+      if (!a.get()) throw InputError(where() + ": corrupt rawlog: an action collection holds a null action");
+      if (const auto* m = dynamic_cast<const mrpt::obs::CActionRobotMovement2D*>(a.get()); m && !m->poseChange.get())
+        throw InputError(where() + ": corrupt rawlog: a robot movement has no pose change");
+    }
     auto mv = acts.getBestMovementEstimation();
     if (!mv) {
       ++skipped;
       return;
     }
     const auto inc = mv->poseChange->getMeanVal();
-    odom = common::compose(odom, {inc.x(), inc.y(), inc.phi()});
+    const std::string w = where();
+    odom = common::compose(
+        odom, {detail::checkedCoordinate(inc.x(), w, "odometry increment x"), detail::checkedCoordinate(inc.y(), w, "odometry increment y"),
+               detail::checkedCoordinate(inc.phi(), w, "odometry increment phi")});
+    detail::checkedCoordinate(odom.x, w, "odometry x");
+    detail::checkedCoordinate(odom.y, w, "odometry y");
     have_odom = true;
     pending.emplace_back(OdometryReading{detail::fromMrptTime(mv->timestamp), odom});
   }
@@ -233,7 +334,7 @@ struct RawlogReader::Impl {
       throw;
     } catch (const std::exception& e) {
       if (limit.refusedBytes() > 0) throw refusal();
-      const std::string msg = mrptMessage(e.what());
+      const std::string msg = stream.refusal().empty() ? mrptMessage(e.what()) : stream.refusal();
       throw InputError(entries == 0 ? path + ": not an MRPT rawlog (" + msg + ")"
                                     : where() + ": corrupt or truncated rawlog (" + object() + ": " + msg + ")");
     }

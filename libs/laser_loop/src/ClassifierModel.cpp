@@ -135,7 +135,8 @@ ClassifierModel parseModel(const std::string& text, const std::string& source) {
       continue;
     }
     if (!line.empty() && line[0] == '#') {
-      m.comments.push_back(line.size() > 2 && line[1] == ' ' ? line.substr(2) : line.substr(1));
+      // saveModel writes "# " + comment: a bare "#" is an empty comment, as "# " is.
+      m.comments.push_back(line.size() >= 2 && line[1] == ' ' ? line.substr(2) : line.substr(1));
       continue;
     }
     const auto f = split(line);
@@ -185,7 +186,9 @@ ClassifierModel parseModel(const std::string& text, const std::string& source) {
       if (f.size() < 2) p.fail(ln, "'provenance' needs a key");
       const size_t at = line.find(f[1], line.find("provenance") + 10) + f[1].size();
       std::string value = at < line.size() ? line.substr(at) : "";
-      value.erase(0, value.find_first_not_of(" \t"));
+      // The white space that separates the fields (split: istream's, isspace), so a value that
+      // starts with a carriage return or form feed reads back the same after saveModel.
+      value.erase(0, value.find_first_not_of(" \t\n\v\f\r"));
       m.provenance.emplace_back(f[1], value);
     } else if (key == "features") {
       if (f.size() < 2) p.fail(ln, "'features' needs a count");

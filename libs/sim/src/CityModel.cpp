@@ -6,7 +6,10 @@
 namespace urbanslam::sim {
 
 namespace {
-int64_t tileKey(int tx, int ty) { return (static_cast<int64_t>(tx) << 32) ^ static_cast<uint32_t>(ty); }
+// Shifted unsigned: a left shift of a negative value is undefined behaviour.
+int64_t tileKey(int tx, int ty) {
+  return static_cast<int64_t>(static_cast<uint64_t>(static_cast<int64_t>(tx)) << 32) ^ static_cast<uint32_t>(ty);
+}
 int floorDiv(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 }  // namespace
 

@@ -21,7 +21,8 @@ std::vector<Vec2> LoopTruthFinder::endPoints(const io::LaserScan& scan, const co
 int64_t LoopTruthFinder::cellKey(Vec2 p) const {
   const auto cx = static_cast<int64_t>(std::floor(p.x / options_.max_distance_m));
   const auto cy = static_cast<int64_t>(std::floor(p.y / options_.max_distance_m));
-  return (cx << 32) ^ (cy & 0xffffffff);
+  // Shifted unsigned: a left shift of a negative value is undefined behaviour.
+  return static_cast<int64_t>(static_cast<uint64_t>(cx) << 32) ^ (cy & 0xffffffff);
 }
 
 std::vector<LoopPair> LoopTruthFinder::add(const io::LaserScan& scan, const common::Pose2& vehicle) {

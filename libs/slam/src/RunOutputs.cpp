@@ -122,10 +122,11 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   if (o.output.write_grid && !pts.empty()) {  // camera-only runs have no map points
     io::OccupancyGridOptions g;
     g.resolution_m = o.map.grid_resolution_m;
-    const auto [w, h] = io::writeOccupancyGrid(path("grid"), posed, g);
+    double resolution = g.resolution_m;
+    const auto [w, h] = io::writeOccupancyGrid(path("grid"), posed, g, &resolution);
     grid["width"] = w;
     grid["height"] = h;
-    grid["resolution_m"] = g.resolution_m;
+    grid["resolution_m"] = resolution;
     files.push("grid.png");
     files.push("grid.yaml");
   }

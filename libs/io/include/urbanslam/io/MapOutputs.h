@@ -52,9 +52,17 @@ struct OccupancyGridOptions {
   double resolution_m = 0.05;
   double occupied_thresh = 0.65;  // map_server thresholds, written into the YAML
   double free_thresh = 0.196;
+  // Bounds the grid's memory (a few bytes per cell while it is built and written): a map
+  // larger than this many cells at resolution_m (10^8: 500 m x 500 m at 5 cm) is written with
+  // cells coarse enough to fit. A log whose odometry jumps kilometres would otherwise ask for
+  // tens of gigabytes.
+  double max_cells = 1e8;
 };
 
 // Writes `<prefix>.png` and `<prefix>.yaml`; returns the PNG's size in cells (width, height).
-std::pair<int, int> writeOccupancyGrid(const std::string& prefix, const std::vector<PosedScan>& scans, const OccupancyGridOptions& options);
+// `resolution_used` (optional) receives the cell size written, resolution_m unless the map
+// needed more than max_cells.
+std::pair<int, int> writeOccupancyGrid(const std::string& prefix, const std::vector<PosedScan>& scans, const OccupancyGridOptions& options,
+                                       double* resolution_used = nullptr);
 
 }  // namespace urbanslam::io
