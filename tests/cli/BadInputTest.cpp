@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "CliRunner.h"
+#include "TestFiles.h"
 
 using namespace urbanslam::test;
 namespace fs = std::filesystem;
@@ -22,11 +23,6 @@ void expectBadInput(const std::string& args, const std::string& fragment) {
   EXPECT_NE(r.err.find("error: "), std::string::npos) << r.err;
   // One line, no stack trace.
   EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << r.err;
-}
-
-std::string writeFile(const fs::path& p, const std::string& text) {
-  std::ofstream(p, std::ios::binary) << text;
-  return p.string();
 }
 
 }  // namespace

@@ -3,9 +3,6 @@
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 
-#include <mrpt/io/CFileGZInputStream.h>
-#include <mrpt/io/CFileGZOutputStream.h>
-
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -13,6 +10,7 @@
 #include <fstream>
 
 #include "CliRunner.h"
+#include "TestFiles.h"
 
 using namespace urbanslam::test;
 namespace fs = std::filesystem;
@@ -39,25 +37,6 @@ void expectOneLineError(const CliResult& r, const std::string& fragment, const s
 }
 
 void expectBadInput(const std::string& args, const std::string& fragment) { expectOneLineError(runCli(args), fragment, args); }
-
-std::string writeFile(const fs::path& p, const std::string& bytes) {
-  std::ofstream(p, std::ios::binary) << bytes;
-  return p.string();
-}
-
-std::string gunzip(const std::string& path) {
-  mrpt::io::CFileGZInputStream in(path);
-  std::string out;
-  char buf[1 << 16];
-  for (size_t n; (n = in.Read(buf, sizeof buf)) > 0;) out.append(buf, n);
-  return out;
-}
-
-std::string writeGz(const fs::path& p, const std::string& bytes) {
-  mrpt::io::CFileGZOutputStream out(p.string());
-  out.Write(bytes.data(), bytes.size());
-  return p.string();
-}
 
 // The Intel rawlog with the beam count of its 6th scan replaced.
 std::string withBeamCount(uint32_t beams) {

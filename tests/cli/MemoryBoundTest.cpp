@@ -7,9 +7,6 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <mrpt/io/CFileGZInputStream.h>
-#include <mrpt/io/CFileGZOutputStream.h>
-
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
@@ -20,6 +17,7 @@
 #include <vector>
 
 #include "CliRunner.h"
+#include "TestFiles.h"
 
 using namespace urbanslam::test;
 namespace fs = std::filesystem;
@@ -92,19 +90,6 @@ void expectBounded(const std::vector<std::string>& args, int expected_code = -1)
   if (r.code == 2) EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << what;
   if (!kSanitized) EXPECT_LT(r.peak_mb, kPeakRssBoundMb) << what;
   EXPECT_GT(r.peak_mb, 0) << what;
-}
-
-std::string gunzip(const std::string& path) {
-  mrpt::io::CFileGZInputStream in(path);
-  std::string out;
-  char buf[1 << 16];
-  for (size_t n; (n = in.Read(buf, sizeof buf)) > 0;) out.append(buf, n);
-  return out;
-}
-
-std::string writeFile(const fs::path& p, const std::string& bytes) {
-  std::ofstream(p, std::ios::binary) << bytes;
-  return p.string();
 }
 
 // A CARMEN log of six identical scans whose odometry jumps `jump_m` along both axes halfway:

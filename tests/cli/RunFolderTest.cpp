@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "CliRunner.h"
+#include "TestFiles.h"
 
 using namespace urbanslam::test;
 namespace fs = std::filesystem;
@@ -21,11 +22,6 @@ namespace fs = std::filesystem;
 namespace {
 
 const std::string kLog = repoPath("rawlogs/intel-corrected-excerpt.log.gz");
-
-std::string writeFile(const fs::path& p, const std::string& text) {
-  std::ofstream(p) << text;
-  return p.string();
-}
 
 std::set<std::string> names(const fs::path& d) {
   std::set<std::string> out;
