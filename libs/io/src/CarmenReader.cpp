@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <optional>
 #include <variant>
 
 #include "CarmenBeams.h"
@@ -46,6 +47,26 @@ int significantDigits(const std::string& token) {
     ++n;
   }
   return n;
+}
+
+// ROBOTLASER1 type start_angle fov resolution max_range accuracy remission_mode n r1..rn
+//   m rem1..remm laser_x laser_y laser_theta robot_x robot_y robot_theta tv rv fwd side turn
+//   timestamp hostname logger_timestamp
+// Where its variable-length parts put the fields after them: `tail` is the index of laser_x (the
+// robot pose at tail + 3, the timestamp at tail + 11). None when a count is negative or the line
+// is too short for the counts it declares.
+struct RobotLaserLayout {
+  size_t beams = 0, tail = 0;
+};
+std::optional<RobotLaserLayout> robotLaserLayout(const std::vector<std::string>& f, const std::string& where) {
+  if (f.size() < 9) return std::nullopt;
+  const long n = parseInteger(f[8], where, "beam count");
+  if (n < 0 || f.size() < 10 + static_cast<size_t>(n)) return std::nullopt;
+  const long m = parseInteger(f[9 + static_cast<size_t>(n)], where, "remission count");
+  if (m < 0) return std::nullopt;
+  const size_t tail = 10 + static_cast<size_t>(n) + static_cast<size_t>(m);
+  if (f.size() < tail + 14) return std::nullopt;
+  return RobotLaserLayout{static_cast<size_t>(n), tail};
 }
 
 // A fixed-point format keeps trailing zeros ("5.20"); %g drops them ("5.2").
@@ -117,18 +138,13 @@ void CarmenReader::prescan() {
         noteScanStamp(f[static_cast<size_t>(n) + 8], where, f[0] == "FLASER");
       }
     }
-    // ROBOTLASER1 type start fov res max acc mode n r1..rn m rem1..remm laser(3) robot(3) 5 more, time
-    if (f[0] == "ROBOTLASER1" && f.size() >= 9) {
-      const long n = parseInteger(f[8], where, "beam count");
-      if (n >= 0 && f.size() >= static_cast<size_t>(n) + 10) {
-        const long m = parseInteger(f[9 + static_cast<size_t>(n)], where, "remission count");
-        const size_t k = 10 + static_cast<size_t>(n) + static_cast<size_t>(std::max(m, 0L));
-        if (m >= 0 && f.size() >= k + 14) {
-          scan_pose = {parseCoordinate(f[k + 3], where, "robot_x"), parseCoordinate(f[k + 4], where, "robot_y"),
-                       parseCoordinate(f[k + 5], where, "robot_theta")};
-          after_scan = true;
-          noteScanStamp(f[k + 11], where, true);
-        }
+    if (f[0] == "ROBOTLASER1") {
+      if (const auto l = robotLaserLayout(f, where)) {
+        const size_t k = l->tail;
+        scan_pose = {parseCoordinate(f[k + 3], where, "robot_x"), parseCoordinate(f[k + 4], where, "robot_y"),
+                     parseCoordinate(f[k + 5], where, "robot_theta")};
+        after_scan = true;
+        noteScanStamp(f[k + 11], where, true);
       }
     }
   }
@@ -315,19 +331,12 @@ void CarmenReader::handleLaser(const std::vector<std::string>& f, const std::str
 }
 
 void CarmenReader::handleRobotLaser(const std::vector<std::string>& f, const std::string& where) {
-  // ROBOTLASER1 type start_angle fov resolution max_range accuracy remission_mode n r1..rn
-  //   m rem1..remm laser_x laser_y laser_theta robot_x robot_y robot_theta tv rv fwd side turn
-  //   timestamp hostname logger_timestamp
   if (f.size() < 9) throw InputError(where + ": truncated ROBOTLASER1 line");
   const long n = parseInteger(f[8], where, "beam count");
   if (n <= 0 || n > 100000) throw InputError(where + ": invalid beam count " + f[8]);
-  const size_t nn = static_cast<size_t>(n);
-  if (f.size() < 9 + nn + 1) throw InputError(where + ": truncated ROBOTLASER1 line");
-  const long m = parseInteger(f[9 + nn], where, "remission count");
-  // Eleven numbers follow the remissions (laser pose, robot pose, tv rv fwd side turn), then the
-  // timestamp, hostname and logger timestamp.
-  if (m < 0 || f.size() < 10 + nn + static_cast<size_t>(m) + 14) throw InputError(where + ": truncated ROBOTLASER1 line");
-  const size_t k = 10 + nn + static_cast<size_t>(m);
+  const auto layout = robotLaserLayout(f, where);
+  if (!layout) throw InputError(where + ": truncated ROBOTLASER1 line");
+  const size_t nn = layout->beams, k = layout->tail;
   LaserScan scan;
   scan.label = "ROBOTLASER1";
   scan.max_range_m = parseNumber(f[5], where, "maximum_range");
