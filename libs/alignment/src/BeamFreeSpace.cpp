@@ -27,12 +27,16 @@ BeamFreeSpace::BeamFreeSpace(const PointSet& scan, double margin_m, double margi
   bin_rad_ = std::max(step, 0.25 * M_PI / 180);
   free_m_.assign(static_cast<size_t>(std::ceil(2 * M_PI / bin_rad_)), 0.0);
   for (const auto& sp : scan) {
-    double from_zero = std::remainder(sp.bearing_rad, 2 * M_PI);
-    if (from_zero < 0) from_zero += 2 * M_PI;
-    double& f = free_m_[static_cast<size_t>(from_zero / bin_rad_) % free_m_.size()];
+    double& f = free_m_[binOf(sp.bearing_rad)];
     f = f > 0 ? std::min(f, sp.range_m) : sp.range_m;
   }
   valid_ = true;
+}
+
+size_t BeamFreeSpace::binOf(double bearing_rad) const {
+  double from_zero = std::remainder(bearing_rad, 2 * M_PI);
+  if (from_zero < 0) from_zero += 2 * M_PI;
+  return static_cast<size_t>(from_zero / bin_rad_) % free_m_.size();
 }
 
 int BeamFreeSpace::conflicts(const std::vector<Eigen::Vector2d>& points, const common::Pose2& scan_pose) const {
@@ -48,9 +52,7 @@ void BeamFreeSpace::classify(const std::vector<Eigen::Vector2d>& points, const c
   for (size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector2d q = to_sensor * points[i];
     const double r = q.norm();
-    double from_zero = std::atan2(q.y(), q.x());
-    if (from_zero < 0) from_zero += 2 * M_PI;
-    const size_t b = static_cast<size_t>(from_zero / bin_rad_) % n;
+    const size_t b = binOf(std::atan2(q.y(), q.x()));
     const double f = std::min({free_m_[b], free_m_[(b + 1) % n], free_m_[(b + n - 1) % n]});
     if (f <= 0) continue;
     const char s = r < f - margin_m_ - margin_fraction_ * f ? kSeenThrough : kInView;

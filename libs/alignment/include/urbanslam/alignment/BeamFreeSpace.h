@@ -27,6 +27,8 @@ class BeamFreeSpace {
   void classify(const std::vector<Eigen::Vector2d>& points, const common::Pose2& scan_pose, std::vector<char>& state) const;
 
  private:
+  size_t binOf(double bearing_rad) const;  // the bearing's bin, counted from 0 rad counter-clockwise
+
   bool valid_ = false;
   common::Pose2 sensor_;  // the sensor in the scan's frame (fitted from the points' own polar coordinates)
   double bin_rad_ = 0;
