@@ -5,6 +5,8 @@
 # New inputs go to BUILD/fuzz-corpus/<target>/ (the seeds in fuzz/corpus/ stay as they are);
 # a crash, hang or over-limit allocation leaves its input in BUILD/fuzz-artifacts/<target>/ and
 # makes the script fail: fix the cause, then add the input to fuzz/regressions/<target>/.
+# Each run is appended to BUILD/fuzz-artifacts/ledger.tsv, and the summary adds every target's
+# executions over all runs on its (kept) corpus, since fuzzing is cumulative.
 #
 #   fuzz/run.sh BUILD SECONDS [TARGET...]
 set -uo pipefail
@@ -14,8 +16,13 @@ seconds=${2:?seconds per target}
 shift 2
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-  targets=(rawlog carmen gfs victoria_park pose_graph tum relations ini laser_model vocabulary image_list)
+  targets=(rawlog carmen gfs victoria_park pose_graph tum relations ini laser_model vocabulary image_list image data_source victoria_park_zip)
 fi
+# Inputs are written to a file per execution: keep that off the disk when we can.
+if [ -z "${TMPDIR:-}" ] && [ -d /dev/shm ] && [ -w /dev/shm ]; then export TMPDIR=/dev/shm; fi
+ledger="$build/fuzz-artifacts/ledger.tsv"
+mkdir -p "$build/fuzz-artifacts"
+[ -f "$ledger" ] || printf 'date\ttarget\tseconds\texecs\tcov\tft\tcorpus\tstatus\n' >"$ledger"
 status=0
 summary=()
 for t in "${targets[@]}"; do
@@ -45,6 +52,10 @@ for t in "${targets[@]}"; do
     grep -m3 -E 'ERROR|fuzz target:|runtime error' "$log" >&2
     status=1
   fi
+  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$(date -u +%FT%TZ)" "$t" "$seconds" "${execs:-0}" "${cov:-?}" \
+    "${ft:-?}" "${corp:-?}" "$([ $rc -eq 0 ] && echo ok || echo "failed:$rc")" >>"$ledger"
+  total=$(awk -F'\t' -v t="$t" '$2 == t { n += $4 } END { print n + 0 }' "$ledger")
+  line="$line total_execs $total"
   echo "$line"
   summary+=("$line")
 done

@@ -8,6 +8,7 @@
 
 #include "MrptConversions.h"
 #include "urbanslam/common/Error.h"
+#include "urbanslam/io/ImageHeader.h"
 
 namespace urbanslam::io {
 
@@ -68,6 +69,7 @@ ImageFolderSource::ImageFolderSource(const std::string& folder) : DataSource(fol
 bool ImageFolderSource::next(Measurement& out) {
   if (at_ >= files_.size()) return false;
   const std::string& p = files_[at_];
+  checkImageFile(p);
   mrpt::img::CImage im;
   if (!im.loadFromFile(p, 0)) throw common::InputError(p + ": cannot read image");
   CameraImage img = detail::toGray(im, static_cast<double>(at_), "CAMERA", p);

@@ -13,6 +13,7 @@
 
 #include "urbanslam/common/Error.h"
 #include "urbanslam/common/Numbers.h"
+#include "urbanslam/io/ImageHeader.h"
 
 namespace urbanslam::io::detail {
 
@@ -150,6 +151,8 @@ mrpt::obs::CObservation::Ptr toMrpt(const Measurement& m) { return std::visit(To
 
 CameraImage toGray(const mrpt::img::CImage& src, double t, const std::string& label, const std::string& where) {
   mrpt::img::CImage gray;
+  // An externally stored image is loaded on demand here: its header is checked first.
+  if (src.isExternallyStored()) checkImageFile(src.getExternalStorageFileAbsolutePath());
   try {
     src.grayscale(gray);  // loads an externally stored image on demand
   } catch (const std::exception& e) {

@@ -8,6 +8,7 @@
 
 #include "urbanslam/common/Error.h"
 #include "urbanslam/io/DataSource.h"
+#include "urbanslam/io/ImageHeader.h"
 
 namespace fs = std::filesystem;
 
@@ -28,6 +29,7 @@ class FileListSequence : public ImageSequence {
     out.path = p;
     out.name = fs::path(p).stem().string();
     out.timestamp = static_cast<double>(at_ - 1);
+    io::checkImageFile(p);
     out.gray = cv::imread(p, cv::IMREAD_GRAYSCALE);
     if (out.gray.empty()) throw common::InputError(p + ": cannot read image");
     return true;
