@@ -123,6 +123,7 @@ struct ToMrpt {
     auto o = mrpt::obs::CObservationImage::Create();
     o->timestamp = toMrptTime(m.timestamp);
     o->sensorLabel = m.label;
+    if (m.calibration) toMrptCamera(*m.calibration, m.width, m.height, o->cameraParams, o->cameraPose);
     o->image = mrpt::img::CImage(m.width, m.height, mrpt::img::CH_GRAY);
     for (int r = 0; r < m.height; ++r)
       std::copy_n(m.pixels->data() + static_cast<size_t>(r) * static_cast<size_t>(m.width), static_cast<size_t>(m.width),
@@ -148,6 +149,38 @@ struct ToMrpt {
 }  // namespace
 
 mrpt::obs::CObservation::Ptr toMrpt(const Measurement& m) { return std::visit(ToMrpt{}, m); }
+
+void toMrptCamera(const CameraCalibration& c, int width, int height, mrpt::img::TCamera& params, mrpt::poses::CPose3D& pose) {
+  params.ncols = static_cast<uint32_t>(width);
+  params.nrows = static_cast<uint32_t>(height);
+  params.setIntrinsicParamsFromValues(c.fx_px, c.fy_px, c.cx_px, c.cy_px);
+  // MRPT's camera frame looks along +Z: a level camera whose optical axis has heading psi on the
+  // vehicle is yaw psi - 90 deg, roll -90 deg.
+  pose = mrpt::poses::CPose3D(c.mount.x, c.mount.y, 0, c.mount.phi - M_PI / 2, 0, -M_PI / 2);
+}
+
+std::optional<CameraCalibration> fromMrptCamera(const mrpt::img::TCamera& params, const mrpt::poses::CPose3D& pose, int width,
+                                                int height, const std::string& where) {
+  if (!(params.fx() > 0) || !(params.fy() > 0)) return std::nullopt;
+  CameraCalibration c;
+  c.fx_px = checkedMagnitude(params.fx(), where, "camera fx");
+  c.fy_px = checkedMagnitude(params.fy(), where, "camera fy");
+  c.cx_px = checkedMagnitude(params.cx(), where, "camera cx");
+  c.cy_px = checkedMagnitude(params.cy(), where, "camera cy");
+  // Intrinsics calibrated at another resolution scale with the image.
+  if (params.ncols > 0 && params.nrows > 0 && (params.ncols != static_cast<uint32_t>(width) || params.nrows != static_cast<uint32_t>(height))) {
+    const double sx = static_cast<double>(width) / params.ncols, sy = static_cast<double>(height) / params.nrows;
+    c.fx_px *= sx;
+    c.cx_px = (c.cx_px + 0.5) * sx - 0.5;
+    c.fy_px *= sy;
+    c.cy_px = (c.cy_px + 0.5) * sy - 0.5;
+  }
+  const auto r = pose.getRotationMatrix();
+  const double axis_x = r(0, 2), axis_y = r(1, 2), axis_z = r(2, 2), right_z = r(2, 0);
+  if (!std::isfinite(axis_x) || !std::isfinite(axis_y) || std::abs(axis_z) > 0.5 || std::abs(right_z) > 0.5) return std::nullopt;
+  c.mount = {checkedCoordinate(pose.x(), where, "camera x"), checkedCoordinate(pose.y(), where, "camera y"), std::atan2(axis_y, axis_x)};
+  return c;
+}
 
 CameraImage toGray(const mrpt::img::CImage& src, double t, const std::string& label, const std::string& where) {
   mrpt::img::CImage gray;

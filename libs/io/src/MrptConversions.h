@@ -4,6 +4,10 @@
 #include <mrpt/obs/CObservation.h>
 #include <mrpt/img/CImage.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/img/TCamera.h>
+#include <mrpt/poses/CPose3D.h>
+
+#include <optional>
 
 #include "urbanslam/io/Measurements.h"
 
@@ -30,6 +34,16 @@ LaserScan fromMrptScan(const mrpt::obs::CObservation2DRangeScan& o, const std::s
 
 // Any measurement as an MRPT observation.
 mrpt::obs::CObservation::Ptr toMrpt(const Measurement& m);
+
+// A camera's calibration as MRPT's CObservationImage holds it: intrinsics in cameraParams, and
+// cameraPose in MRPT's camera frame (+Z the optical axis, +X right, +Y down) on the vehicle.
+void toMrptCamera(const CameraCalibration& c, int width, int height, mrpt::img::TCamera& params, mrpt::poses::CPose3D& pose);
+// The calibration of an image `width` x `height`, or none when the log did not set one (fx or fy
+// not positive) or the camera is not level (optical axis or rows tilted more than 30 degrees):
+// the planar relative pose needs a level camera. Throws common::InputError (with `where`) for
+// non-finite or out-of-range values.
+std::optional<CameraCalibration> fromMrptCamera(const mrpt::img::TCamera& params, const mrpt::poses::CPose3D& pose, int width,
+                                                int height, const std::string& where);
 
 // An MRPT image (colour or gray, embedded or stored externally) as our 8-bit gray CameraImage.
 // Throws common::InputError (with `where`) when an external image cannot be loaded.

@@ -180,7 +180,9 @@ struct RawlogReader::Impl {
       pending.emplace_back(OdometryReading{t, odom});
       have_odom = true;
     } else if (auto im = std::dynamic_pointer_cast<CObservationImage>(obs)) {
-      pending.emplace_back(detail::toGray(im->image, t, im->sensorLabel, where()));
+      CameraImage img = detail::toGray(im->image, t, im->sensorLabel, where());
+      img.calibration = detail::fromMrptCamera(im->cameraParams, im->cameraPose, img.width, img.height, w);
+      pending.emplace_back(std::move(img));
     } else if (auto st = std::dynamic_pointer_cast<CObservationStereoImages>(obs)) {
       pending.emplace_back(detail::toGray(st->imageLeft, t, st->sensorLabel, where()));
     } else if (auto daq = std::dynamic_pointer_cast<CObservationRawDAQ>(obs);

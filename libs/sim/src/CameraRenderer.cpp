@@ -161,6 +161,8 @@ io::CameraImage CameraRenderer::render(uint64_t index, double timestamp, const c
   img.width = w;
   img.height = hgt;
   img.pixels = std::move(pixels);
+  // The renderer's pixel centres sit at +0.5; OpenCV's at integers.
+  img.calibration = io::CameraCalibration{fx_, fx_, cx_ - 0.5, cy_ - 0.5, cameraMount(options_)};
   return img;
 }
 

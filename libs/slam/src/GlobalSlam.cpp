@@ -189,17 +189,27 @@ void GlobalSlam::recoverAll() {
   for (auto* o : observers_) o->onPosesUpdated({&poses});
 }
 
-void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double score) {
+void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double score, const std::optional<CameraMeasurement>& camera) {
   ++stats_.image_proposals;
   ImageMatchEvent ev{current, earlier, score, false, ""};
   const bool filter = map_.filter() != nullptr;
-  if (filter && options_.loop_closure.enabled && map_.keyframes()[earlier].hasScan() && map_.keyframes()[current].hasScan()) {
-    // The same path as a laser candidate: alignment, gating, confirmation by a second closure.
+  const bool scans = map_.keyframes()[earlier].hasScan() && map_.keyframes()[current].hasScan();
+  const bool measured = camera && camera->relative.valid;
+  if (filter && options_.loop_closure.enabled && (scans || measured)) {
+    // The same path as a laser candidate: alignment of the scans when both keyframes have one,
+    // else the camera's own relative pose; then gating and confirmation by a second closure.
     common::Stopwatch sw;
     expirePending(current);
     const bool confirm = options_.loop_closure.confirm_window > 0;
     const Detection detection{"image", score};
-    LoopClosureRecord r = closer_.tryClose(*map_.filter(), map_.keyframes(), earlier, current, !confirm, &detection);
+    esdf::Esdf& f = *map_.filter();
+    LoopClosureRecord r;
+    if (scans) {
+      r = closer_.tryClose(f, map_.keyframes(), earlier, current, !confirm, &detection);
+    } else {
+      const esdf::RelativeFactor factor = cameraFactor(*camera, f.mean(static_cast<int>(earlier)), f.mean(static_cast<int>(current)));
+      r = closer_.tryCloseMeasured(f, map_.keyframes(), earlier, current, factor.z, factor.omega, !confirm, detection);
+    }
     ++stats_.closures_tried;
     const ClosureReason reason = r.reason;
     const Admission a = admit(std::move(r), current);
@@ -210,7 +220,7 @@ void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double scor
     if (ev.accepted) recoverAll();
     stats_.closure_ms.push_back(sw.milliseconds());
   } else {
-    // Without scans (or a filter) the pair cannot be aligned: a proposal on record, never a
+    // Neither scans nor a camera relative pose (or no filter): a proposal on record, never a
     // constraint.
     LoopClosureRecord r;
     r.from = earlier;
@@ -221,6 +231,7 @@ void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double scor
     r.score = score;
     r.reason = !filter                          ? ClosureReason::NoFilter
                : !options_.loop_closure.enabled ? ClosureReason::LoopClosureDisabled
+               : camera                         ? ClosureReason::CameraGeometry
                                                 : ClosureReason::NoScans;
     ev.fate = reasonName(r.reason);
     reportClosure(r);

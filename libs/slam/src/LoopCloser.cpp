@@ -38,6 +38,8 @@ const char* reasonName(ClosureReason reason) {
       return "unconfirmed";
     case ClosureReason::NoScans:
       return "no_scans";
+    case ClosureReason::CameraGeometry:
+      return "camera_geometry";
     case ClosureReason::NoFilter:
       return "no_filter";
     case ClosureReason::LoopClosureDisabled:
@@ -207,6 +209,28 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
   } else {
     gate = filter.gateRelative(static_cast<int>(earlier), static_cast<int>(current), esdf::toVec(a.transform), r.information);
   }
+  r.mahalanobis2 = gate.mahalanobis2;
+  r.gate_threshold = gate.threshold;
+  r.accepted = gate.accepted;
+  if (!r.accepted) r.reason = ClosureReason::Gating;
+  return r;
+}
+
+LoopClosureRecord LoopCloser::tryCloseMeasured(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current,
+                                               const esdf::Vec3& z, const Eigen::Matrix3d& information, bool commit,
+                                               const Detection& detection) {
+  LoopClosureRecord r;
+  r.from = earlier;
+  r.to = current;
+  r.from_time = keyframes[earlier].timestamp;
+  r.to_time = keyframes[current].timestamp;
+  r.detector = detection.detector;
+  r.score = detection.score;
+  r.prior_sigma_m = largestPositionSigma(relativeCovariance(filter, earlier, current));
+  r.measurement = esdf::toPose(z);
+  r.information = information;
+  const esdf::GateResult gate = commit ? filter.observeRelative(static_cast<int>(earlier), static_cast<int>(current), z, information, true).gate
+                                       : filter.gateRelative(static_cast<int>(earlier), static_cast<int>(current), z, information);
   r.mahalanobis2 = gate.mahalanobis2;
   r.gate_threshold = gate.threshold;
   r.accepted = gate.accepted;

@@ -6,6 +6,7 @@
 #include "urbanslam/common/Timing.h"
 #include "urbanslam/slam/Pipeline.h"
 #include "urbanslam/vision_loop/LoopDetector.h"
+#include "urbanslam/vision_loop/PlanarRelativePose.h"
 #include "urbanslam/vision_loop/VocabularyFile.h"
 
 namespace urbanslam::slam {
@@ -57,7 +58,27 @@ void Pipeline::attachImage(const AssignedImage& assigned) {
   kf.image_words = bag;
   const vision_loop::LoopResult r = image_detector_->process(std::move(features), std::move(bag));
   image_keyframes_.push_back(assigned.keyframe);
-  if (r.detected()) global_.proposeImageClosure(image_keyframes_[r.match], assigned.keyframe, r.normalized_score);
+  image_cameras_.push_back({im.calibration, im.width});
+  if (r.detected()) global_.proposeImageClosure(image_keyframes_[r.match], assigned.keyframe, r.normalized_score, measureCamera(r.match, r.query));
+}
+
+std::optional<CameraMeasurement> Pipeline::measureCamera(size_t earlier, size_t current) const {
+  const ImageCamera& a = image_cameras_[earlier];
+  const ImageCamera& b = image_cameras_[current];
+  if (!a.calibration || !b.calibration) return std::nullopt;
+  // One camera seen twice: the relative pose of two different cameras is not this measurement.
+  const auto& ca = *a.calibration;
+  const auto& cb = *b.calibration;
+  if (a.width != b.width || ca.fx_px != cb.fx_px || ca.fy_px != cb.fy_px || ca.cx_px != cb.cx_px || ca.cy_px != cb.cy_px ||
+      ca.mount.x != cb.mount.x || ca.mount.y != cb.mount.y || ca.mount.phi != cb.mount.phi)
+    return std::nullopt;
+  const vision_loop::ImageFeatures& fa = image_detector_->features(static_cast<vision_loop::ImageId>(earlier));
+  const vision_loop::ImageFeatures& fb = image_detector_->features(static_cast<vision_loop::ImageId>(current));
+  CameraMeasurement m;
+  m.mount = cb.mount;
+  m.relative = vision_loop::planarRelativePose(fa, fb, image_detector_->vocabulary().descriptorType(),
+                                               pinholeFor(cb, b.width, fb.image_size.width));
+  return m;
 }
 
 }  // namespace urbanslam::slam

@@ -3,6 +3,7 @@
 // accumulated pose in the odometry frame (rawlog actions carry increments; readers chain them),
 // so consumers never care which layout the file had.
 #include <memory>
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
@@ -24,6 +25,15 @@ struct DriveReading {
   double steering_rad = 0;
 };
 
+// A calibrated camera, level on the vehicle: pinhole intrinsics (OpenCV's convention: the centre
+// of the top-left pixel is (0, 0)) of the image as delivered, and the camera's pose in the
+// vehicle frame, its heading being the direction of the optical axis. Enough to turn two images
+// into a planar relative pose of the vehicle (vision_loop/PlanarRelativePose.h).
+struct CameraCalibration {
+  double fx_px = 0, fy_px = 0, cx_px = 0, cy_px = 0;
+  common::Pose2 mount;
+};
+
 // 8-bit grayscale image. Pixels are loaded eagerly by the readers (images stored externally
 // beside a rawlog are resolved against the rawlog's "<name>_Images" folder).
 struct CameraImage {
@@ -32,6 +42,7 @@ struct CameraImage {
   std::string source;  // file name the image came from, or "" when embedded
   int width = 0, height = 0;
   std::shared_ptr<const std::vector<uint8_t>> pixels;  // row-major, width*height
+  std::optional<CameraCalibration> calibration;        // when the log or the simulator gives one
 };
 
 // A position fix in local metres (Victoria Park's GPS.txt).

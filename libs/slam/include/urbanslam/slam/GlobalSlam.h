@@ -8,8 +8,10 @@
 #include <array>
 #include <deque>
 #include <memory>
+#include <optional>
 #include <vector>
 
+#include "urbanslam/slam/CameraClosure.h"
 #include "urbanslam/slam/LocalSlam.h"
 #include "urbanslam/slam/LoopCloser.h"
 #include "urbanslam/slam/Map.h"
@@ -37,8 +39,10 @@ class GlobalSlam {
   // Loop closures of keyframe `current` with earlier ones, when [loop_closure] asks for it now.
   void closeLoops(size_t current);
   // A Tree of Words proposal between two keyframes, through alignment, gating and confirmation
-  // when both have scans (else recorded with the reason it cannot be); observers hear its fate.
-  void proposeImageClosure(size_t earlier, size_t current, double score);
+  // when both have scans, else through gating and confirmation with the camera's relative pose
+  // (`camera`: when both images are calibrated; invalid when the images gave none); otherwise
+  // recorded with the reason it cannot be. Observers hear its fate.
+  void proposeImageClosure(size_t earlier, size_t current, double score, const std::optional<CameraMeasurement>& camera);
   // End of input: hypotheses still awaiting confirmation are dropped, the last poses recovered.
   void finish();
 

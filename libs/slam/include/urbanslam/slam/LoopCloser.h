@@ -28,7 +28,8 @@ enum class ClosureReason {
   FreeSpace,            // one scan's points lie where the other scan's beams passed through
   Gating,               // the innovation gate refused it
   Unconfirmed,          // no second closure agreed with it in time
-  NoScans,              // an image proposal between keyframes without laser scans
+  NoScans,              // an image proposal between keyframes without laser scans (nor a calibrated camera)
+  CameraGeometry,       // an image proposal whose images gave no relative pose (too few inliers, degenerate)
   NoFilter,             // an image proposal in dead reckoning
   LoopClosureDisabled,  // an image proposal with [loop_closure] enabled = false
 };
@@ -74,6 +75,10 @@ class LoopCloser {
   // added to the filter; without, it is only tested (accepted = passed) for later confirmation.
   LoopClosureRecord tryClose(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current, bool commit = true,
                              const Detection* detection = nullptr);
+  // Gating (and with `commit` the update) of a relative-pose factor measured by another sensor
+  // (the camera: CameraClosure.h) in place of a scan alignment.
+  LoopClosureRecord tryCloseMeasured(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current,
+                                     const esdf::Vec3& z, const Eigen::Matrix3d& information, bool commit, const Detection& detection);
 
  private:
   Eigen::Matrix3d relativeCovariance(esdf::Esdf& filter, size_t i, size_t k);

@@ -65,6 +65,9 @@ class Pipeline {
   void startImageDetector();  // [loop_closure] image_detector, at the first image
   void onCameraImage(const io::CameraImage& image, double progress);
   void attachImage(const AssignedImage& assigned);
+  // The camera's relative pose between two database images, when both are calibrated (the
+  // same camera); invalid when the images give none.
+  std::optional<CameraMeasurement> measureCamera(size_t earlier_image, size_t current_image) const;
   bool acceptLabel(const std::string& label) const;
   void applyRangeLimits(io::LaserScan& scan) const;
 
@@ -78,6 +81,11 @@ class Pipeline {
   GlobalSlam global_;
   std::unique_ptr<vision_loop::LoopDetector> image_detector_;  // [loop_closure] image_detector = tree_of_words
   std::vector<size_t> image_keyframes_;                        // image database id -> keyframe
+  struct ImageCamera {
+    std::optional<io::CameraCalibration> calibration;
+    int width = 0;  // of the image the calibration is for
+  };
+  std::vector<ImageCamera> image_cameras_;  // image database id -> its camera
   KeyframeImageAssigner images_;
   bool have_first_ts_ = false;
 };

@@ -83,6 +83,9 @@ class LoopDetector {
   const Vocabulary& vocabulary() const { return *vocabulary_; }
   const FeatureExtractor& extractor() const { return extractor_; }
   const LoopDetectorOptions& options() const { return options_; }
+  // The features of an image in the database (kept for geometric verification), so a detected
+  // pair can be measured as well (PlanarRelativePose.h) without extracting them again.
+  const ImageFeatures& features(ImageId id) const { return frames_.at(id); }
   // Verification results keyed by (query, match), shared between detectors fed the same frames
   // (a threshold sweep verifies each pair once).
   void shareVerificationCache(std::shared_ptr<VerificationCache> cache) { cache_ = std::move(cache); }

@@ -1,0 +1,89 @@
+// The camera's bearing + heading as a factor on the vehicle poses (slam/CameraClosure.h), against
+// the geometry computed directly: the bearing and heading of camera j seen from camera i, for
+// cameras mounted off the vehicle's origin and turned (a side camera).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "urbanslam/esdf/PoseOps.h"
+#include "urbanslam/slam/CameraClosure.h"
+
+namespace urbanslam::slam {
+namespace {
+
+using esdf::Vec3;
+
+// What the camera sees between the vehicle poses: (bearing, heading) of camera j from camera i.
+Eigen::Vector2d seen(const Vec3& xi, const Vec3& xj, const Vec3& mount) {
+  const Vec3 c = esdf::between(esdf::compose(xi, mount), esdf::compose(xj, mount));
+  return {std::atan2(c.y(), c.x()), c.z()};
+}
+
+double chi2(const esdf::RelativeFactor& f, const Vec3& xi, const Vec3& xj) {
+  const Vec3 e = esdf::relativePoseError(xi, xj, f.z);
+  return e.dot(f.omega * e);
+}
+
+TEST(CameraFactor, WeighsTheCameraBearingAndHeadingNotTheRange) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const double sb = 0.02, sh = 0.004;  // rad
+  for (int trial = 0; trial < 50; ++trial) {
+    const Vec3 mount(1.0 + 0.5 * u(rng), 0.4 * u(rng), M_PI / 2 + 0.3 * u(rng));
+    const Vec3 xi(30 * u(rng), 30 * u(rng), M_PI * u(rng));
+    const Vec3 xj = esdf::compose(xi, Vec3(8 + 10 * u(rng), 6 * u(rng), 0.5 * u(rng)));
+    const Eigen::Vector2d truth = seen(xi, xj, mount);
+    CameraMeasurement m;
+    m.mount = esdf::toPose(mount);
+    m.relative.valid = true;
+    m.relative.bearing_rad = truth(0);
+    m.relative.heading_rad = truth(1);
+    m.relative.cov = Eigen::Vector2d(sb * sb, sh * sh).asDiagonal();
+    const esdf::RelativeFactor f = cameraFactor(m, xi, xj);
+    EXPECT_LT(chi2(f, xi, xj), 1e-12);
+
+    const Vec3 ci = esdf::compose(xi, mount), cj = esdf::compose(xj, mount);
+    const Vec3 c = esdf::between(ci, cj);
+    const double range = std::hypot(c.x(), c.y()), bearing = std::atan2(c.y(), c.x());
+    const auto vehicleAt = [&](const Vec3& camera_rel) { return esdf::compose(esdf::compose(ci, camera_rel), esdf::inverse(mount)); };
+    // Camera j moved sideways by a small bearing change d (same range and heading): (d / sb)^2.
+    const double d = 0.5 * sb;
+    const Vec3 turned(range * std::cos(bearing + d), range * std::sin(bearing + d), c.z());
+    const Vec3 xj_b = vehicleAt(turned);
+    EXPECT_NEAR(seen(xi, xj_b, mount)(0) - truth(0), d, 1e-9);
+    EXPECT_NEAR(chi2(f, xi, xj_b), (d / sb) * (d / sb), 0.02 * (d / sb) * (d / sb));
+    // Camera j turned by a small angle in place: (d / sh)^2.
+    const double dh = 0.5 * sh;
+    const Vec3 xj_h = vehicleAt(Vec3(c.x(), c.y(), c.z() + dh));
+    EXPECT_NEAR(chi2(f, xi, xj_h), (dh / sh) * (dh / sh), 0.02 * (dh / sh) * (dh / sh));
+    // Camera j moved along the bearing by a metre: the camera cannot see it; the factor adds
+    // next to nothing (the odometry carries the scale).
+    const Vec3 xj_r = vehicleAt(Vec3((range + 1) * std::cos(bearing), (range + 1) * std::sin(bearing), c.z()));
+    EXPECT_LT(chi2(f, xi, xj_r), 1e-4);
+  }
+}
+
+TEST(CameraFactor, PinholeOfADownscaledImageProjectsTheSameRays) {
+  io::CameraCalibration c;
+  c.fx_px = 320;
+  c.fy_px = 330;
+  c.cx_px = 319.5;
+  c.cy_px = 359.5;
+  const auto full = pinholeFor(c, 640, 640);
+  const auto half = pinholeFor(c, 640, 320);
+  EXPECT_DOUBLE_EQ(full.fx, 320);
+  EXPECT_DOUBLE_EQ(full.cx, 319.5);
+  // A pixel edge at u in the full image is at u / 2 in the half image: a ray through the full
+  // image's point (u, v) (pixel centres at integers) passes the half image at ((u + 0.5) / 2 - 0.5, ...).
+  for (double u : {0.0, 100.0, 639.0})
+    for (double v : {0.0, 250.0, 479.0}) {
+      const double xn = (u - full.cx) / full.fx, yn = (v - full.cy) / full.fy;
+      const double uh = (u + 0.5) / 2 - 0.5, vh = (v + 0.5) / 2 - 0.5;
+      EXPECT_NEAR((uh - half.cx) / half.fx, xn, 1e-12);
+      EXPECT_NEAR((vh - half.cy) / half.fy, yn, 1e-12);
+    }
+}
+
+}  // namespace
+}  // namespace urbanslam::slam
