@@ -8,6 +8,7 @@
 #include "urbanslam/common/Timing.h"
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/esdf/Recovery.h"
+#include "urbanslam/slam/CameraMotion.h"
 #include "urbanslam/vision_loop/LoopDetector.h"
 
 namespace urbanslam::slam {
@@ -162,14 +163,20 @@ void Pipeline::onScan(io::LaserScan scan, double progress) {
   for (auto* o : observers_) o->onStep(ev);
 }
 
-void Pipeline::addKeyframe(io::LaserScan scan) {
+void Pipeline::addKeyframe(io::LaserScan scan, const std::optional<CameraMeasurement>& camera_motion) {
   const size_t k = map_.size();
   // 1. The previous keyframe's image is final once this keyframe exists (it may be nearer in time).
   if (auto done = images_.keyframeAdded(k, scan.timestamp)) attachImage(*done);
   // 2. Local SLAM: the motion since the previous keyframe, refined by the submap match.
-  const KeyframeConstraint c = local_.keyframeConstraint(scan, map_);
+  KeyframeConstraint c = local_.keyframeConstraint(scan, map_);
   if (c.match == KeyframeConstraint::Match::Used) ++stats_.scan_matches_used;
   if (c.match == KeyframeConstraint::Match::Rejected) ++stats_.scan_matches_rejected;
+  //    Without scans, the camera's view of the motion refines it instead.
+  if (camera_motion && !map_.empty()) {
+    const CameraMotionResult r = fuseCameraMotion(c, *camera_motion, 1.0 - options_.local.odometry_outlier_probability);
+    c = r.constraint;
+    ++(r.used ? stats_.camera_motions_used : stats_.camera_motions_rejected);
+  }
   // 3. Global SLAM: the keyframe into the filter as a delayed pose.
   const double timestamp = scan.timestamp;
   const std::array<double, 9> cov = global_.addKeyframe(Keyframe{k, timestamp, {}, std::move(scan), false, {}}, c);

@@ -29,13 +29,23 @@ void Pipeline::onCameraImage(const io::CameraImage& image, double progress) {
     return;
   }
   // No laser so far (a camera-only log): every image is a keyframe, without motion if there is
-  // no odometry, so loop proposals can still be found and reported.
+  // no odometry, so loop proposals can still be found and reported. With a calibrated camera,
+  // its view of the motion since the previous keyframe's image refines the odometry.
   common::Stopwatch sw;
+  std::optional<PreparedImage> prepared;
+  std::optional<CameraMeasurement> camera_motion;
+  if (image_detector_) {
+    prepared = prepareImage(image);
+    const size_t previous = image_keyframes_.size();
+    if (previous > 0 && image_keyframes_.back() + 1 == map_.size())
+      camera_motion = measureCamera(image_cameras_[previous - 1], image_detector_->features(static_cast<vision_loop::ImageId>(previous - 1)),
+                                    {image.calibration, image.width}, prepared->features);
+  }
   io::LaserScan none;
   none.timestamp = image.timestamp;
   none.label = image.label;
-  addKeyframe(std::move(none));
-  attachImage(images_.imageKeyframe(map_.size() - 1, image));
+  addKeyframe(std::move(none), camera_motion);
+  attachImage(images_.imageKeyframe(map_.size() - 1, image), std::move(prepared));
   const double ms = sw.milliseconds();
   stats_.keyframe_ms.push_back(ms);
   stats_.recordStep(ms, map_.size());
@@ -43,7 +53,15 @@ void Pipeline::onCameraImage(const io::CameraImage& image, double progress) {
   for (auto* o : observers_) o->onStep(ev);
 }
 
-void Pipeline::attachImage(const AssignedImage& assigned) {
+Pipeline::PreparedImage Pipeline::prepareImage(const io::CameraImage& im) const {
+  const cv::Mat gray(im.height, im.width, CV_8U, const_cast<uint8_t*>(im.pixels->data()));
+  PreparedImage p;
+  p.features = image_detector_->extractor().extract(gray);
+  p.words = image_detector_->vocabulary().transform(p.features.descriptors);
+  return p;
+}
+
+void Pipeline::attachImage(const AssignedImage& assigned, std::optional<PreparedImage> prepared) {
   Keyframe& kf = map_.keyframe(assigned.keyframe);
   kf.has_image = true;
   ++stats_.image_keyframes;
@@ -52,19 +70,20 @@ void Pipeline::attachImage(const AssignedImage& assigned) {
   // Words once per keyframe: kept on the keyframe (the pixels are not), then queried against
   // and added to the database.
   const io::CameraImage& im = assigned.image;
-  const cv::Mat gray(im.height, im.width, CV_8U, const_cast<uint8_t*>(im.pixels->data()));
-  vision_loop::ImageFeatures features = image_detector_->extractor().extract(gray);
-  vision_loop::BagOfWords bag = image_detector_->vocabulary().transform(features.descriptors);
-  kf.image_words = bag;
-  const vision_loop::LoopResult r = image_detector_->process(std::move(features), std::move(bag));
+  if (!prepared) prepared = prepareImage(im);
+  kf.image_words = prepared->words;
+  const vision_loop::LoopResult r = image_detector_->process(std::move(prepared->features), std::move(prepared->words));
   image_keyframes_.push_back(assigned.keyframe);
   image_cameras_.push_back({im.calibration, im.width});
-  if (r.detected()) global_.proposeImageClosure(image_keyframes_[r.match], assigned.keyframe, r.normalized_score, measureCamera(r.match, r.query));
+  if (!r.detected()) return;
+  const auto id = [](size_t i) { return static_cast<vision_loop::ImageId>(i); };
+  global_.proposeImageClosure(image_keyframes_[r.match], assigned.keyframe, r.normalized_score,
+                              measureCamera(image_cameras_[r.match], image_detector_->features(id(r.match)), image_cameras_[r.query],
+                                            image_detector_->features(id(r.query))));
 }
 
-std::optional<CameraMeasurement> Pipeline::measureCamera(size_t earlier, size_t current) const {
-  const ImageCamera& a = image_cameras_[earlier];
-  const ImageCamera& b = image_cameras_[current];
+std::optional<CameraMeasurement> Pipeline::measureCamera(const ImageCamera& a, const vision_loop::ImageFeatures& fa, const ImageCamera& b,
+                                                         const vision_loop::ImageFeatures& fb) const {
   if (!a.calibration || !b.calibration) return std::nullopt;
   // One camera seen twice: the relative pose of two different cameras is not this measurement.
   const auto& ca = *a.calibration;
@@ -72,8 +91,6 @@ std::optional<CameraMeasurement> Pipeline::measureCamera(size_t earlier, size_t 
   if (a.width != b.width || ca.fx_px != cb.fx_px || ca.fy_px != cb.fy_px || ca.cx_px != cb.cx_px || ca.cy_px != cb.cy_px ||
       ca.mount.x != cb.mount.x || ca.mount.y != cb.mount.y || ca.mount.phi != cb.mount.phi)
     return std::nullopt;
-  const vision_loop::ImageFeatures& fa = image_detector_->features(static_cast<vision_loop::ImageId>(earlier));
-  const vision_loop::ImageFeatures& fb = image_detector_->features(static_cast<vision_loop::ImageId>(current));
   CameraMeasurement m;
   m.mount = cb.mount;
   m.relative = vision_loop::planarRelativePose(fa, fb, image_detector_->vocabulary().descriptorType(),

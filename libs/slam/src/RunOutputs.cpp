@@ -150,6 +150,8 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   c["map_points"] = pts.size();
   c["scan_matches_used"] = s.scan_matches_used;
   c["scan_matches_rejected"] = s.scan_matches_rejected;
+  c["camera_motions_used"] = s.camera_motions_used;
+  c["camera_motions_rejected"] = s.camera_motions_rejected;
   c["scans_anchored"] = s.scans_anchored;
   c["loop_closures_tried"] = s.closures_tried;
   c["loop_closures_accepted"] = s.closures_accepted;

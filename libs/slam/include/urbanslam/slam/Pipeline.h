@@ -15,6 +15,8 @@
 #include "urbanslam/slam/Observer.h"
 #include "urbanslam/slam/PipelineOptions.h"
 #include "urbanslam/slam/PipelineStats.h"
+#include "urbanslam/vision_loop/BagOfWords.h"
+#include "urbanslam/vision_loop/FeatureExtractor.h"
 
 namespace urbanslam::vision_loop {
 class LoopDetector;
@@ -60,14 +62,26 @@ class Pipeline {
  private:
   bool stepOnce(io::DataSource& source);
   void onScan(io::LaserScan scan, double progress);
-  void addKeyframe(io::LaserScan scan);
-  // Camera images (PipelineImages.cpp): attachment to keyframes, Tree of Words proposals.
+  // `camera_motion`: the camera's view of the motion since the previous keyframe (camera-only logs).
+  void addKeyframe(io::LaserScan scan, const std::optional<CameraMeasurement>& camera_motion = std::nullopt);
+  // Camera images (PipelineImages.cpp): attachment to keyframes, Tree of Words proposals, the
+  // camera's relative poses.
+  struct PreparedImage {
+    vision_loop::ImageFeatures features;
+    vision_loop::BagOfWords words;
+  };
+  struct ImageCamera {
+    std::optional<io::CameraCalibration> calibration;
+    int width = 0;  // of the image the calibration is for
+  };
   void startImageDetector();  // [loop_closure] image_detector, at the first image
   void onCameraImage(const io::CameraImage& image, double progress);
-  void attachImage(const AssignedImage& assigned);
-  // The camera's relative pose between two database images, when both are calibrated (the
-  // same camera); invalid when the images give none.
-  std::optional<CameraMeasurement> measureCamera(size_t earlier_image, size_t current_image) const;
+  PreparedImage prepareImage(const io::CameraImage& image) const;
+  void attachImage(const AssignedImage& assigned, std::optional<PreparedImage> prepared = std::nullopt);
+  // The camera's relative pose between two images, when both are calibrated (the same camera);
+  // invalid when the images give none.
+  std::optional<CameraMeasurement> measureCamera(const ImageCamera& a, const vision_loop::ImageFeatures& fa, const ImageCamera& b,
+                                                 const vision_loop::ImageFeatures& fb) const;
   bool acceptLabel(const std::string& label) const;
   void applyRangeLimits(io::LaserScan& scan) const;
 
@@ -81,10 +95,6 @@ class Pipeline {
   GlobalSlam global_;
   std::unique_ptr<vision_loop::LoopDetector> image_detector_;  // [loop_closure] image_detector = tree_of_words
   std::vector<size_t> image_keyframes_;                        // image database id -> keyframe
-  struct ImageCamera {
-    std::optional<io::CameraCalibration> calibration;
-    int width = 0;  // of the image the calibration is for
-  };
   std::vector<ImageCamera> image_cameras_;  // image database id -> its camera
   KeyframeImageAssigner images_;
   bool have_first_ts_ = false;

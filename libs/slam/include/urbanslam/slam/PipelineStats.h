@@ -8,6 +8,7 @@ namespace urbanslam::slam {
 struct PipelineStats {
   size_t measurements = 0, scans = 0, scans_used = 0, odometry = 0, drive = 0, images = 0, gps = 0, reference = 0, keyframes = 0;
   size_t scan_matches_used = 0, scan_matches_rejected = 0;
+  size_t camera_motions_used = 0, camera_motions_rejected = 0;  // camera-only keyframes: the camera's view of the motion
   size_t scans_anchored = 0;  // scans between keyframes placed by a submap match ([local] match_every_scan)
   size_t closures_tried = 0, closures_accepted = 0, closures_rejected = 0;
   size_t image_keyframes = 0;  // keyframes with an image attached
