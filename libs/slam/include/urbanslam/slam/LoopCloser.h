@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "urbanslam/alignment/Aligner.h"
+#include "urbanslam/common/BinaryStream.h"
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/io/LaserScan.h"
 #include "urbanslam/slam/KeyframeGrid.h"
@@ -74,6 +75,11 @@ class LoopCloser {
   // added to the filter; without, it is only tested (accepted = passed) for later confirmation.
   LoopClosureRecord tryClose(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current, bool commit = true,
                              const Detection* detection = nullptr);
+
+  // The relative covariances kept for the current keyframe (a later image proposal for it
+  // reuses them). The scorer is code: whoever set it sets it again.
+  void writeState(common::BinaryWriter& w) const;
+  void readState(common::BinaryReader& r);
 
  private:
   Eigen::Matrix3d relativeCovariance(esdf::Esdf& filter, size_t i, size_t k);
