@@ -359,7 +359,7 @@ void MainFrame::buildMenus() {
         const std::string dir = dlg.GetPath().ToStdString();
         try {
           worker_->withPipeline([&](const slam::Pipeline& p) {
-            slam::writeRunOutputs(p, dir, {worker_->logPath(), worker_->inputFormat(), worker_->iniPath(), worker_->resolvedIni()});
+            slam::writeRunOutputs(p, dir, {worker_->logPath(), worker_->inputFormat(), worker_->iniPath(), worker_->resolvedIni(), {}, {}});
           });
           SetStatusText("exported to " + dir, 0);
         } catch (const std::exception& e) {

@@ -9,6 +9,7 @@
 #include "urbanslam/common/Progress.h"
 #include "urbanslam/sim/SimOptions.h"
 #include "urbanslam/sim/SimulatedSource.h"
+#include "urbanslam/slam/MapFile.h"
 #include "urbanslam/slam/Pipeline.h"
 #include "urbanslam/slam/RunOutputs.h"
 
@@ -31,7 +32,7 @@ class ProgressObserver : public slam::PipelineObserver {
 }  // namespace
 
 int runCommand(const Argv& args) {
-  ArgParser ap("urbanslam run [--ini FILE] [--out DIR] [--quiet] [--json] [LOG | --simulate CITY_INI]",
+  ArgParser ap("urbanslam run [--ini FILE] [--out DIR] [--quiet] [--json] [--resume MAP] [LOG | --simulate CITY_INI]",
                "Builds a map and trajectory from a log: MRPT rawlog (either layout, gzipped or not),\n"
                "CARMEN log (raw or Freiburg-corrected), GMapping gfs log, Victoria Park (folder or zip) or a\n"
                "folder of camera images (one keyframe per image; image loop proposals need [loop_closure] image_detector).");
@@ -39,14 +40,19 @@ int runCommand(const Argv& args) {
   ap.addOption("simulate", "CITY_INI",
                "map a simulated city drive streamed straight from the simulator (no file; see\n"
                "`urbanslam simulate`) instead of a LOG");
-  ap.addOption("ini", "FILE", "configuration (see ini/default.ini for every key)", "ini/default.ini");
+  ap.addOption("ini", "FILE", "configuration (see ini/default.ini for every key); with --resume: the map's own by default",
+               "ini/default.ini");
+  ap.addOption("resume", "MAP",
+               "continue the map of an earlier run (its map.usmap, or its output folder) with LOG, which\n"
+               "must start where that run's log ended (e.g. the rest of a split log); the result is that of\n"
+               "one run over both. An --ini may change only [map] and [output] keys");
   ap.addOption("out", "DIR", "output folder (created if needed)", "out");
   ap.addFlag("quiet", "no progress bar and no summary on stderr");
   ap.addFlag("json", "print stats.json as one JSON object on stdout");
   ap.addEpilog(
       "outputs in DIR: trajectory_keyframes.tum, trajectory_odometry.tum, trajectory_scans.tum (every\n"
       "scan placed by matching), reference.tum (when the log has one), map.ply/.pcd/.xyz,\n"
-      "map.simplemap, grid.png + grid.yaml, pose_graph.g2o,\n"
+      "map.simplemap, grid.png + grid.yaml, pose_graph.g2o, map.usmap (the state --resume continues),\n"
       "loop_closures.csv (every hypothesis, laser or image, and its fate), config.ini, stats.json.\n"
       "DIR appears complete at the end (written beside it, then swapped in): it is replaced only when\n"
       "it is empty or holds an earlier run.");
@@ -54,37 +60,53 @@ int runCommand(const Argv& args) {
 
   if (ap.has("simulate") && !ap.positional("LOG").empty())
     throw common::InputError("run: give either a LOG or --simulate CITY_INI, not both");
+  if (ap.has("resume") && !ap.has("simulate") && ap.positional("LOG").empty())
+    throw common::InputError("run --resume: give the LOG that continues the map");
   const std::string log = ap.has("simulate")             ? ap.option("simulate")
                           : ap.positional("LOG").empty() ? defaultRawlog()
                                                          : ap.positional("LOG");
-  const std::string ini = ap.has("ini") ? ap.option("ini") : defaultIni();
   const bool quiet = ap.flag("quiet");
+  const std::string map = ap.has("resume") ? slam::mapFilePath(ap.option("resume")) : "";
+  // Resuming without --ini keeps the map's own options.
+  std::string ini = ap.has("ini") ? ap.option("ini") : map.empty() ? defaultIni() : "";
   std::string resolved;
-  slam::PipelineOptions options = slam::loadPipelineOptions(ini, &resolved);
-  slam::resolveDefaultPaths(options, projectHome());
+  slam::PipelineOptions options;
+  if (!ini.empty()) {
+    options = slam::loadPipelineOptions(ini, &resolved);
+    slam::resolveDefaultPaths(options, projectHome());
+  }
+  std::unique_ptr<slam::Pipeline> pipeline =
+      map.empty() ? std::make_unique<slam::Pipeline>(options) : slam::loadMap(map, ini.empty() ? nullptr : &options);
+  if (ini.empty()) {
+    resolved = slam::optionsToIni(pipeline->options());
+    ini = map + " (its saved options)";
+  }
 
   // The simulator is a data source like a file reader: a drive of any length streams through.
   std::unique_ptr<io::DataSource> source =
       ap.has("simulate") ? std::make_unique<sim::SimulatedSource>(sim::loadSimOptions(log)) : io::openDataSource(log);
-  slam::Pipeline pipeline(options);
   common::ProgressBar bar("run", 1000, !quiet);
   ProgressObserver progress(bar);
-  pipeline.addObserver(&progress);
-  pipeline.run(*source);
+  pipeline->addObserver(&progress);
+  pipeline->runInput(*source);
+  // The map is saved before finish(): finish() drops the closures still awaiting confirmation,
+  // which a continued run may yet confirm.
+  std::string map_file = pipeline->keyframes().empty() ? std::string() : slam::encodeMap(*pipeline);
+  pipeline->finish(*source);
   bar.finish();
   // A log without a single keyframe has nothing to map: outputs would only look like a run.
-  if (pipeline.keyframes().empty()) {
-    const size_t scans = pipeline.stats().scans;
+  if (pipeline->keyframes().empty()) {
+    const size_t scans = pipeline->stats().scans;
     throw common::InputError(log + (scans == 0 ? ": no laser scans (nor images) in the log: nothing to map"
                                                : ": none of its " + std::to_string(scans) + " laser scans could be used: nothing to map"));
   }
 
   const std::string out = ap.option("out");
-  const common::Json stats = slam::writeRunOutputs(pipeline, out, {log, source->format(), ini, resolved});
+  const common::Json stats = slam::writeRunOutputs(*pipeline, out, {log, source->format(), ini, resolved, std::move(map_file), map});
   if (ap.flag("json")) std::cout << stats.dump() << "\n";
   if (!quiet) {
     const auto& t = stats.at("timing");
-    std::cerr << "urbanslam run: " << pipeline.stats().scans_used << " scans, " << pipeline.keyframes().size() << " keyframes, "
+    std::cerr << "urbanslam run: " << pipeline->stats().scans_used << " scans, " << pipeline->keyframes().size() << " keyframes, "
               << stats.at("counts").at("map_points").asNumber() << " map points in " << t.at("wall_s").asNumber() << " s ("
               << t.at("real_time_factor").asNumber() << "x real time)\n"
               << "outputs in " << std::filesystem::absolute(out).string() << "/ (grid.png, map.ply, "

@@ -66,7 +66,7 @@ int main(int argc, char** argv) {
     pipeline.addObserver(&rec);
     pipeline.run(*source);
     std::filesystem::create_directories(out);
-    const common::Json stats = slam::writeRunOutputs(pipeline, out, {city.empty() ? log : city, source->format(), ini, resolved});
+    const common::Json stats = slam::writeRunOutputs(pipeline, out, {city.empty() ? log : city, source->format(), ini, resolved, {}, {}});
 
     std::ofstream csv(out + "/steps.csv");
     csv << "keyframes,step_ms\n";

@@ -33,6 +33,7 @@ struct SparseCholesky::Impl {
   FillReducingOrdering ordering;
   // Pattern of the last analysed matrix: the symbolic factor is reused when it is unchanged.
   std::vector<int> last_p, last_i;
+  std::vector<double> last_x;  // its values at the last factorisation (see matrix())
 
   explicit Impl(FillReducingOrdering o) : ordering(o) {
     cholmod_start(&common);
@@ -101,6 +102,14 @@ void SparseCholesky::factorize(const InformationState& s, int first, int last) {
       colptr[3 * (p - first) + c + 1] = static_cast<int>(rowind.size());
     }
   }
+  factorizeLower(std::move(colptr), std::move(rowind), std::move(values));
+  first_ = first;
+  last_ = last;
+  stamp_ = s.structureStamp();
+}
+
+void SparseCholesky::factorizeLower(std::vector<int> colptr, std::vector<int> rowind, std::vector<double> values) {
+  const size_t n = colptr.size() - 1;
   cholmod_sparse a{};
   a.nrow = a.ncol = n;
   a.nzmax = rowind.size();
@@ -130,9 +139,45 @@ void SparseCholesky::factorize(const InformationState& s, int first, int last) {
     impl_->last_p.clear();
     throw NotPositiveDefinite("information matrix is not positive definite (CHOLMOD status " + std::to_string(cm->status) + ")");
   }
-  first_ = first;
-  last_ = last;
-  stamp_ = s.structureStamp();
+  impl_->last_x = std::move(values);
+}
+
+SparseCholesky::Matrix SparseCholesky::matrix() const {
+  Matrix m;
+  if (!impl_->factor) return m;
+  m.first = first_;
+  m.last = last_;
+  m.structure_stamp = stamp_;
+  m.colptr = impl_->last_p;
+  m.rowind = impl_->last_i;
+  m.values = impl_->last_x;
+  return m;
+}
+
+void SparseCholesky::factorize(const Matrix& m) {
+  if (m.first < 0 || m.last <= m.first) throw std::invalid_argument("factorize: bad pose range");
+  const size_t n = 3 * static_cast<size_t>(m.last - m.first);
+  if (m.colptr.size() != n + 1 || m.colptr.front() != 0 || m.rowind.size() != m.values.size() ||
+      static_cast<size_t>(m.colptr.back()) != m.rowind.size())
+    throw std::invalid_argument("factorize: inconsistent matrix sizes");
+  for (size_t c = 0; c < n; ++c) {
+    if (m.colptr[c + 1] < m.colptr[c]) throw std::invalid_argument("factorize: decreasing column pointers");
+    // Lower triangle, sorted rows, the diagonal first (as factorize(state) builds it).
+    for (int k = m.colptr[c]; k < m.colptr[c + 1]; ++k) {
+      const int r = m.rowind[static_cast<size_t>(k)];
+      if (r < static_cast<int>(c) || static_cast<size_t>(r) >= n || (k > m.colptr[c] && r <= m.rowind[static_cast<size_t>(k) - 1]))
+        throw std::invalid_argument("factorize: row index out of order");
+    }
+  }
+  // A fresh analysis of the same pattern is the one a reused analysis came from (both
+  // deterministic), so the factor is the same.
+  if (impl_->factor) cholmod_free_factor(&impl_->factor, &impl_->common);
+  impl_->last_p.clear();
+  impl_->last_i.clear();
+  factorizeLower(m.colptr, m.rowind, m.values);
+  first_ = m.first;
+  last_ = m.last;
+  stamp_ = m.structure_stamp;
 }
 
 Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& b) const {

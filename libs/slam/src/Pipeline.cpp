@@ -125,8 +125,16 @@ bool Pipeline::stepOnce(io::DataSource& source) {
 }
 
 void Pipeline::run(io::DataSource& source) {
+  runInput(source);
+  finish(source);
+}
+
+void Pipeline::runInput(io::DataSource& source) {
   while (step(source)) {
   }
+}
+
+void Pipeline::finish(const io::DataSource& source) {
   try {
     finish();
   } catch (const esdf::NotPositiveDefinite& e) {
@@ -136,6 +144,7 @@ void Pipeline::run(io::DataSource& source) {
 }
 
 void Pipeline::finish() {
+  finished_ = true;
   common::Stopwatch sw;
   if (auto last = images_.finish()) attachImage(*last);  // the last keyframe's image is final now
   global_.finish();

@@ -157,6 +157,21 @@ PipelineOptions loadPipelineOptions(const std::string& ini_path, std::string* re
   return o;
 }
 
+PipelineOptions parsePipelineOptions(const std::string& ini_text, const std::string& name) {
+  PipelineOptions o;
+  common::OptionsSchema schema;
+  declareOptions(schema, o);
+  schema.load(common::IniFile::parse(ini_text, name));
+  return o;
+}
+
+std::string optionsToIni(const PipelineOptions& options) {
+  PipelineOptions copy = options;  // the schema binds to mutable members
+  common::OptionsSchema schema;
+  declareOptions(schema, copy);
+  return schema.toIni();
+}
+
 std::string defaultLaserModelPath(const std::string& home) { return home + "/" + laser_loop::kDefaultModelPath; }
 
 std::string defaultVocabularyPath(const std::string& home) { return home + "/" + vision_loop::kDefaultVocabularyPath; }

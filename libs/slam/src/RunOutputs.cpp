@@ -10,6 +10,7 @@
 #include "urbanslam/common/Timing.h"
 #include "urbanslam/esdf/PoseGraphIO.h"
 #include "urbanslam/io/MapOutputs.h"
+#include "urbanslam/slam/MapFile.h"
 
 namespace urbanslam::slam {
 
@@ -81,6 +82,10 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
 
   writePoseGraphG2o(p, path("pose_graph.g2o"));
   files.push("pose_graph.g2o");
+  if (!info.map_file.empty()) {
+    writeMapFile(info.map_file, path(kMapFileName));
+    files.push(kMapFileName);
+  }
   {
     common::AtomicFile f(path("loop_closures.csv"));
     f.stream() << "from_keyframe,to_keyframe,from_time,to_time,detector,score,accepted,reason,x,y,phi,rms_m,mahalanobis2,gate_threshold,"
@@ -136,6 +141,7 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   j["input"] = info.input_path;
   j["input_format"] = info.input_format;
   j["ini"] = info.ini_path;
+  if (!info.resumed_map.empty()) j["resumed_map"] = info.resumed_map;
   j["estimator"] = p.estimatorName();
   Json& c = j["counts"];
   c["measurements"] = s.measurements;

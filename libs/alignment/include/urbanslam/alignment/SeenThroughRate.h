@@ -24,6 +24,15 @@ class SeenThroughRate {
   }
   double rate() const { return (seen_ + prior_seen_) / (points_ + prior_points_); }
 
+  // What was learnt (the prior and memory are the constructor's): for saving a run and taking
+  // it up again where it stopped.
+  double seenCount() const { return seen_; }
+  double pointCount() const { return points_; }
+  void restore(double seen, double points) {
+    seen_ = seen;
+    points_ = points;
+  }
+
  private:
   double prior_seen_, prior_points_, memory_points_;
   double seen_ = 0, points_ = 0;

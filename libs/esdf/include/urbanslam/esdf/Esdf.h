@@ -137,6 +137,17 @@ class Esdf {
   // recover() calls it; exposed for tests and experiments.
   long long relineariseMoved();
 
+  // The filter's whole state, so that a filter read back continues exactly as this one would
+  // (EsdfState.cpp): the information form, the factors with their linearisation points, the
+  // matrix of the last full factorisation (refactorised on reading: conservative covariances
+  // come from it) and the dead-reckoning chain. The options are not written: the reader is
+  // constructed with the options of the writer. Filters holding motion-model factors
+  // (predictAugment) cannot be written (std::logic_error): a model is code, not data.
+  void writeState(common::BinaryWriter& w) const;
+  // Into a filter with no poses yet. Throws common::InputError (naming the reader's file) for
+  // inconsistent contents.
+  void readState(common::BinaryReader& r);
+
  private:
   struct Factor {
     enum class Kind : std::uint8_t { Prior, Motion, Relative };

@@ -13,6 +13,11 @@
 
 #include "urbanslam/esdf/PoseOps.h"
 
+namespace urbanslam::common {
+class BinaryWriter;
+class BinaryReader;
+}  // namespace urbanslam::common
+
 namespace urbanslam::esdf {
 
 class InformationState {
@@ -53,6 +58,12 @@ class InformationState {
   long long linkCount() const { return link_count_; }
   // Bytes held by the block rows (for the memory-per-pose figure of the benchmarks).
   size_t memoryBytes() const;
+
+  // Every row exactly as held, links in their order (sums over them depend on it), and the
+  // stamps (EsdfState.cpp). read() replaces this state; it throws common::InputError (through
+  // the reader) for links that point outside the state or lack their mirror.
+  void write(common::BinaryWriter& w) const;
+  void read(common::BinaryReader& r);
 
   // Dense copies for tests and small problems only (O(size^2)).
   Eigen::MatrixXd denseInformation() const;

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <memory>
 #include <stdexcept>
+#include <vector>
 
 #include "urbanslam/esdf/InformationState.h"
 
@@ -49,7 +50,24 @@ class SparseCholesky {
   // Non-zeros of the factor L (for statistics).
   long long factorNonZeros() const;
 
+  // The matrix the current factor was computed from (lower triangle, compressed columns), kept
+  // so that a saved filter can rebuild exactly this factor: a covariance from an older
+  // factorisation (CovarianceMode::Conservative) must not change across a save and a load.
+  struct Matrix {
+    int first = 0, last = 0;
+    std::uint64_t structure_stamp = 0;
+    std::vector<int> colptr, rowind;
+    std::vector<double> values;
+  };
+  // Empty (colptr empty) when there is no factor.
+  Matrix matrix() const;
+  // Factorises `m` as factorize() did (same analysis, same numbers). Throws std::invalid_argument
+  // for a malformed matrix, NotPositiveDefinite like factorize().
+  void factorize(const Matrix& m);
+
  private:
+  void factorizeLower(std::vector<int> colptr, std::vector<int> rowind, std::vector<double> values);
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
   int first_ = 0, last_ = 0;

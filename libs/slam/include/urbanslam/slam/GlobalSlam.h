@@ -48,6 +48,12 @@ class GlobalSlam {
 
   const std::vector<LoopClosureRecord>& closures() const { return closures_; }
 
+  // Closure records, hypotheses awaiting confirmation, the loop closer's cache and whether a
+  // full recovery is owed. Read after the map: the laser detector's keyframe features are
+  // recomputed from the map's scans. PipelineState.cpp.
+  void writeState(common::BinaryWriter& w) const;
+  void readState(common::BinaryReader& r);
+
  private:
   enum class Admission { Rejected, Pending, Accepted };
   Admission admit(LoopClosureRecord r, size_t current);

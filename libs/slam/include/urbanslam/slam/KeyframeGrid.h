@@ -6,6 +6,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "urbanslam/common/BinaryStream.h"
+
 namespace urbanslam::slam {
 
 class KeyframeGrid {
@@ -16,6 +18,11 @@ class KeyframeGrid {
   // Indices of keyframes whose cell lies within `radius` of (x, y) (a superset of the disk).
   // Costs at most the number of occupied cells, however large the radius.
   void query(double x, double y, double radius, std::vector<size_t>& out) const;
+
+  // The cells as they are (not rebuilt from the keyframes: between two reindex() calls a
+  // keyframe stays in the cell of the pose it was inserted at). PipelineState.cpp.
+  void writeState(common::BinaryWriter& w) const;
+  void readState(common::BinaryReader& r, size_t keyframes);
 
  private:
   // Cell indices are clamped to +-2^30 so that any double (huge, infinite, NaN) has a cell and a

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <optional>
 
+#include "urbanslam/common/BinaryStream.h"
 #include "urbanslam/io/Measurements.h"
 
 namespace urbanslam::slam {
@@ -29,6 +30,10 @@ class KeyframeImageAssigner {
   AssignedImage imageKeyframe(size_t index, const io::CameraImage& image);
   // End of input: the last keyframe's image, if it has one.
   std::optional<AssignedImage> finish();
+
+  // The open keyframe and the images held for it, pixels included (PipelineState.cpp).
+  void writeState(common::BinaryWriter& w) const;
+  void readState(common::BinaryReader& r, size_t keyframes);
 
  private:
   struct Slot {

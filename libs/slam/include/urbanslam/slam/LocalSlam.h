@@ -43,6 +43,10 @@ class LocalSlam {
   // `scan` became the newest keyframe: it joins the submap, and the motion starts again there.
   void keyframeAdded(const io::LaserScan& scan);
 
+  // Motion, submap and keyframe decision state (PipelineState.cpp).
+  void writeState(common::BinaryWriter& w) const;
+  void readState(common::BinaryReader& r);
+
  private:
   alignment::PriorMatchResult matchSubmap(const io::LaserScan& scan, const common::Pose2& z, const Eigen::Matrix3d& cov,
                                           const Map& map) const;

@@ -14,6 +14,7 @@
 #include "urbanslam/alignment/PriorScanMatcher.h"
 #include "urbanslam/alignment/ScanModel.h"
 #include "urbanslam/alignment/SeenThroughRate.h"
+#include "urbanslam/common/BinaryStream.h"
 #include "urbanslam/io/LaserScan.h"
 #include "urbanslam/slam/PipelineOptions.h"
 
@@ -33,6 +34,12 @@ class LocalSubmap {
   // oldest first (size() of them). Not valid when the submap or the scan has too few points.
   alignment::PriorMatchResult match(const io::LaserScan& scan, const common::Pose2& prior, const Eigen::Matrix3d& prior_cov,
                                     const std::vector<common::Pose2>& poses) const;
+
+  // The keyframes' points, the count of keyframes added and the learnt seen-through rates. The
+  // beams are rebuilt from the points and the prepared reference from both at the next match,
+  // as a cache miss would (the same inputs give the same reference).
+  void writeState(common::BinaryWriter& w) const;
+  void readState(common::BinaryReader& r);
 
  private:
   const alignment::MatchReference* reference(const std::vector<common::Pose2>& poses) const;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "urbanslam/alignment/Aligner.h"
+#include "urbanslam/common/BinaryStream.h"
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/io/LaserScan.h"
 #include "urbanslam/slam/KeyframeGrid.h"
@@ -79,6 +80,11 @@ class LoopCloser {
   // (the camera: CameraClosure.h) in place of a scan alignment.
   LoopClosureRecord tryCloseMeasured(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current,
                                      const esdf::Vec3& z, const Eigen::Matrix3d& information, bool commit, const Detection& detection);
+
+  // The relative covariances kept for the current keyframe (a later image proposal for it
+  // reuses them). The scorer is code: whoever set it sets it again.
+  void writeState(common::BinaryWriter& w) const;
+  void readState(common::BinaryReader& r);
 
  private:
   Eigen::Matrix3d relativeCovariance(esdf::Esdf& filter, size_t i, size_t k);

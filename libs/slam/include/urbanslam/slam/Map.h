@@ -8,6 +8,7 @@
 #include <memory>
 #include <vector>
 
+#include "urbanslam/common/BinaryStream.h"
 #include "urbanslam/io/MapOutputs.h"
 #include "urbanslam/slam/KeyframeGrid.h"
 #include "urbanslam/vision_loop/BagOfWords.h"
@@ -85,6 +86,11 @@ class Map {
   std::vector<io::PosedScan> posedKeyframes() const;
   size_t anchors() const { return anchors_.size(); }
   double lastAnchorTime() const { return anchors_.empty() ? 0.0 : anchors_.back().timestamp; }
+
+  // Keyframes, edges, the spatial index, anchors and odometry samples (the filter is written on
+  // its own: Esdf::writeState). PipelineState.cpp.
+  void writeState(common::BinaryWriter& w) const;
+  void readState(common::BinaryReader& r);
 
  private:
   struct OdometrySample {

@@ -6,6 +6,7 @@
 // storing them, so the filter holds one pose per keyframe.
 #include <Eigen/Core>
 
+#include "urbanslam/common/BinaryStream.h"
 #include "urbanslam/common/Pose2.h"
 #include "urbanslam/io/Measurements.h"
 #include "urbanslam/slam/PipelineOptions.h"
@@ -27,6 +28,10 @@ class MotionIntegrator {
   // Accumulated odometry pose (for the odometry-rate trajectory), and whether any input came.
   const common::Pose2& odometryPose() const { return odom_; }
   bool hasInput() const { return have_input_; }
+
+  // The interval so far and the last readings (the options are the constructor's).
+  void writeState(common::BinaryWriter& w) const;
+  void readState(common::BinaryReader& r);
 
  private:
   void accumulate(const Eigen::Vector3d& step, const Eigen::Matrix3d& step_cov);

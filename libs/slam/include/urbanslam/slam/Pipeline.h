@@ -37,8 +37,21 @@ class Pipeline {
   bool step(io::DataSource& source);
   // Runs to the end of the input, then finish().
   void run(io::DataSource& source);
+  // Runs to the end of the input without finish(): a run that saves its map (MapFile.h) saves
+  // it here, since finish() drops the hypotheses awaiting confirmation that a continued run
+  // still confirms.
+  void runInput(io::DataSource& source);
   // Final full recovery; tells observers the run is complete.
   void finish();
+  // finish(), a filter failure reported as bad input against `source` (as run() does).
+  void finish(const io::DataSource& source);
+  bool finished() const { return finished_; }
+
+  // Everything a continued run depends on, in tagged sections (PipelineState.cpp; the file
+  // around it: MapFile.h). readState() goes into a fresh pipeline built with the same options,
+  // before any step, and throws common::InputError for contents it cannot take.
+  void writeState(common::BinaryWriter& w) const;
+  void readState(common::BinaryReader& r);
 
   const Map& map() const { return map_; }
   const std::vector<Keyframe>& keyframes() const { return map_.keyframes(); }
@@ -98,6 +111,7 @@ class Pipeline {
   std::vector<ImageCamera> image_cameras_;  // image database id -> its camera
   KeyframeImageAssigner images_;
   bool have_first_ts_ = false;
+  bool finished_ = false;
 };
 
 }  // namespace urbanslam::slam

@@ -155,6 +155,10 @@ std::string estimatorName(EstimatorOptions::Type type);
 // Defaults, overridden by the ini file when `ini_path` is not empty. Throws common::ConfigError.
 // `resolved_ini` (optional) receives the resolved configuration as ini text.
 PipelineOptions loadPipelineOptions(const std::string& ini_path, std::string* resolved_ini = nullptr);
+// The same from ini text (`name` names it in errors), and the options as resolved ini text
+// (numbers to 12 significant digits, as config.ini shows them).
+PipelineOptions parsePipelineOptions(const std::string& ini_text, const std::string& name);
+std::string optionsToIni(const PipelineOptions& options);
 
 // The shipped data files under the project home (the repository, or $URBANSLAM_HOME), in one
 // place for every program: the laser classifier's model and the Tree of Words vocabulary.

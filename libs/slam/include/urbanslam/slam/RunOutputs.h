@@ -3,7 +3,8 @@
 // clouds, .simplemap, occupancy grid, stats.json and the resolved config.ini. The folder is
 // replaced as a whole (common::AtomicFolder): it appears complete, holding one run, or not at
 // all; an existing folder that is neither empty nor a run's is refused (InputError), never
-// deleted. stats.json still comes last.
+// deleted. stats.json still comes last. map.usmap, the state another run can continue
+// (MapFile.h), is encoded before finish() and handed over in RunInfo.
 #include <string>
 
 #include "urbanslam/common/Json.h"
@@ -13,6 +14,8 @@ namespace urbanslam::slam {
 
 struct RunInfo {
   std::string input_path, input_format, ini_path, resolved_ini;
+  std::string map_file;     // map.usmap's bytes (encodeMap before finish()); empty: not written
+  std::string resumed_map;  // the map this run continued, "" for a run from scratch
 };
 
 // The keyframe pose graph (estimates, motion and loop-closure constraints) as g2o.

@@ -1,0 +1,35 @@
+#pragma once
+// map.usmap: a run's state saved so that another run continues it with a new log, with the same
+// result as one run over both logs in a row. A versioned little-endian binary file: signature,
+// format version, payload length, FNV-1a 64 checksum of the payload, then the payload's tagged
+// sections (the resolved options first, then Pipeline::writeState). libs/slam/README.md ("The
+// map file") documents every byte.
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "urbanslam/slam/Pipeline.h"
+
+namespace urbanslam::slam {
+
+constexpr const char* kMapFileName = "map.usmap";
+constexpr std::uint32_t kMapFormatVersion = 1;
+
+// The file's bytes for the pipeline's current state. Call it before finish() (after finish()
+// the state cannot be continued: std::logic_error).
+std::string encodeMap(const Pipeline& pipeline);
+// Writes `bytes` (encodeMap's) atomically: a temporary beside `path`, renamed when complete.
+void writeMapFile(const std::string& bytes, const std::string& path);
+inline void saveMap(const Pipeline& pipeline, const std::string& path) { writeMapFile(encodeMap(pipeline), path); }
+
+// The map file named by the user: the file itself, or the run folder holding map.usmap.
+std::string mapFilePath(const std::string& file_or_run_folder);
+
+// The pipeline a map file holds, ready for its next measurement. `options` (optional): the
+// options the continued run asks for, which must equal the map's on every key that changes the
+// result (all but [map] and [output]; InputError naming the key otherwise); the pipeline then
+// runs with them. Without, it runs with the map's own. Throws common::InputError naming the file
+// for a file that is not a map, of another format version, truncated or corrupt.
+std::unique_ptr<Pipeline> loadMap(const std::string& path, const PipelineOptions* options = nullptr);
+
+}  // namespace urbanslam::slam

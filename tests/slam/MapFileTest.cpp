@@ -1,0 +1,170 @@
+// The map file itself: a map read back writes the same bytes, and a file that is not a sound map
+// of this version is refused with one error naming it.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <iterator>
+
+#include "TestPaths.h"
+#include "urbanslam/common/BinaryStream.h"
+#include "urbanslam/common/Error.h"
+#include "urbanslam/slam/MapFile.h"
+#include "urbanslam/slam/Pipeline.h"
+
+using namespace urbanslam;
+
+namespace {
+
+slam::PipelineOptions fr079Options() { return slam::loadPipelineOptions(test::repoPath("ini/fr079.ini")); }
+
+// A map part way through the Freiburg 079 excerpt (closures made, some awaiting confirmation).
+std::string partialMapBytes() {
+  slam::Pipeline p(fr079Options());
+  auto src = io::openDataSource(test::repoPath("rawlogs/fr079-raw-excerpt.clf.gz"));
+  for (int i = 0; i < 1500; ++i) p.step(*src);
+  return slam::encodeMap(p);
+}
+
+const std::string& mapBytes() {
+  static const std::string bytes = partialMapBytes();
+  return bytes;
+}
+
+std::string writeBytes(const std::string& name, const std::string& bytes) {
+  const std::string path = (test::scratchDir("map_file_" + name) / "map.usmap").string();
+  std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  return path;
+}
+
+std::string readBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// The error loadMap gives for `bytes` ("" when it loads).
+std::string loadError(const std::string& name, const std::string& bytes, const slam::PipelineOptions* options = nullptr) {
+  const std::string path = writeBytes(name, bytes);
+  try {
+    slam::loadMap(path, options);
+  } catch (const common::InputError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind(path + ": ", 0), 0u) << what;  // names the file first
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    return what;
+  }
+  return "";
+}
+
+constexpr size_t kHeaderBytes = 28;
+
+}  // namespace
+
+TEST(MapFile, SaveLoadSaveGivesTheSameBytes) {
+  const std::string path = writeBytes("round_trip", mapBytes());
+  const auto loaded = slam::loadMap(path);
+  EXPECT_EQ(loaded->stats().measurements, 1500u);
+  EXPECT_GT(loaded->loopClosures().size(), 0u);
+  const std::string again = slam::encodeMap(*loaded);
+  ASSERT_EQ(again.size(), mapBytes().size());
+  EXPECT_TRUE(again == mapBytes());
+  // saveMap writes exactly encodeMap's bytes.
+  const std::string saved = (test::scratchDir("map_file_saved") / "again.usmap").string();
+  slam::saveMap(*loaded, saved);
+  EXPECT_TRUE(readBytes(saved) == mapBytes());
+}
+
+TEST(MapFile, HeaderIsLittleEndianWithTheFormatVersion) {
+  const std::string& b = mapBytes();
+  ASSERT_GT(b.size(), kHeaderBytes);
+  EXPECT_EQ(b.substr(0, 5), "USMAP");
+  EXPECT_EQ(static_cast<unsigned char>(b[8]), slam::kMapFormatVersion);
+  EXPECT_EQ(b[9] | b[10] | b[11], 0);
+  uint64_t length = 0, checksum = 0;
+  for (int i = 7; i >= 0; --i) {
+    length = length << 8 | static_cast<unsigned char>(b[12 + static_cast<size_t>(i)]);
+    checksum = checksum << 8 | static_cast<unsigned char>(b[20 + static_cast<size_t>(i)]);
+  }
+  EXPECT_EQ(length, b.size() - kHeaderBytes);
+  EXPECT_EQ(checksum, common::fnv1a64(b.data() + kHeaderBytes, b.size() - kHeaderBytes));
+  EXPECT_EQ(b.substr(kHeaderBytes, 4), "OPTS");  // the options section comes first
+}
+
+TEST(MapFile, TruncatedFileIsRefused) {
+  EXPECT_NE(loadError("truncated", mapBytes().substr(0, mapBytes().size() / 2)).find("truncated map"), std::string::npos);
+  EXPECT_NE(loadError("truncated_header", mapBytes().substr(0, 15)).find("truncated map"), std::string::npos);
+  EXPECT_NE(loadError("empty", "").find("not an urbanslam map"), std::string::npos);
+}
+
+TEST(MapFile, FlippedByteFailsTheChecksum) {
+  std::string b = mapBytes();
+  b[b.size() / 2] = static_cast<char>(b[b.size() / 2] ^ 0x10);
+  EXPECT_NE(loadError("flipped", b).find("checksum"), std::string::npos);
+}
+
+TEST(MapFile, OtherVersionIsRefused) {
+  std::string b = mapBytes();
+  b[8] = static_cast<char>(slam::kMapFormatVersion + 1);
+  const std::string e = loadError("version", b);
+  EXPECT_NE(e.find("format version " + std::to_string(slam::kMapFormatVersion + 1)), std::string::npos) << e;
+}
+
+TEST(MapFile, OtherFilesAreNotMaps) {
+  std::string b = mapBytes();
+  b[0] = 'X';
+  EXPECT_NE(loadError("magic", b).find("not an urbanslam map"), std::string::npos);
+  EXPECT_NE(loadError("text", "# CARMEN Logfile\nODOM 0 0 0\n").find("not an urbanslam map"), std::string::npos);
+}
+
+// A payload with a valid checksum but a count far beyond the bytes left: refused before any
+// allocation of that size.
+TEST(MapFile, ImpossibleCountUnderAValidChecksumIsRefused) {
+  std::string b = mapBytes();
+  // The options text's length, right after the OPTS tag and its section length.
+  const size_t at = kHeaderBytes + 4 + 8;
+  for (size_t i = 0; i < 8; ++i) b[at + i] = static_cast<char>(0x7f);
+  const uint64_t sum = common::fnv1a64(b.data() + kHeaderBytes, b.size() - kHeaderBytes);
+  for (size_t i = 0; i < 8; ++i) b[20 + i] = static_cast<char>(static_cast<uint8_t>(sum >> (8 * i)));
+  EXPECT_NE(loadError("count", b).find("corrupt map"), std::string::npos);
+}
+
+TEST(MapFile, ResumeRefusesChangedAlgorithmOptionsNamingTheKey) {
+  slam::PipelineOptions o = fr079Options();
+  o.loop_closure.max_candidates += 1;
+  const std::string e = loadError("options", mapBytes(), &o);
+  EXPECT_NE(e.find("[loop_closure] max_candidates"), std::string::npos) << e;
+  // Output keys may change.
+  slam::PipelineOptions out = fr079Options();
+  out.output.write_pcd = !out.output.write_pcd;
+  out.map.grid_resolution_m = 0.1;
+  EXPECT_EQ(loadError("output_options", mapBytes(), &out), "");
+}
+
+TEST(MapFile, RunFolderNamesItsMap) {
+  const auto dir = test::scratchDir("map_file_folder");
+  EXPECT_THROW(slam::mapFilePath(dir.string()), common::InputError);
+  std::ofstream((dir / "map.usmap").string(), std::ios::binary) << mapBytes();
+  EXPECT_EQ(slam::mapFilePath(dir.string()), (dir / "map.usmap").string());
+  EXPECT_EQ(slam::mapFilePath("x.usmap"), "x.usmap");
+}
+
+TEST(MapFile, FinishedRunCannotBeSaved) {
+  slam::Pipeline p(fr079Options());
+  auto src = io::openDataSource(test::repoPath("rawlogs/fr079-raw-excerpt.clf.gz"));
+  for (int i = 0; i < 200; ++i) p.step(*src);
+  p.finish();
+  EXPECT_THROW(slam::encodeMap(p), std::logic_error);
+}
+
+// The Tree of Words database is not in the file: a map that has one is refused on loading, with
+// the reason, rather than continued without the images seen so far.
+TEST(MapFile, MapWithAnImageDatabaseIsRefused) {
+  slam::PipelineOptions o;
+  o.loop_closure.image_detector = slam::LoopClosureOptions::ImageDetector::TreeOfWords;
+  o.image_loop.vocabulary = test::repoPath("share/vision_loop/sift_k10_L4.usvoc");
+  slam::Pipeline p(o);
+  auto src = io::openDataSource(test::repoPath("rawlogs/rtabmap-loop-excerpt"));
+  for (int i = 0; i < 4; ++i) p.step(*src);
+  ASSERT_GT(p.keyframes().size(), 0u);
+  const std::string e = loadError("images", slam::encodeMap(p));
+  EXPECT_NE(e.find("image_detector = tree_of_words"), std::string::npos) << e;
+}
