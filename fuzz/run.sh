@@ -16,7 +16,7 @@ seconds=${2:?seconds per target}
 shift 2
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-  targets=(rawlog carmen gfs victoria_park pose_graph tum relations ini laser_model vocabulary image_list image data_source victoria_park_zip)
+  targets=(rawlog carmen gfs victoria_park pose_graph tum relations ini laser_model vocabulary image_list image data_source victoria_park_zip map_file)
 fi
 # Inputs are written to a file per execution: keep that off the disk when we can.
 if [ -z "${TMPDIR:-}" ] && [ -d /dev/shm ] && [ -w /dev/shm ]; then export TMPDIR=/dev/shm; fi

@@ -24,6 +24,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "ActionCollection.h"
 #include "AllocationLimit.h"
 #include "MovementGuard.h"
 #include "MrptConversions.h"
@@ -43,12 +44,7 @@ class GzMrptStream : public mrpt::io::CStream {
  public:
   explicit GzMrptStream(const std::string& path) : in_(detail::openGzFile(path)) {}
   size_t Read(void* buf, size_t n) override {
-    size_t got = 0;
-    while (got < n) {
-      const size_t k = in_->read(static_cast<char*>(buf) + got, n - got);
-      if (k == 0) break;
-      got += k;
-    }
+    const size_t got = rawRead(static_cast<char*>(buf), n);
     const size_t keep = std::min(got, head_.size() - std::min(head_.size(), static_cast<size_t>(pos_ - entry_start_)));
     head_len_ = std::max<size_t>(head_len_, static_cast<size_t>(pos_ - entry_start_) + keep);
     if (keep > 0) std::memcpy(head_.data() + (pos_ - entry_start_), buf, keep);
@@ -63,6 +59,17 @@ class GzMrptStream : public mrpt::io::CStream {
   // Why the last Read refused a field (MovementGuard), or "".
   const std::string& refusal() const { return movement_.failure(); }
   double progress() const { return in_->progress(); }
+
+  // The class name of the object header that comes next (MRPT's: length | 0x80, then the
+  // name), without consuming it; "" when the next bytes are not such a header.
+  std::string peekClassName() {
+    if (!peek(1)) return {};
+    const auto c = static_cast<unsigned char>(pushback_[0]);
+    if (!(c & 0x80)) return {};
+    const size_t len = c & 0x7f;
+    peek(1 + len);
+    return pushback_.substr(1, len);
+  }
 
   void startEntry() {
     entry_start_ = pos_;
@@ -80,7 +87,32 @@ class GzMrptStream : public mrpt::io::CStream {
   }
 
  private:
+  // Makes the next `n` bytes available in pushback_ (fewer at the end of the file).
+  bool peek(size_t n) {
+    while (pushback_.size() < n) {
+      char buf[128];
+      const size_t k = in_->read(buf, std::min(sizeof buf, n - pushback_.size()));
+      if (k == 0) return false;
+      pushback_.append(buf, k);
+    }
+    return true;
+  }
+
+  // From the bytes peeked first, then the file.
+  size_t rawRead(char* buf, size_t n) {
+    size_t got = std::min(n, pushback_.size());
+    std::memcpy(buf, pushback_.data(), got);
+    pushback_.erase(0, got);
+    while (got < n) {
+      const size_t k = in_->read(buf + got, n - got);
+      if (k == 0) break;
+      got += k;
+    }
+    return got;
+  }
+
   std::unique_ptr<detail::ByteStream> in_;
+  std::string pushback_;
   uint64_t pos_ = 0, entry_start_ = 0;
   std::array<char, 130> head_{};
   size_t head_len_ = 0;
@@ -251,7 +283,8 @@ struct RawlogReader::Impl {
       return InputError(where() + ": corrupt rawlog: " + object() + " declares " + why);
     };
     try {
-      obj = arch.ReadObject();
+      const std::string cls = stream.peekClassName();
+      obj = cls == "CActionCollection" || cls == "mrpt::obs::CActionCollection" ? detail::readActionCollection(arch, stream, where()) : arch.ReadObject();
     } catch (const mrpt::serialization::CExceptionEOF&) {
       ended = true;
       if (stream.getPosition() != before) throw InputError(where() + ": truncated rawlog (file ends inside an entry)");
