@@ -55,7 +55,10 @@ void BeamFreeSpace::classify(const std::vector<Eigen::Vector2d>& points, const c
     const size_t b = binOf(std::atan2(q.y(), q.x()));
     const double f = std::min({free_m_[b], free_m_[(b + 1) % n], free_m_[(b + n - 1) % n]});
     if (f <= 0) continue;
-    const char s = r < f - margin_m_ - margin_fraction_ * f ? kSeenThrough : kInView;
+    const double g = std::max({free_m_[b], free_m_[(b + 1) % n], free_m_[(b + n - 1) % n]});
+    const char s = r < f - margin_m_ - margin_fraction_ * f   ? kSeenThrough
+                   : r > g + margin_m_ + margin_fraction_ * g ? kBehind
+                                                              : kInView;
     state[i] = std::max(state[i], s);
   }
 }

@@ -74,7 +74,7 @@ PriorMatchResult matchWithPrior(const MatchReference& reference, const PointSet&
   // Free space of both sides at a pose: points in view and seen through (reference points in the
   // scan's beams, the scan's points in the reference scans' beams).
   const BeamFreeSpace scan_beams(scan, o.free_margin_m, o.free_margin_fraction);
-  const auto freeSpace = [&](const common::Pose2& pose) {
+  const auto freeSpace = [&](const common::Pose2& pose, std::pair<double, int>* in_view_score = nullptr) {
     std::vector<char> ref_state(reference.thinned().size(), BeamFreeSpace::kUnseen);
     scan_beams.classify(reference.thinned(), pose, ref_state);
     std::vector<Eigen::Vector2d> placed;
@@ -88,6 +88,20 @@ PriorMatchResult matchWithPrior(const MatchReference& reference, const PointSet&
         n.first += c != BeamFreeSpace::kUnseen;
         n.second += c == BeamFreeSpace::kSeenThrough;
       }
+    if (in_view_score) {
+      // The scan's points where the reference has looked (not hidden behind what it saw): their
+      // mean log-likelihood.
+      double sum = 0;
+      int k = 0;
+      const LikelihoodGrid& grid = reference.grid();
+      for (size_t i = 0; i < placed.size(); ++i) {
+        if (scan_state[i] < BeamFreeSpace::kInView) continue;
+        const Eigen::Vector2i c = grid.cellOf(placed[i]);
+        sum += grid.value(0, c.x(), c.y());
+        ++k;
+      }
+      *in_view_score = {sum, k};
+    }
     return n;
   };
   // 2'. The scan outvotes the odometry: the best pose the odometry allows, and both weighed again
@@ -96,16 +110,34 @@ PriorMatchResult matchWithPrior(const MatchReference& reference, const PointSet&
   if (o.seen_through_rate > 0 && scan_beams.valid() && prior.gaussianWeight(prior.mahalanobis2(prior.difference(coarse.pose))) < 0.5) {
     // "The odometry is right": its Gaussian alone, over the same window.
     const MotionPrior odometry_right(prior_mean, prior_cov, 0.0, volume);
-    const CorrelativeResult near = correlativeSearch(reference.grid(), thinned, odometry_right, window);
+    CorrelativeResult near = correlativeSearch(reference.grid(), thinned, odometry_right, window);
     out.search_nodes += near.nodes;
     // Per point in view: log p(what it shows | right pose) / p(... | wrong pose).
     const double right = std::clamp(o.seen_through_rate, 1e-6, 0.5);
     const double wrong = std::clamp(o.seen_through_rate_displaced, right, 1 - 1e-6);
     const auto full = [&](const CorrelativeResult& c) {
-      const auto [in_view, seen] = freeSpace(c.pose);
-      return c.scan_score + prior.logDensity(c.pose) + seen * std::log(right / wrong) +
-             (in_view - seen) * std::log((1 - right) / (1 - wrong));
+      std::pair<double, int> scored{0, 0};
+      const auto [in_view, seen] = freeSpace(c.pose, &scored);
+      // A scan point where the reference never looked says nothing about the pose: it counts
+      // as the hypothesis's own points in view do on average, so a pose that turns the scan
+      // towards new ground is not scored down for it (nor one that folds it onto old ground up).
+      const double scan = scored.second >= o.min_points ? thinned.size() * scored.first / scored.second : c.scan_score;
+      return scan + prior.logDensity(c.pose) + seen * std::log(right / wrong) + (in_view - seen) * std::log((1 - right) / (1 - wrong));
     };
+    // And the odometry's own pose: the searches maximise the plain score, which still marks the
+    // scan down for what it sees of new ground.
+    CorrelativeResult at_prior;
+    at_prior.pose = prior_mean;
+    at_prior.scan_score = 0;
+    {
+      const Rigid2 to_ref = Rigid2::fromPose(prior_mean);
+      const LikelihoodGrid& grid = reference.grid();
+      for (const auto& p : thinned) {
+        const Eigen::Vector2i c = grid.cellOf(to_ref * p);
+        at_prior.scan_score += grid.value(0, c.x(), c.y());
+      }
+    }
+    if (full(at_prior) > full(near)) near = at_prior;
     if (full(near) >= full(coarse)) coarse = near;
   }
   out.search_pose = coarse.pose;

@@ -21,9 +21,10 @@ class BeamFreeSpace {
   bool valid() const { return valid_; }
   // Of `points` (in the frame where the scan sits at `scan_pose`), how many the scan saw through.
   int conflicts(const std::vector<Eigen::Vector2d>& points, const common::Pose2& scan_pose) const;
-  // Per point (sized like points): raised to kInView where the scan's beams reach its bearing, to
-  // kSeenThrough where they passed it. Never lowered, so several scans can judge one point set.
-  static constexpr char kUnseen = 0, kInView = 1, kSeenThrough = 2;
+  // Per point (sized like points): raised to kBehind where the scan's beams reach its bearing but
+  // stopped short of it (hidden: the scan says nothing there), to kInView where they reached it,
+  // to kSeenThrough where they passed it. Never lowered, so several scans can judge one point set.
+  static constexpr char kUnseen = 0, kBehind = 1, kInView = 2, kSeenThrough = 3;
   void classify(const std::vector<Eigen::Vector2d>& points, const common::Pose2& scan_pose, std::vector<char>& state) const;
 
  private:
