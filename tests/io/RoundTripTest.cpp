@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include "TestPaths.h"
 #include "urbanslam/io/DataSource.h"
@@ -198,4 +199,48 @@ TEST(RoundTrip, ExternalImagesFolderIsReplacedWholeAtClose) {
   while (src->next(m))
     if (const auto* im = std::get_if<io::CameraImage>(&m)) firsts.push_back(im->pixels->at(0));
   EXPECT_EQ(firsts, (std::vector<uint8_t>{10, 200}));
+}
+
+// A camera's calibration goes into the rawlog as MRPT keeps it (cameraParams, and cameraPose in
+// MRPT's camera frame: +Z the optical axis) and comes back as it was; an image without one comes
+// back without.
+TEST(RoundTrip, CameraCalibrationSurvivesInMrptsConvention) {
+  const std::string out = (test::scratchDir("rt_calibration") / "cam.rawlog").string();
+  const auto image = [](double t, std::optional<io::CameraCalibration> c) {
+    io::CameraImage im;
+    im.timestamp = t;
+    im.label = "CAMERA";
+    im.width = 64, im.height = 48;
+    im.pixels = std::make_shared<const std::vector<uint8_t>>(64 * 48, 100);
+    im.calibration = c;
+    return io::Measurement(im);
+  };
+  io::CameraCalibration side;
+  side.fx_px = 32, side.fy_px = 33, side.cx_px = 31.5, side.cy_px = 35.5;
+  side.mount = {1.0, -0.25, M_PI / 2};  // looking left
+  io::CameraCalibration back = side;
+  back.mount.phi = -2.5;
+  {
+    io::RawlogWriter w(out, io::RawlogLayout::Observations, 5, io::ImageStorage::Embedded);
+    w.write(image(1.0, side));
+    w.write(image(2.0, back));
+    w.write(image(3.0, std::nullopt));
+    w.close();
+  }
+  std::vector<std::optional<io::CameraCalibration>> got;
+  for (const auto& m : readAll(out))
+    if (const auto* im = std::get_if<io::CameraImage>(&m)) got.push_back(im->calibration);
+  ASSERT_EQ(got.size(), 3u);
+  for (int k = 0; k < 2; ++k) {
+    const io::CameraCalibration& want = k == 0 ? side : back;
+    ASSERT_TRUE(got[k].has_value()) << k;
+    EXPECT_DOUBLE_EQ(got[k]->fx_px, want.fx_px);
+    EXPECT_DOUBLE_EQ(got[k]->fy_px, want.fy_px);
+    EXPECT_DOUBLE_EQ(got[k]->cx_px, want.cx_px);
+    EXPECT_DOUBLE_EQ(got[k]->cy_px, want.cy_px);
+    EXPECT_NEAR(got[k]->mount.x, want.mount.x, 1e-12);
+    EXPECT_NEAR(got[k]->mount.y, want.mount.y, 1e-12);
+    EXPECT_NEAR(got[k]->mount.phi, want.mount.phi, 1e-9);
+  }
+  EXPECT_FALSE(got[2].has_value());
 }
