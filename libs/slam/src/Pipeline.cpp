@@ -29,18 +29,11 @@ std::unique_ptr<esdf::Esdf> makeFilter(const PipelineOptions& options) {
 
 Pipeline::Pipeline(PipelineOptions options)
     : options_(std::move(options)),
+      input_(options_.input),
       map_(makeFilter(options_), std::max(1.0, options_.loop_closure.search_radius_m)),
       local_(options_),
       global_(options_, map_, stats_, observers_),
-      images_(options_.loop_closure.image_max_offset_s) {
-  std::stringstream ss(options_.input.laser_labels);
-  std::string label;
-  while (std::getline(ss, label, ',')) {
-    label.erase(0, label.find_first_not_of(" \t"));
-    label.erase(label.find_last_not_of(" \t") + 1);
-    if (!label.empty()) labels_.push_back(label);
-  }
-}
+      images_(options_.loop_closure.image_max_offset_s) {}
 
 Pipeline::~Pipeline() = default;
 
@@ -56,20 +49,6 @@ void Pipeline::addObserver(PipelineObserver* observer) { observers_.push_back(ob
 
 void Pipeline::setCandidateScorer(CandidateScorer scorer, std::string name) {
   global_.setCandidateScorer(std::move(scorer), std::move(name));
-}
-
-bool Pipeline::acceptLabel(const std::string& label) const {
-  if (labels_.empty()) return true;
-  for (const auto& l : labels_)
-    if (l == label) return true;
-  return false;
-}
-
-void Pipeline::applyRangeLimits(io::LaserScan& scan) const {
-  const double lo = options_.input.min_range_m, hi = options_.input.max_range_m;
-  if (lo <= 0 && hi <= 0) return;
-  for (size_t i = 0; i < scan.ranges.size(); ++i)
-    if (scan.ranges[i] < lo || (hi > 0 && scan.ranges[i] >= hi)) scan.valid[i] = 0;
 }
 
 bool Pipeline::step(io::DataSource& source) {
@@ -155,9 +134,9 @@ void Pipeline::finish() {
 
 void Pipeline::onScan(io::LaserScan scan, double progress) {
   common::Stopwatch sw;
-  if (!acceptLabel(scan.label)) return;
+  if (!input_.accepts(scan.label)) return;
   ++stats_.scans_used;
-  applyRangeLimits(scan);
+  input_.limitRanges(scan);
   if (local_.isKeyframe(map_)) {
     common::Stopwatch kw;
     addKeyframe(std::move(scan));

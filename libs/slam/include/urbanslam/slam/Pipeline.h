@@ -9,6 +9,7 @@
 #include "urbanslam/io/DataSource.h"
 #include "urbanslam/io/MapOutputs.h"
 #include "urbanslam/slam/GlobalSlam.h"
+#include "urbanslam/slam/InputFilter.h"
 #include "urbanslam/slam/KeyframeImages.h"
 #include "urbanslam/slam/LocalSlam.h"
 #include "urbanslam/slam/Map.h"
@@ -95,12 +96,10 @@ class Pipeline {
   // invalid when the images give none.
   std::optional<CameraMeasurement> measureCamera(const ImageCamera& a, const vision_loop::ImageFeatures& fa, const ImageCamera& b,
                                                  const vision_loop::ImageFeatures& fb) const;
-  bool acceptLabel(const std::string& label) const;
-  void applyRangeLimits(io::LaserScan& scan) const;
 
   PipelineOptions options_;
   std::vector<PipelineObserver*> observers_;
-  std::vector<std::string> labels_;
+  InputFilter input_;
   std::vector<io::StampedPose> reference_;
   PipelineStats stats_;
   Map map_;

@@ -1,0 +1,93 @@
+// `urbanslam localize`: track the vehicle of a log in a map an earlier run built (its
+// map.usmap), which stays as it is.
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include "ArgParser.h"
+#include "Commands.h"
+#include "urbanslam/common/Error.h"
+#include "urbanslam/common/Progress.h"
+#include "urbanslam/common/Timing.h"
+#include "urbanslam/slam/LocalizationOutputs.h"
+#include "urbanslam/slam/Localizer.h"
+#include "urbanslam/slam/MapFile.h"
+
+namespace urbanslam::cli {
+
+namespace {
+
+common::Pose2 parsePose(const std::string& text) {
+  std::stringstream ss(text);
+  double v[3];
+  char comma1 = 0, comma2 = 0;
+  if (!(ss >> v[0] >> comma1 >> v[1] >> comma2 >> v[2]) || comma1 != ',' || comma2 != ',' || !(ss >> std::ws).eof() ||
+      !std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
+    throw common::InputError("localize --initial: expected x,y,phi (metres, metres, radians), got '" + text + "'");
+  return {v[0], v[1], common::wrapToPi(v[2])};
+}
+
+}  // namespace
+
+int localizeCommand(const Argv& args) {
+  ArgParser ap("urbanslam localize --map MAP LOG [--initial x,y,phi] [--out DIR] [--quiet] [--json]",
+               "Tracks the vehicle of LOG in the map of an earlier `urbanslam run` (its map.usmap, or its output\n"
+               "folder), which is not changed: every scan is predicted by the odometry and matched against the\n"
+               "map's scans near that pose. Without --initial, and whenever the matches stop supporting the pose\n"
+               "(lost), the whole map is searched for the scan's place until one place clearly wins.");
+  ap.addPositional("LOG", "the log to localize (any format `run` reads)");
+  ap.addOption("map", "MAP", "the map: a map.usmap file or the run folder holding one (required)");
+  ap.addOption("initial", "x,y,phi", "the vehicle's pose at the first scan in the map frame (m, m, rad); default: searched");
+  ap.addOption("out", "DIR", "output folder (created if needed)", "out_localize");
+  ap.addFlag("quiet", "no progress bar and no summary on stderr");
+  ap.addFlag("json", "print stats.json as one JSON object on stdout");
+  ap.addEpilog(
+      "outputs in DIR: trajectory_scans.tum (the tracked scans; `urbanslam eval DIR --relations F`\n"
+      "scores it), localization.csv (every scan: time, x, y, phi, covariance upper triangle xx xy xphi\n"
+      "yy yphi phiphi, state tracking|lost), stats.json (counts, time lost, relocalisations, wall time,\n"
+      "real-time factor). DIR appears complete at the end; it is replaced only when it is empty or\n"
+      "holds an earlier localization.");
+  if (!ap.parse(args)) return 0;
+  if (!ap.has("map")) throw common::InputError("localize: --map MAP is required (a map.usmap or a run folder)");
+  common::Stopwatch wall;
+  const bool quiet = ap.flag("quiet");
+  slam::LocalizationInfo info;
+  info.input_path = ap.positional("LOG");
+  info.map_path = slam::mapFilePath(ap.option("map"));
+  if (ap.has("initial")) {
+    info.initial_pose = parsePose(ap.option("initial"));
+    info.initial_pose_given = true;
+  }
+  std::unique_ptr<slam::Pipeline> pipeline = slam::loadMap(info.map_path);
+  // The final estimates of the map's keyframes (what `run` wrote out); nothing is added after.
+  pipeline->finish();
+  if (pipeline->keyframes().empty()) throw common::InputError(info.map_path + ": the map has no keyframes");
+  std::unique_ptr<io::DataSource> source = io::openDataSource(info.input_path);
+  info.input_format = source->format();
+
+  slam::Localizer localizer(pipeline->map(), pipeline->options(), slam::localizerOptions(pipeline->options()));
+  if (info.initial_pose_given) localizer.setInitialPose(info.initial_pose);
+  common::ProgressBar bar("localize", 1000, !quiet);
+  const auto scans = slam::localize(localizer, *source, [&](const slam::LocalizedScan& r, double progress) {
+    const auto& s = localizer.stats();
+    bar.update(static_cast<uint64_t>(progress * 1000), std::to_string(s.scans_used) + " scans, " + slam::stateName(r.state) + ", " +
+                                                           std::to_string(s.relocalisations) + " relocalisations");
+  });
+  bar.finish();
+  if (scans.empty()) throw common::InputError(info.input_path + ": no laser scans the map's [input] options accept: nothing to localize");
+  info.wall_s = wall.seconds();
+  const std::string out = ap.option("out");
+  const common::Json stats = slam::writeLocalizationOutputs(scans, localizer.stats(), info, out);
+  if (ap.flag("json")) std::cout << stats.dump() << "\n";
+  if (!quiet) {
+    const auto& s = localizer.stats();
+    std::cerr << "urbanslam localize: " << s.scans_used << " scans, " << s.tracking << " tracked, " << s.lost << " lost ("
+              << s.lost_s << " s), " << s.relocalisations << " relocalisations in " << info.wall_s << " s ("
+              << stats.at("timing").at("real_time_factor").asNumber() << "x real time)\n"
+              << "outputs in " << std::filesystem::absolute(out).string() << "/ (trajectory_scans.tum, localization.csv, stats.json)\n";
+  }
+  return 0;
+}
+
+}  // namespace urbanslam::cli

@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# Localization benchmark: for each raw Freiburg log, map its first half (`urbanslam run` on the
+# log cut at its middle laser scan), localize the second half in that map (`urbanslam localize`),
+# and compare with the mapping run over the whole log on the same relations.
+#
+#   bench/localize/run_localize.sh [BUILD_DIR] [OUT_DIR]
+#
+# Needs ../shared/data. Rows (RESULTS.md):
+#   rel_m loc / full   mean absolute translational relation error [m] of the localized second
+#                      half and of the full mapping run, on the relations whose two ends are both
+#                      tracked by the localizer (eval --max-gap 1 on a relations file restricted to
+#                      those, see relations_within.py); rel_deg likewise [deg];
+#   tracked            share of the second half's scans tracked (the rest: lost, e.g. rooms the first
+#                      half never entered);
+#   reloc              relocalisations (place searches that found the pose) in the run with --initial;
+#   fix_s              kidnapping: the second half localized with no initial pose, log time from its
+#                      first scan to the first tracked one;
+#   fix_err_m          that first fix against the full run's pose at the same scan (map frames agree:
+#                      both runs start at the same first scan);
+#   rtf                log duration / wall time of `urbanslam localize` with --initial (map loading
+#                      included), and of the kidnapped run.
+# Environment: DATASETS="intel fr079" (default: intel aces fr079 csail).
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/../.."
+BUILD=${1:-build}
+OUT=${2:-$BUILD/localize_bench}
+U=$BUILD/apps/urbanslam/urbanslam
+D=../shared/data/freiburg_slam_benchmark
+HERE=bench/localize
+mkdir -p "$OUT"
+declare -A LOG=([intel]=intel [aces]=aces [fr079]=fr079 [csail]=mit-csail)
+declare -A REL=([intel]=intel [aces]=aces [fr079]=fr079 [csail]=mit-csail)
+printf "%-7s %6s %8s %8s %8s %8s %8s %6s %7s %9s %8s %8s\n" dataset rel_n rel_m_loc rel_m_full rel_deg_loc rel_deg_full tracked reloc fix_s fix_err_m rtf rtf_kidnap
+for ds in ${DATASETS:-intel aces fr079 csail}; do
+  W=$OUT/$ds
+  mkdir -p "$W"
+  src=$D/raw_logs/${LOG[$ds]}.clf.gz
+  n=$(zcat "$src" | grep -c '^FLASER')
+  half=$((n / 2))
+  # The first half: every line up to the middle scan; the second: the header lines and the rest.
+  zcat "$src" | awk -v h=$half '/^FLASER/{k++} k<=h {print}' > "$W/first.clf"
+  zcat "$src" | awk -v h=$half '/^FLASER/{k++} k>h || /^#/ || /^PARAM/ {print}' > "$W/second.clf"
+  [ -f "$W/full/stats.json" ] || "$U" run --quiet --ini ini/$ds.ini --out "$W/full" "$src"
+  "$U" run --quiet --ini ini/$ds.ini --out "$W/map" "$W/first.clf"
+  initial=$(python3 $HERE/last_pose.py "$W/map/trajectory_scans.tum")
+  "$U" localize --quiet --map "$W/map" --initial "$initial" --out "$W/loc" "$W/second.clf"
+  "$U" localize --quiet --map "$W/map" --out "$W/kidnap" "$W/second.clf"
+  python3 $HERE/relations_within.py "$D/relations/${REL[$ds]}.relations" "$W/loc/trajectory_scans.tum" 1.0 > "$W/relations_tracked"
+  "$U" eval "$W/loc" --relations "$W/relations_tracked" --time-offset 0 --max-gap 1 --json > "$W/eval_loc.json"
+  "$U" eval "$W/full" --relations "$W/relations_tracked" --time-offset 0 --max-gap 1 --json > "$W/eval_full.json"
+  python3 $HERE/row.py "$ds" "$W"
+done

@@ -1,0 +1,35 @@
+#pragma once
+// What `urbanslam localize` writes into its folder, as one unit (common::AtomicFolder: the
+// folder appears complete or not at all; an existing folder that is neither empty nor an earlier
+// localization's is refused, never deleted):
+//   trajectory_scans.tum  the tracked scans' poses (what `urbanslam eval --relations` scores; lost
+//                         scans have no trusted pose and are left out); trajectory_odometry.tum
+//                         holds the same poses, for eval, which reads both;
+//   localization.csv      every scan: time, pose, covariance upper triangle, state;
+//   stats.json            counts, time lost, relocalisations, wall time, real-time factor.
+#include <string>
+#include <vector>
+
+#include "urbanslam/common/Json.h"
+#include "urbanslam/slam/Localizer.h"
+
+namespace urbanslam::slam {
+
+// The first line of localization.csv (it marks a folder as a localization's).
+extern const char* const kLocalizationCsvHeader;
+
+struct LocalizationInfo {
+  std::string map_path, input_path, input_format;
+  bool initial_pose_given = false;
+  common::Pose2 initial_pose;
+  double wall_s = 0;  // the whole run: reading the map and the log included
+};
+
+// stats.json's content (also what --json prints).
+common::Json localizationStats(const std::vector<LocalizedScan>& scans, const LocalizerStats& stats, const LocalizationInfo& info);
+
+// Writes the folder; returns the stats.json content written.
+common::Json writeLocalizationOutputs(const std::vector<LocalizedScan>& scans, const LocalizerStats& stats, const LocalizationInfo& info,
+                                      const std::string& dir);
+
+}  // namespace urbanslam::slam

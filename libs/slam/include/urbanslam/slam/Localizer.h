@@ -1,0 +1,137 @@
+#pragma once
+// Localization in a frozen map: the vehicle tracked scan by scan in a map that a run built
+// (map.usmap), the map never changed. Each scan's pose is predicted by the odometry (the motion
+// model of local SLAM, MotionIntegrator) from the previous scan's, the prediction's covariance
+// carried along, and the scan is matched near it against the map's keyframe scans
+// (MapAreas: the tile's reference, built on demand) by local SLAM's matcher, which weighs the
+// odometry prior against the scan by their covariances; its posterior is the scan's pose and
+// covariance. A TrackingMonitor decides when the matches no longer support the pose (lost);
+// then, and at the start without an initial pose, the PlaceRecognizer searches the whole map
+// until one place clearly wins (relocalised). While lost, the reported pose is the odometry's
+// from the last known one, if any, and no pose is trusted.
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "urbanslam/alignment/SeenThroughRate.h"
+#include "urbanslam/io/DataSource.h"
+#include "urbanslam/io/Measurements.h"
+#include "urbanslam/slam/InputFilter.h"
+#include "urbanslam/slam/Map.h"
+#include "urbanslam/slam/MapAreas.h"
+#include "urbanslam/slam/MotionIntegrator.h"
+#include "urbanslam/slam/PipelineOptions.h"
+#include "urbanslam/slam/PlaceRecognizer.h"
+#include "urbanslam/slam/TrackingMonitor.h"
+
+namespace urbanslam::slam {
+
+struct LocalizerOptions {
+  MapAreaOptions areas;
+  PlaceRecognitionOptions places;
+  TrackingMonitorOptions monitor;
+  double min_matched_fraction = 0.5;  // a tracking match must explain this share of the scan's points
+  // A match's posterior covariance times covariance_scale (the map's [local] one: successive
+  // matches against the same map points have correlated errors), with these floors: the map's
+  // keyframes disagree with each other by about this much, which no single match sees.
+  double covariance_scale = 4.0;
+  double min_sigma_xy_m = 0.02;
+  double min_sigma_deg = 0.5;
+  double initial_sigma_xy_m = 0.5;    // the uncertainty of a given initial pose
+  double initial_sigma_deg = 10.0;
+  // While lost, a place search at most every relocalise_interval_s of log time, the interval
+  // doubling after each failed search up to relocalise_max_interval_s, and only once the vehicle
+  // moved or turned this much since the last one (the same view gives the same answer).
+  double relocalise_interval_s = 0.5;
+  double relocalise_max_interval_s = 4.0;
+  double relocalise_min_motion_m = 0.3;
+  double relocalise_min_rotation_deg = 10.0;
+};
+
+// The defaults, with the matcher, scan model and floors of the map's own [local] options.
+LocalizerOptions localizerOptions(const PipelineOptions& map_options);
+
+enum class LocalizationState { Tracking, Lost };
+const char* stateName(LocalizationState state);
+
+struct LocalizedScan {
+  double timestamp = 0;
+  LocalizationState state = LocalizationState::Lost;
+  bool has_pose = false;  // false: lost since the start, no pose at all
+  common::Pose2 pose;     // vehicle pose in the map frame
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Identity();
+  bool matched = false;      // the scan's match explained it (tracking)
+  bool relocalised = false;  // a place search found the pose at this scan
+  double matched_fraction = 0;
+  double mahalanobis2 = 0;  // the match's correction of the prediction, d' P⁻¹ d
+};
+
+struct LocalizerStats {
+  size_t measurements = 0, scans = 0, scans_used = 0, odometry = 0;
+  size_t tracking = 0, lost = 0, matches_failed = 0;
+  size_t place_searches = 0, relocalisations = 0, lost_events = 0;
+  double first_timestamp = 0, last_timestamp = 0;
+  double lost_s = 0;         // log time spent lost
+  double first_fix_s = -1;   // log time from the first scan to the first tracked one (-1: never)
+  double wall_s = 0, place_search_wall_s = 0;
+  size_t references_built = 0, coarse_grids_built = 0;
+};
+
+class Localizer {
+ public:
+  // `map` must outlive the localizer; it is only read. `map_options`: the options the map was
+  // built with (motion model, input filter).
+  Localizer(const Map& map, const PipelineOptions& map_options, LocalizerOptions options);
+
+  // The vehicle's pose at the first scan, in the map frame: tracking starts there.
+  void setInitialPose(const common::Pose2& pose);
+  // One measurement; the result when it was a scan that was used.
+  std::optional<LocalizedScan> add(const io::Measurement& m);
+  LocalizationState state() const { return state_; }
+  const LocalizerStats& stats() const { return stats_; }
+
+ private:
+  LocalizedScan onScan(io::LaserScan scan);
+  bool placeSearchDue(double t) const;
+  void setPose(const common::Pose2& pose, const Eigen::Matrix3d& cov);
+
+  const Map& map_;
+  LocalizerOptions options_;
+  MotionOptions::Model motion_model_;
+  InputFilter input_;
+  MotionIntegrator motion_;
+  // Wheel odometry arrives at its own times, a scan in between: the odometry pose at the scan is
+  // the last reading's carried on at the last step's rate ("lead"), otherwise the prediction
+  // jumps by up to a reading's motion from scan to scan.
+  common::Pose2 odometryLead(double t) const;
+  io::OdometryReading odom_prev_, odom_last_;
+  size_t odom_readings_ = 0;
+  common::Pose2 lead_;  // the lead applied at the previous scan
+  MapAreas areas_;
+  PlaceRecognizer places_;
+  TrackingMonitor monitor_;
+  alignment::PriorMatcherOptions matcher_;
+  alignment::SeenThroughRate seen_through_{0.05}, seen_through_displaced_{0.3};
+
+  LocalizationState state_ = LocalizationState::Lost;
+  bool have_pose_ = false;
+  common::Pose2 pose_;
+  Eigen::Matrix3d cov_ = Eigen::Matrix3d::Identity();
+  bool have_scan_ = false;
+  double last_scan_time_ = 0;
+  // Place-search schedule while lost.
+  bool searched_ = false;
+  double last_search_time_ = 0, search_interval_s_ = 0;
+  common::Pose2 last_search_odometry_;
+  LocalizerStats stats_;
+};
+
+// Localizes every measurement of `source`; on_scan (optional) sees each result with the
+// source's progress.
+std::vector<LocalizedScan> localize(Localizer& localizer, io::DataSource& source,
+                                    const std::function<void(const LocalizedScan&, double progress)>& on_scan = {});
+
+}  // namespace urbanslam::slam

@@ -1,0 +1,223 @@
+#include "urbanslam/slam/Localizer.h"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+
+#include "urbanslam/alignment/ScanModel.h"
+#include "urbanslam/common/Timing.h"
+#include "urbanslam/slam/LocalSubmap.h"
+
+namespace urbanslam::slam {
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+}  // namespace
+
+LocalizerOptions localizerOptions(const PipelineOptions& map_options) {
+  LocalizerOptions o;
+  o.areas.matcher = priorMatcherOptions(map_options.local);
+  o.covariance_scale = map_options.local.covariance_scale;
+  // Place recognition searches whole heading circles over metres: a coarser grid whose returns
+  // spread over a few cells keeps that search affordable and tolerant of the window's steps.
+  o.areas.coarse.resolution_m = 0.1;
+  o.areas.coarse.hit_sigma_m = 0.1;
+  o.areas.coarse.miss_floor = map_options.local.miss_floor;
+  o.areas.coarse.levels = 5;
+  return o;
+}
+
+const char* stateName(LocalizationState state) { return state == LocalizationState::Tracking ? "tracking" : "lost"; }
+
+Localizer::Localizer(const Map& map, const PipelineOptions& map_options, LocalizerOptions options)
+    : map_(map),
+      options_(std::move(options)),
+      motion_model_(map_options.motion.model),
+      input_(map_options.input),
+      motion_(map_options.motion, map_options.vehicle),
+      areas_(map_, options_.areas),
+      places_(map_, areas_, options_.places),
+      monitor_(options_.monitor),
+      matcher_(areas_.options().matcher) {}
+
+void Localizer::setInitialPose(const common::Pose2& pose) {
+  const double s = options_.initial_sigma_xy_m, a = options_.initial_sigma_deg * kDeg;
+  setPose(pose, Eigen::Vector3d(s * s, s * s, a * a).asDiagonal());
+  state_ = LocalizationState::Tracking;
+  monitor_.reset();
+}
+
+void Localizer::setPose(const common::Pose2& pose, const Eigen::Matrix3d& cov) {
+  pose_ = pose;
+  cov_ = 0.5 * (cov + cov.transpose());
+  // The matcher's posterior alone would shrink without bound over many matches against the same
+  // map, which has errors of its own.
+  const double sxy = options_.min_sigma_xy_m, sphi = options_.min_sigma_deg * kDeg;
+  cov_(0, 0) = std::max(cov_(0, 0), sxy * sxy);
+  cov_(1, 1) = std::max(cov_(1, 1), sxy * sxy);
+  cov_(2, 2) = std::max(cov_(2, 2), sphi * sphi);
+  have_pose_ = true;
+}
+
+std::optional<LocalizedScan> Localizer::add(const io::Measurement& m) {
+  common::Stopwatch sw;
+  ++stats_.measurements;
+  std::optional<LocalizedScan> out;
+  if (const auto* scan = std::get_if<io::LaserScan>(&m)) {
+    ++stats_.scans;
+    if (input_.accepts(scan->label)) out = onScan(*scan);
+  } else if (const auto* od = std::get_if<io::OdometryReading>(&m)) {
+    ++stats_.odometry;
+    if (motion_model_ != MotionOptions::Model::Steering) {
+      motion_.addOdometry(*od);
+      odom_prev_ = odom_last_;
+      odom_last_ = *od;
+      ++odom_readings_;
+    }
+  } else if (const auto* dr = std::get_if<io::DriveReading>(&m)) {
+    if (motion_model_ != MotionOptions::Model::Odometry) motion_.addDrive(*dr);
+  }
+  stats_.wall_s += sw.seconds();
+  stats_.references_built = areas_.referencesBuilt();
+  stats_.coarse_grids_built = areas_.coarseGridsBuilt();
+  return out;
+}
+
+common::Pose2 Localizer::odometryLead(double t) const {
+  if (odom_readings_ < 2) return {};
+  const double dt = odom_last_.timestamp - odom_prev_.timestamp;
+  if (!(dt > 0)) return {};
+  // Within one reading interval either way: beyond, the last rate says little.
+  const double f = std::clamp((t - odom_last_.timestamp) / dt, -1.0, 1.0);
+  const common::Pose2 step = common::between(odom_prev_.pose, odom_last_.pose);
+  return {f * step.x, f * step.y, f * step.phi};
+}
+
+bool Localizer::placeSearchDue(double t) const {
+  if (!searched_) return true;
+  if (t - last_search_time_ < search_interval_s_) return false;
+  const common::Pose2 moved = common::between(last_search_odometry_, motion_.odometryPose());
+  return std::hypot(moved.x, moved.y) >= options_.relocalise_min_motion_m ||
+         std::abs(moved.phi) >= options_.relocalise_min_rotation_deg * kDeg;
+}
+
+LocalizedScan Localizer::onScan(io::LaserScan scan) {
+  input_.limitRanges(scan);
+  ++stats_.scans_used;
+  const double t = scan.timestamp;
+  if (!have_scan_) stats_.first_timestamp = t;
+  if (have_scan_ && state_ == LocalizationState::Lost) stats_.lost_s += std::max(0.0, t - last_scan_time_);
+  stats_.last_timestamp = t;
+  const alignment::PointSet points = alignment::pointSetFromScan(scan, areas_.options().scan_model, true);
+
+  // The prediction: the odometry since the previous scan composed onto its pose, the covariance
+  // carried through the composition's Jacobians.
+  common::Pose2 predicted = pose_;
+  Eigen::Matrix3d predicted_cov = cov_;
+  if (have_pose_) {
+    const common::Pose2 lead = odometryLead(t);
+    const common::Pose2 d = common::compose(common::compose(common::inverse(lead_), motion_.increment()), lead);
+    const double c = std::cos(pose_.phi), s = std::sin(pose_.phi);
+    Eigen::Matrix3d ja = Eigen::Matrix3d::Identity(), jd = Eigen::Matrix3d::Identity();
+    ja(0, 2) = -s * d.x - c * d.y;
+    ja(1, 2) = c * d.x - s * d.y;
+    jd.topLeftCorner<2, 2>() << c, -s, s, c;
+    predicted = common::compose(pose_, d);
+    predicted_cov = ja * cov_ * ja.transpose() + jd * motion_.covariance() * jd.transpose();
+  }
+
+  LocalizedScan out;
+  out.timestamp = t;
+  if (state_ == LocalizationState::Tracking) {
+    const alignment::MatchReference* reference = areas_.reference(predicted.x, predicted.y);
+    alignment::PriorMatchResult r;
+    if (reference) {
+      alignment::PriorMatcherOptions o = matcher_;
+      o.seen_through_rate = seen_through_.rate();
+      o.seen_through_rate_displaced = seen_through_displaced_.rate();
+      // The window covers the prediction's 3σ; the matcher's wider reach for a vehicle that
+      // travelled far from the reference's origin does not apply in the map frame.
+      const double sxy = std::sqrt(std::max(predicted_cov(0, 0), predicted_cov(1, 1)));
+      o.max_search_window_m = std::clamp(3 * sxy, o.search_window_m, matcher_.max_search_window_m);
+      r = alignment::matchWithPrior(*reference, points, predicted, predicted_cov, o);
+    }
+    out.matched_fraction = r.matchedFraction();
+    if (reference && r.valid && out.matched_fraction >= options_.min_matched_fraction) {
+      Eigen::Vector3d d(r.pose.x - predicted.x, r.pose.y - predicted.y, common::wrapToPi(r.pose.phi - predicted.phi));
+      out.mahalanobis2 = d.dot(predicted_cov.inverse() * d);
+      out.matched = true;
+      monitor_.addMatch(out.mahalanobis2);
+      setPose(r.pose, options_.covariance_scale * r.cov);
+      if (!r.odometry_outvoted) {
+        seen_through_.add(r.in_view, r.seen_through);
+        seen_through_displaced_.add(r.displaced_in_view, r.displaced_seen_through);
+      }
+    } else {
+      ++stats_.matches_failed;
+      monitor_.addFailure();
+      setPose(predicted, predicted_cov);
+    }
+    if (monitor_.lost()) {
+      state_ = LocalizationState::Lost;
+      ++stats_.lost_events;
+      searched_ = false;  // a place search right away
+    }
+  } else if (have_pose_) {
+    setPose(predicted, predicted_cov);
+  }
+
+  motion_.reset();
+  lead_ = odometryLead(t);
+  if (state_ == LocalizationState::Lost && placeSearchDue(t)) {
+    common::Stopwatch sw;
+    const PlaceHypothesis h = places_.locate(points, matcher_);
+    stats_.place_search_wall_s += sw.seconds();
+    ++stats_.place_searches;
+    if (h.found) {
+      setPose(h.pose, options_.covariance_scale * h.cov);
+      state_ = LocalizationState::Tracking;
+      monitor_.reset();
+      out.relocalised = true;
+      out.matched = true;
+      out.matched_fraction = h.matched_fraction;
+      ++stats_.relocalisations;
+      searched_ = false;
+    } else {
+      search_interval_s_ = searched_ ? std::min(options_.relocalise_max_interval_s, 2 * search_interval_s_) : options_.relocalise_interval_s;
+      searched_ = true;
+      last_search_time_ = t;
+      last_search_odometry_ = motion_.odometryPose();
+    }
+  }
+
+  out.state = state_;
+  out.has_pose = have_pose_;
+  out.pose = pose_;
+  out.cov = cov_;
+  if (state_ == LocalizationState::Tracking) {
+    ++stats_.tracking;
+    if (stats_.first_fix_s < 0) stats_.first_fix_s = t - stats_.first_timestamp;
+  } else {
+    ++stats_.lost;
+  }
+  have_scan_ = true;
+  last_scan_time_ = t;
+  return out;
+}
+
+std::vector<LocalizedScan> localize(Localizer& localizer, io::DataSource& source,
+                                    const std::function<void(const LocalizedScan&, double progress)>& on_scan) {
+  std::vector<LocalizedScan> out;
+  io::Measurement m;
+  while (source.next(m)) {
+    if (auto r = localizer.add(m)) {
+      if (on_scan) on_scan(*r, source.progress());
+      out.push_back(*r);
+    }
+  }
+  return out;
+}
+
+}  // namespace urbanslam::slam

@@ -1,0 +1,114 @@
+#include "urbanslam/slam/PlaceRecognizer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+#include <unordered_set>
+
+#include "urbanslam/alignment/CorrelativeSearch.h"
+#include "urbanslam/alignment/MotionPrior.h"
+
+namespace urbanslam::slam {
+
+namespace {
+constexpr double kDeg = M_PI / 180.0;
+}  // namespace
+
+PlaceRecognizer::PlaceRecognizer(const Map& map, MapAreas& areas, PlaceRecognitionOptions options)
+    : areas_(areas), options_(std::move(options)) {
+  const double s = options_.candidate_spacing_m;
+  std::set<std::pair<int64_t, int64_t>> cells;
+  for (const Keyframe& k : map.keyframes())
+    if (k.hasScan() && std::isfinite(k.pose.x) && std::isfinite(k.pose.y))
+      cells.insert({static_cast<int64_t>(std::floor(k.pose.x / s)), static_cast<int64_t>(std::floor(k.pose.y / s))});
+  for (const auto& [cx, cy] : cells) centres_.emplace_back((static_cast<double>(cx) + 0.5) * s, (static_cast<double>(cy) + 0.5) * s);
+  // Grouped by tile, so one search builds (or fetches) each tile's grid once.
+  std::stable_sort(centres_.begin(), centres_.end(), [&](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return areas_.tileKey(a.x(), a.y()) < areas_.tileKey(b.x(), b.y());
+  });
+}
+
+PlaceHypothesis PlaceRecognizer::locate(const alignment::PointSet& scan, const alignment::PriorMatcherOptions& matcher) {
+  PlaceHypothesis h;
+  // The search's points: one per voxel, near returns only (far ones fall outside the grids).
+  std::vector<Eigen::Vector2d> points;
+  std::unordered_set<int64_t> voxels;
+  for (const auto& sp : scan) {
+    if (sp.p.norm() > options_.max_range_m) continue;
+    const auto vx = static_cast<int64_t>(std::floor(sp.p.x() / options_.voxel_m));
+    const auto vy = static_cast<int64_t>(std::floor(sp.p.y() / options_.voxel_m));
+    if (voxels.insert(vx * 1000003 + vy).second) points.push_back(sp.p);
+  }
+  h.points = static_cast<int>(points.size());
+  if (h.points < options_.min_points) {
+    h.reason = "too few points";
+    return h;
+  }
+  alignment::CorrelativeWindow window;
+  window.half_width_m = options_.candidate_spacing_m / 2 + options_.window_overlap_m;
+  window.half_angle_rad = M_PI;
+  // No prior: a Gaussian so wide that its density is flat over any window.
+  const Eigen::Matrix3d flat = Eigen::Vector3d(1e8, 1e8, 1e8).asDiagonal();
+  struct Found {
+    common::Pose2 pose;
+    double score;
+  };
+  std::vector<Found> found;
+  for (const Eigen::Vector2d& c : centres_) {
+    const alignment::LikelihoodGrid* grid = areas_.coarseGrid(c.x(), c.y());
+    if (!grid) continue;
+    const alignment::MotionPrior prior({c.x(), c.y(), 0.0}, flat, 0.0, 1.0);
+    const alignment::CorrelativeResult r = alignment::correlativeSearch(*grid, points, prior, window);
+    found.push_back({r.pose, r.scan_score});
+    h.nodes += r.nodes;
+  }
+  h.candidates = static_cast<int>(found.size());
+  if (found.empty()) {
+    h.reason = "empty map";
+    return h;
+  }
+  const auto best = std::max_element(found.begin(), found.end(), [](const Found& a, const Found& b) { return a.score < b.score; });
+  h.score = best->score;
+  h.second_score = -std::numeric_limits<double>::infinity();
+  for (const Found& f : found) {
+    const bool elsewhere = std::hypot(f.pose.x - best->pose.x, f.pose.y - best->pose.y) > options_.distinct_m ||
+                           std::abs(common::wrapToPi(f.pose.phi - best->pose.phi)) > options_.distinct_deg * kDeg;
+    if (elsewhere) h.second_score = std::max(h.second_score, f.score);
+  }
+  h.margin_per_point = (h.score - h.second_score) / h.points;  // +inf when the map has one place only
+  h.pose = best->pose;
+  if (h.margin_per_point < options_.min_margin_per_point) {
+    h.reason = "ambiguous";
+    return h;
+  }
+  // The winner refined on the fine reference, from the coarse pose.
+  const alignment::MatchReference* reference = areas_.reference(best->pose.x, best->pose.y);
+  if (!reference) {
+    h.reason = "no reference";
+    return h;
+  }
+  const double s = options_.refine_sigma_m, a = options_.refine_sigma_deg * kDeg;
+  const alignment::PriorMatchResult r =
+      alignment::matchWithPrior(*reference, scan, best->pose, Eigen::Vector3d(s * s, s * s, a * a).asDiagonal(), matcher);
+  h.matched_fraction = r.matchedFraction();
+  if (!r.valid) {
+    h.reason = "refinement failed: " + r.failure_reason;
+    return h;
+  }
+  if (h.matched_fraction < options_.min_matched_fraction) {
+    h.reason = "poor fit";
+    return h;
+  }
+  h.seen_through_share = r.in_view > 0 ? static_cast<double>(r.seen_through) / r.in_view : 1.0;
+  if (h.seen_through_share > options_.max_seen_through_share) {
+    h.reason = "walls where the other side saw free space";
+    return h;
+  }
+  h.found = true;
+  h.pose = r.pose;
+  h.cov = r.cov;
+  return h;
+}
+
+}  // namespace urbanslam::slam

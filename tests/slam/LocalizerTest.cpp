@@ -1,0 +1,160 @@
+// Localization in a frozen map, checked against references independent of the localizer: the
+// benchmark relations of the FR079 excerpt (Kümmerle et al. 2009) and the trajectory of a
+// mapping run over the whole excerpt. The map is built from the excerpt's first 600 scans; the
+// other 600 are localized in it. They start where the map ended, leave it for a room the first
+// half never saw (about 1350-1430 s and again after 1460 s) and come back in between.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+
+#include "SkippingSource.h"
+#include "TestPaths.h"
+#include "urbanslam/evaluation/Evaluation.h"
+#include "urbanslam/slam/Localizer.h"
+#include "urbanslam/slam/Pipeline.h"
+
+using namespace urbanslam;
+
+namespace {
+
+constexpr size_t kMappedScans = 600;
+
+std::string excerpt() { return test::repoPath("rawlogs/fr079-raw-excerpt.clf.gz"); }
+
+struct Maps {
+  std::unique_ptr<slam::Pipeline> first;  // the first kMappedScans scans
+  std::unique_ptr<slam::Pipeline> full;   // every scan: the reference trajectory
+  size_t skip = 0;                        // measurements of the first part
+};
+
+const Maps& maps() {
+  static const Maps m = [] {
+    Maps m;
+    const slam::PipelineOptions o = slam::loadPipelineOptions(test::repoPath("ini/fr079.ini"));
+    m.first = std::make_unique<slam::Pipeline>(o);
+    auto src = io::openDataSource(excerpt());
+    while (m.first->stats().scans < kMappedScans && m.first->step(*src)) {
+    }
+    m.first->finish();
+    m.skip = m.first->stats().measurements;
+    m.full = std::make_unique<slam::Pipeline>(o);
+    m.full->run(*io::openDataSource(excerpt()));
+    return m;
+  }();
+  return m;
+}
+
+struct Localized {
+  std::vector<slam::LocalizedScan> scans;
+  slam::LocalizerStats stats;
+};
+
+Localized localizeRest(const std::optional<common::Pose2>& initial, const std::string& log = excerpt(), size_t skip = maps().skip,
+                       size_t max_scans = 100000) {
+  const slam::Pipeline& map = *maps().first;
+  slam::Localizer localizer(map.map(), map.options(), slam::localizerOptions(map.options()));
+  if (initial) localizer.setInitialPose(*initial);
+  test::SkippingSource src(io::openDataSource(log), skip);
+  Localized out;
+  io::Measurement m;
+  while (out.scans.size() < max_scans && src.next(m))
+    if (auto r = localizer.add(m)) out.scans.push_back(*r);
+  out.stats = localizer.stats();
+  return out;
+}
+
+std::vector<io::StampedPose> tracked(const std::vector<slam::LocalizedScan>& scans) {
+  std::vector<io::StampedPose> out;
+  for (const auto& s : scans)
+    if (s.state == slam::LocalizationState::Tracking) out.push_back({s.timestamp, s.pose});
+  return out;
+}
+
+// The full run's pose at a scan time (both place every scan of the excerpt).
+common::Pose2 reference(double t) {
+  common::Pose2 p;
+  EXPECT_TRUE(evaluation::interpolatePose(maps().full->scanTrajectory(), t, 1.0, p));
+  return p;
+}
+
+double distance(const common::Pose2& a, const common::Pose2& b) { return std::hypot(a.x - b.x, a.y - b.y); }
+
+double percentileOf(std::vector<double> v, double q) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[static_cast<size_t>(q * static_cast<double>(v.size() - 1))];
+}
+
+}  // namespace
+
+// Started where the map ended: the relations between the tracked scans are met about as well as
+// by the mapping run over the whole excerpt, and the poses are those of that run (whose frame is
+// the map's: both start at the same first scan).
+TEST(Localizer, TracksTheRestOfTheExcerptAsWellAsTheFullRunMapsIt) {
+  const common::Pose2 start = maps().first->scanTrajectory().back().pose;
+  const Localized loc = localizeRest(start);
+  const auto traj = tracked(loc.scans);
+  ASSERT_GT(traj.size(), 200u);
+
+  // The relations whose two ends are both tracked (none across a lost stretch).
+  std::vector<evaluation::Relation> inside;
+  common::Pose2 unused;
+  for (const auto& r : evaluation::readRelations(test::repoPath("rawlogs/fr079-raw-excerpt.relations")))
+    if (evaluation::interpolatePose(traj, r.t1, 0.5, unused) && evaluation::interpolatePose(traj, r.t2, 0.5, unused)) inside.push_back(r);
+  ASSERT_GE(inside.size(), 40u);
+  const auto localized = evaluation::relationMetrics(traj, inside, 0.0, 0.5);
+  const auto mapped = evaluation::relationMetrics(maps().full->scanTrajectory(), inside, 0.0, 0.5);
+  EXPECT_EQ(localized.used, inside.size());
+  EXPECT_LT(localized.abs_trans_m.mean, 1.5 * mapped.abs_trans_m.mean + 0.01);
+  EXPECT_LT(localized.abs_rot_deg.mean, 1.5 * mapped.abs_rot_deg.mean + 0.2);
+
+  std::vector<double> errors;
+  for (const auto& p : traj) errors.push_back(distance(p.pose, reference(p.timestamp)));
+  EXPECT_LT(percentileOf(errors, 0.5), 0.06);
+  EXPECT_LT(percentileOf(errors, 0.95), 0.2);
+
+  // The room the map never saw is not tracked, and the way back is found.
+  EXPECT_GE(loc.stats.lost_events, 1u);
+  EXPECT_GE(loc.stats.relocalisations, 1u);
+  EXPECT_GT(loc.stats.lost_s, 30.0);
+}
+
+// No initial pose: the place search finds the start at once, in the right place.
+TEST(Localizer, FindsItsPlaceWithoutAnInitialPose) {
+  const Localized loc = localizeRest(std::nullopt, excerpt(), maps().skip, 50);
+  ASSERT_GE(loc.stats.first_fix_s, 0.0);
+  EXPECT_LE(loc.stats.first_fix_s, 3.0);
+  for (const auto& s : loc.scans) {
+    if (s.state != slam::LocalizationState::Tracking) continue;
+    EXPECT_LT(distance(s.pose, reference(s.timestamp)), 0.2) << s.timestamp;
+    EXPECT_LT(std::abs(common::wrapToPi(s.pose.phi - reference(s.timestamp).phi)), 3 * M_PI / 180) << s.timestamp;
+  }
+}
+
+// Kidnapped: told a pose 3 m and 40° off, it loses track and the place search puts it back.
+TEST(Localizer, RecoversFromAWrongInitialPose) {
+  const common::Pose2 truth = maps().first->scanTrajectory().back().pose;
+  const Localized loc = localizeRest(common::compose(truth, {3.0, -1.5, 0.7}), excerpt(), maps().skip, 60);
+  size_t relocalised_at = loc.scans.size();
+  for (size_t i = 0; i < loc.scans.size(); ++i)
+    if (loc.scans[i].relocalised) {
+      relocalised_at = i;
+      break;
+    }
+  ASSERT_LT(relocalised_at, 30u);
+  for (size_t i = relocalised_at; i < loc.scans.size(); ++i) {
+    const auto& s = loc.scans[i];
+    EXPECT_EQ(s.state, slam::LocalizationState::Tracking) << s.timestamp;
+    EXPECT_LT(distance(s.pose, reference(s.timestamp)), 0.2) << s.timestamp;
+  }
+}
+
+// A building the map has never seen (the Intel lab): no place is ever accepted.
+TEST(Localizer, StaysLostWhereTheMapHasNeverBeen) {
+  const Localized loc = localizeRest(std::nullopt, test::repoPath("rawlogs/intel.rawlog"), 0, 120);
+  ASSERT_EQ(loc.scans.size(), 120u);
+  EXPECT_GT(loc.stats.place_searches, 10u);
+  EXPECT_EQ(loc.stats.relocalisations, 0u);
+  EXPECT_EQ(loc.stats.tracking, 0u);
+  for (const auto& s : loc.scans) EXPECT_FALSE(s.has_pose);
+}
