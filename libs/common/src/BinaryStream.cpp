@@ -124,7 +124,10 @@ std::string BinaryReader::string() {
   return std::string(reinterpret_cast<const char*>(p), n);
 }
 
-void BinaryReader::raw(void* out, size_t n) { std::memcpy(out, take(n), n); }
+void BinaryReader::raw(void* out, size_t n) {
+  const unsigned char* p = take(n);
+  if (n > 0) std::memcpy(out, p, n);  // an empty vector's data() may be null, and memcpy must not get one
+}
 
 Eigen::MatrixXd BinaryReader::dense() {
   const size_t rows = size(), cols = size();

@@ -48,7 +48,7 @@ std::vector<size_t> MapAreas::tileKeyframes(int64_t key) const {
   std::sort(near.begin(), near.end());
   // Revisits add scans of the same walls from the same places: the first keyframe of each cell
   // and heading quadrant stands for them (the earliest, so a rebuilt tile is the same).
-  std::unordered_set<int64_t> taken;
+  std::unordered_set<uint64_t> taken;
   std::vector<size_t> out;
   const double s = options_.keyframe_spacing_m;
   for (size_t k : near) {
@@ -56,7 +56,9 @@ std::vector<size_t> MapAreas::tileKeyframes(int64_t key) const {
     if (std::hypot(kf.pose.x - c.x(), kf.pose.y - c.y()) > radius) continue;
     const auto cx = static_cast<int64_t>(std::floor(kf.pose.x / s)), cy = static_cast<int64_t>(std::floor(kf.pose.y / s));
     const auto quadrant = static_cast<int64_t>(std::floor((kf.pose.phi + M_PI) / (M_PI / 2))) & 3;
-    if (s <= 0 || taken.insert(packKey(cx, cy) * 4 + quadrant).second) out.push_back(k);
+    // Unsigned: the packed cell uses the whole 64 bits, and shifting it must wrap, not overflow.
+    const uint64_t cell = static_cast<uint64_t>(packKey(cx, cy)) << 2 | static_cast<uint64_t>(quadrant);
+    if (s <= 0 || taken.insert(cell).second) out.push_back(k);
   }
   return out;
 }
