@@ -18,7 +18,9 @@ BeamFreeSpace::BeamFreeSpace(const PointSet& scan, double margin_m, double margi
     polar.emplace_back(scan[i].range_m * std::cos(scan[i].bearing_rad), scan[i].range_m * std::sin(scan[i].bearing_rad));
     placed.push_back(scan[i].p);
     if (i > 0 && scan[i].beam != scan[i - 1].beam) {
-      const double d = std::abs(scan[i].bearing_rad - scan[i - 1].bearing_rad) / std::abs(scan[i].beam - scan[i - 1].beam);
+      // In double: beam indices read from a file may be anything, and an int difference overflow.
+      const double d = std::abs(scan[i].bearing_rad - scan[i - 1].bearing_rad) /
+                       std::abs(static_cast<double>(scan[i].beam) - static_cast<double>(scan[i - 1].beam));
       if (d > 1e-6) step = std::min(step, d);
     }
   }
