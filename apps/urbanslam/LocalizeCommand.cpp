@@ -35,7 +35,8 @@ int localizeCommand(const Argv& args) {
                "Tracks the vehicle of LOG in the map of an earlier `urbanslam run` (its map.usmap, or its output\n"
                "folder), which is not changed: every scan is predicted by the odometry and matched against the\n"
                "map's scans near that pose. Without --initial, and whenever the matches stop supporting the pose\n"
-               "(lost), the whole map is searched for the scan's place until one place clearly wins.");
+               "(lost), the map is searched for the scan's place until one place clearly wins: the whole map,\n"
+               "or, once matches have confirmed the pose, only where the odometry from it can have gone.");
   ap.addPositional("LOG", "the log to localize (any format `run` reads)");
   ap.addOption("map", "MAP", "the map: a map.usmap file or the run folder holding one (required)");
   ap.addOption("initial", "x,y,phi", "the vehicle's pose at the first scan in the map frame (m, m, rad); default: searched");

@@ -97,6 +97,19 @@ TEST(CorrelativeSearch, BranchAndBoundFindsTheExhaustiveOptimum) {
   EXPECT_NEAR(r.pose.x, best_pose.x, 1e-9);
   EXPECT_NEAR(r.pose.y, best_pose.y, 1e-9);
   EXPECT_NEAR(r.pose.phi, best_pose.phi, 1e-9);
+  EXPECT_FALSE(r.below_min_score);
+
+  // A floor below the optimum leaves the answer as it is; one above it, no answer.
+  window.min_score = best - 5.0;
+  const CorrelativeResult floored = correlativeSearch(grid, pts, prior, window);
+  EXPECT_FALSE(floored.below_min_score);
+  EXPECT_NEAR(floored.score, best, 1e-3);
+  EXPECT_NEAR(floored.pose.x, best_pose.x, 1e-9);
+  EXPECT_NEAR(floored.pose.y, best_pose.y, 1e-9);
+  EXPECT_NEAR(floored.pose.phi, best_pose.phi, 1e-9);
+  EXPECT_LE(floored.nodes, r.nodes);
+  window.min_score = best + 0.01;
+  EXPECT_TRUE(correlativeSearch(grid, pts, prior, window).below_min_score);
 }
 
 // The scan taken at `truth` (in the reference scan's frame), matched from a prior at `odometry`.

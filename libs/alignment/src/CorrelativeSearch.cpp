@@ -18,7 +18,7 @@ struct Node {
 class Search {
  public:
   Search(const LikelihoodGrid& grid, const std::vector<Eigen::Vector2d>& points, const MotionPrior& prior, const CorrelativeWindow& w)
-      : grid_(grid), prior_(prior), r_(grid.resolution()) {
+      : grid_(grid), prior_(prior), r_(grid.resolution()), min_score_(w.min_score) {
     // A heading step that moves a typical point by one cell (Hess et al. 2016, eq. 7 takes the
     // farthest), "typical" being the median range: half the points then move by at most a cell
     // between neighbouring headings, the rest by a few, which the refinement absorbs. Outdoors
@@ -54,6 +54,9 @@ class Search {
     // The prior's mean is scored first: the bound to beat, and the odometry wins ties.
     const int centre = static_cast<int>(dphi_.size() / 2);
     best_ = {centre, 0, 0, score(0, centre, 0, 0)};
+    // Below the caller's floor the centre is a stand-in to beat, not an answer.
+    below_min_ = best_.score <= min_score_;
+    if (below_min_) best_.score = min_score_;
     std::vector<Node> roots;
     const int s = 1 << top;
     for (int a = 0; a < static_cast<int>(dphi_.size()); ++a)
@@ -66,6 +69,7 @@ class Search {
     out.score = best_.score;
     out.scan_score = best_.score - prior_.logDensity(out.pose);
     out.nodes = nodes_;
+    out.below_min_score = below_min_;
     return out;
   }
 
@@ -98,6 +102,7 @@ class Search {
       if (n.score <= best_.score) return;  // sorted: no later block can beat the best either
       if (level == 0) {
         best_ = n;
+        below_min_ = false;
         continue;
       }
       branchChildren(n, level);
@@ -118,9 +123,10 @@ class Search {
     for (int k = 0; k < count; ++k) {
       const Node& c = children[static_cast<size_t>(k)];
       if (c.score <= best_.score) return;
-      if (level - 1 == 0)
+      if (level - 1 == 0) {
         best_ = c;
-      else
+        below_min_ = false;
+      } else
         branchChildren(c, level - 1);
     }
   }
@@ -128,10 +134,12 @@ class Search {
   const LikelihoodGrid& grid_;
   const MotionPrior& prior_;
   double r_, step_ = 0;
+  double min_score_;
   int half_cells_ = 0, nodes_ = 0;
   std::vector<double> dphi_;
   std::vector<std::vector<Eigen::Vector2i>> cells_;
   Node best_{0, 0, 0, 0};
+  bool below_min_ = false;
 };
 
 }  // namespace

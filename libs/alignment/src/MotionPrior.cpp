@@ -9,7 +9,7 @@
 namespace urbanslam::alignment {
 
 MotionPrior::MotionPrior(const common::Pose2& mean, const Eigen::Matrix3d& cov, double outlier_probability, double window_volume)
-    : mean_(mean), information_(cov.inverse()) {
+    : mean_(mean), information_(cov.inverse()), position_ldlt_(information_.topLeftCorner<2, 2>()) {
   const double p = std::clamp(outlier_probability, 0.0, 1.0);
   log_gauss_norm_ =
       p < 1 ? std::log1p(-p) - 1.5 * std::log(2 * M_PI) - 0.5 * std::log(cov.determinant()) : -std::numeric_limits<double>::infinity();
@@ -42,7 +42,7 @@ double MotionPrior::minMahalanobis2(double dx0, double dx1, double dy0, double d
     return A(0, 0) * x * x + 2 * A(0, 1) * x * y + A(1, 1) * y * y + 2 * (b(0) * x + b(1) * y) + c;
   };
   // The unconstrained minimum, when it lies inside the rectangle.
-  const Eigen::Vector2d u = -A.ldlt().solve(b);
+  const Eigen::Vector2d u = -position_ldlt_.solve(b);
   if (u(0) >= dx0 && u(0) <= dx1 && u(1) >= dy0 && u(1) <= dy1) return std::max(0.0, q(u(0), u(1)));
   // Otherwise on an edge: a 1D convex quadratic on each, minimised by clamping.
   double best = std::numeric_limits<double>::infinity();

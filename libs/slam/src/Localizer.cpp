@@ -6,6 +6,7 @@
 
 #include "urbanslam/alignment/ScanModel.h"
 #include "urbanslam/common/Timing.h"
+#include "urbanslam/esdf/Gating.h"
 #include "urbanslam/slam/LocalSubmap.h"
 
 namespace urbanslam::slam {
@@ -40,13 +41,16 @@ Localizer::Localizer(const Map& map, const PipelineOptions& map_options, Localiz
       areas_(map_, options_.areas),
       places_(map_, areas_, options_.places),
       monitor_(options_.monitor),
-      matcher_(areas_.options().matcher) {}
+      matcher_(areas_.options().matcher),
+      continuity_gate_(esdf::chi2Quantile(options_.continuity_probability, 2)) {}
 
 void Localizer::setInitialPose(const common::Pose2& pose) {
   const double s = options_.initial_sigma_xy_m, a = options_.initial_sigma_deg * kDeg;
   setPose(pose, Eigen::Vector3d(s * s, s * s, a * a).asDiagonal());
   state_ = LocalizationState::Tracking;
   monitor_.reset();
+  consecutive_matches_ = 0;
+  confirmed_ = false;
 }
 
 void Localizer::setPose(const common::Pose2& pose, const Eigen::Matrix3d& cov) {
@@ -149,6 +153,7 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
       out.mahalanobis2 = d.dot(predicted_cov.inverse() * d);
       out.matched = true;
       monitor_.addMatch(out.mahalanobis2);
+      if (++consecutive_matches_ >= options_.confirm_matches) confirmed_ = true;
       setPose(r.pose, options_.covariance_scale * r.cov);
       if (!r.odometry_outvoted) {
         seen_through_.add(r.in_view, r.seen_through);
@@ -157,9 +162,16 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
     } else {
       ++stats_.matches_failed;
       monitor_.addFailure();
+      consecutive_matches_ = 0;
       setPose(predicted, predicted_cov);
     }
     if (monitor_.lost()) {
+      const double sxy = options_.lost_sigma_xy_m, sphi = options_.lost_sigma_deg * kDeg;
+      Eigen::Matrix3d widened = cov_;
+      widened(0, 0) = std::max(widened(0, 0), sxy * sxy);
+      widened(1, 1) = std::max(widened(1, 1), sxy * sxy);
+      widened(2, 2) = std::max(widened(2, 2), sphi * sphi);
+      setPose(pose_, widened);
       state_ = LocalizationState::Lost;
       ++stats_.lost_events;
       searched_ = false;  // a place search right away
@@ -172,11 +184,27 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
   lead_ = odometryLead(t);
   if (state_ == LocalizationState::Lost && placeSearchDue(t)) {
     common::Stopwatch sw;
-    const PlaceHypothesis h = places_.locate(points, matcher_);
+    // A confirmed dead reckoning rules out every place beyond its gate (below): those are not
+    // searched at all, which also leaves no search where the map never reached.
+    std::optional<PlaceSearchRegion> region;
+    const double k2 = options_.continuity_sigma_scale * options_.continuity_sigma_scale;
+    if (confirmed_ && have_pose_) region = PlaceSearchRegion{{pose_.x, pose_.y}, k2 * cov_.topLeftCorner<2, 2>(), continuity_gate_};
+    const PlaceHypothesis h = places_.locate(points, matcher_, region);
     stats_.place_search_wall_s += sw.seconds();
     ++stats_.place_searches;
-    if (h.found) {
+    bool accepted = h.found;
+    if (h.found && region) {
+      const Eigen::Vector2d d(h.pose.x - pose_.x, h.pose.y - pose_.y);
+      const Eigen::Matrix2d s = region->cov + options_.covariance_scale * h.cov.topLeftCorner<2, 2>();
+      accepted = d.dot(s.inverse() * d) <= continuity_gate_;
+      if (!accepted) ++stats_.fixes_rejected;
+    }
+    if (accepted) {
       setPose(h.pose, options_.covariance_scale * h.cov);
+      consecutive_matches_ = 0;
+      // A fix that the confirmed dead reckoning admitted carries its confirmation on; one from
+      // the whole map has yet to earn it.
+      confirmed_ = region.has_value();
       state_ = LocalizationState::Tracking;
       monitor_.reset();
       out.relocalised = true;

@@ -1,5 +1,6 @@
 #include "urbanslam/slam/PlaceRecognizer.h"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -29,7 +30,8 @@ PlaceRecognizer::PlaceRecognizer(const Map& map, MapAreas& areas, PlaceRecogniti
   });
 }
 
-PlaceHypothesis PlaceRecognizer::locate(const alignment::PointSet& scan, const alignment::PriorMatcherOptions& matcher) {
+PlaceHypothesis PlaceRecognizer::locate(const alignment::PointSet& scan, const alignment::PriorMatcherOptions& matcher,
+                                        const std::optional<PlaceSearchRegion>& region) {
   PlaceHypothesis h;
   // The search's points: one per voxel, near returns only (far ones fall outside the grids).
   std::vector<Eigen::Vector2d> points;
@@ -54,18 +56,38 @@ PlaceHypothesis PlaceRecognizer::locate(const alignment::PointSet& scan, const a
     common::Pose2 pose;
     double score;
   };
+  // A window reaches into the region when its centre does once the region's covariance is
+  // widened by the window's half diagonal.
+  Eigen::Matrix2d region_inverse = Eigen::Matrix2d::Zero();
+  if (region) {
+    const double reach = window.half_width_m * M_SQRT2;
+    region_inverse = (region->cov + reach * reach * Eigen::Matrix2d::Identity()).inverse();
+  }
   std::vector<Found> found;
+  // Only poses within the margin of the best so far can win or make the winner ambiguous: each
+  // window is searched for those only (the prior's log-density, nearly flat, taken at its lowest
+  // in the window, so that no such pose is missed).
+  double best_scan = -HUGE_VAL;
+  const double margin = options_.min_margin_per_point * static_cast<double>(points.size());
   for (const Eigen::Vector2d& c : centres_) {
+    if (region) {
+      const Eigen::Vector2d d = c - region->centre;
+      if (d.dot(region_inverse * d) > region->gate) continue;
+    }
     const alignment::LikelihoodGrid* grid = areas_.coarseGrid(c.x(), c.y());
     if (!grid) continue;
     const alignment::MotionPrior prior({c.x(), c.y(), 0.0}, flat, 0.0, 1.0);
+    const double lowest_prior = prior.logDensity(prior.mahalanobis2({window.half_width_m, window.half_width_m, M_PI}));
+    window.min_score = best_scan - margin + lowest_prior;
     const alignment::CorrelativeResult r = alignment::correlativeSearch(*grid, points, prior, window);
-    found.push_back({r.pose, r.scan_score});
     h.nodes += r.nodes;
+    ++h.candidates;
+    if (r.below_min_score) continue;
+    found.push_back({r.pose, r.scan_score});
+    best_scan = std::max(best_scan, r.scan_score);
   }
-  h.candidates = static_cast<int>(found.size());
   if (found.empty()) {
-    h.reason = "empty map";
+    h.reason = region ? "no mapped place within reach" : "empty map";
     return h;
   }
   const auto best = std::max_element(found.begin(), found.end(), [](const Found& a, const Found& b) { return a.score < b.score; });

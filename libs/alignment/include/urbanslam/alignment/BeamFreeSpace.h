@@ -35,6 +35,7 @@ class BeamFreeSpace {
   double bin_rad_ = 0;
   std::vector<double> free_m_;  // per bin: the shortest return, or 0 (none)
   double margin_m_, margin_fraction_;
+  double reach_m_ = 0;  // beyond this range every bin's returns hide a point (it can only be kBehind)
 };
 
 }  // namespace urbanslam::alignment

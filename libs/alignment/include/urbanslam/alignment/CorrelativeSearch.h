@@ -5,6 +5,7 @@
 // the prior's density at the block's pose nearest the prior (an upper bound for every pose in
 // the block), and a block is split only while its bound beats the best pose found so far.
 // Headings are enumerated at a step that moves the farthest point by about one cell.
+#include <cmath>
 #include <vector>
 
 #include <Eigen/Core>
@@ -17,13 +18,18 @@ namespace urbanslam::alignment {
 struct CorrelativeWindow {
   double half_width_m = 1.0;    // translations within +-this of the prior's mean, on each axis
   double half_angle_rad = 0.5;  // headings within +-this of the prior's mean
+  // Poses scoring at most this are of no interest to the caller (a place search that only needs
+  // the poses near its best so far): blocks bounded below it are not searched, and when no pose
+  // beats it the result says so (below_min_score) instead of naming the best.
+  double min_score = -HUGE_VAL;
 };
 
 struct CorrelativeResult {
   common::Pose2 pose;
-  double score = 0;       // scan log-likelihood + prior log-density at pose
-  double scan_score = 0;  // the scan's share of it
-  int nodes = 0;          // blocks scored (the search's cost)
+  double score = 0;              // scan log-likelihood + prior log-density at pose
+  double scan_score = 0;         // the scan's share of it
+  int nodes = 0;                 // blocks scored (the search's cost)
+  bool below_min_score = false;  // no pose scored above the window's min_score: pose and scores say nothing
 };
 
 // points: the scan's points in its own frame (thinned so they are roughly independent).

@@ -9,6 +9,17 @@
 // then, and at the start without an initial pose, the PlaceRecognizer searches the whole map
 // until one place clearly wins (relocalised). While lost, the reported pose is the odometry's
 // from the last known one, if any, and no pose is trusted.
+//
+// A place search answers from one scan, and a building of repeated rooms and corridors (ACES)
+// has places that one scan, and the scans tracked after it, cannot tell apart: a wrong fix there
+// tracks as smoothly as the right one. What does tell them apart is where the vehicle came from:
+// once the map has confirmed the pose (a run of consecutive matches), that pose carried on by
+// the odometry, with its growing covariance, is evidence the search lacks. The search then looks
+// only where that dead reckoning can be (chi-square on the position), and a fix outside is
+// rejected; the longer the vehicle is lost, the wider the covariance and the farther away a fix
+// may lie (and where no mapped place is within reach, nothing is searched at all). A fix found
+// that way inherits the confirmation; a pose the map never confirmed (a given initial pose, a fix
+// from the whole map not yet tracked) vetoes nothing.
 #include <functional>
 #include <optional>
 #include <string>
@@ -49,6 +60,19 @@ struct LocalizerOptions {
   double relocalise_max_interval_s = 4.0;
   double relocalise_min_motion_m = 0.3;
   double relocalise_min_rotation_deg = 10.0;
+  // The pose counts as confirmed after this many consecutive matches; then a fix's position must
+  // lie within the dead-reckoned position's chi-square gate (2 dof, this probability; the two
+  // covariances added, the dead reckoning's widened by continuity_sigma_scale: the motion model
+  // is tuned on increments of a few scans, and over a minute lost, ACES's odometry strayed more
+  // than twice as far as its covariance said; the heading is not tested, its linearised
+  // covariance is poor at tens of degrees).
+  int confirm_matches = 10;
+  double continuity_probability = 0.999;
+  double continuity_sigma_scale = 2.0;
+  // When the monitor declares the pose lost, the last matches disagreed with the prediction: the
+  // pose is uncertain by at least this much, whatever the matcher's covariance said.
+  double lost_sigma_xy_m = 0.5;
+  double lost_sigma_deg = 5.0;
 };
 
 // The defaults, with the matcher, scan model and floors of the map's own [local] options.
@@ -73,6 +97,7 @@ struct LocalizerStats {
   size_t measurements = 0, scans = 0, scans_used = 0, odometry = 0;
   size_t tracking = 0, lost = 0, matches_failed = 0;
   size_t place_searches = 0, relocalisations = 0, lost_events = 0;
+  size_t fixes_rejected = 0;  // place-search fixes the confirmed dead-reckoned pose ruled out
   double first_timestamp = 0, last_timestamp = 0;
   double lost_s = 0;         // log time spent lost
   double first_fix_s = -1;   // log time from the first scan to the first tracked one (-1: never)
@@ -118,6 +143,11 @@ class Localizer {
 
   LocalizationState state_ = LocalizationState::Lost;
   bool have_pose_ = false;
+  // Consecutive matches since the last fix, initial pose or failure; confirmed_: the pose (or the
+  // dead reckoning from it while lost) descends from a run of confirm_matches of them.
+  int consecutive_matches_ = 0;
+  bool confirmed_ = false;
+  double continuity_gate_ = 0;
   common::Pose2 pose_;
   Eigen::Matrix3d cov_ = Eigen::Matrix3d::Identity();
   bool have_scan_ = false;

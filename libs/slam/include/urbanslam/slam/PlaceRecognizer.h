@@ -8,6 +8,7 @@
 // place by a margin per point (a corridor's look-alike doors, a symmetric room, a place the map
 // has not seen: no answer rather than a wrong one), the refined match explains most points, and
 // few of them stand where the other side's beams passed through.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,15 @@ struct PlaceRecognitionOptions {
   double refine_sigma_deg = 3.0;
 };
 
+// Where the scan may have been taken, when something other than the scan says so: a position
+// with its covariance and a chi-square gate. Only the windows that reach into that ellipse are
+// searched, and the winner must stand out among those only; the rest of the map is ruled out.
+struct PlaceSearchRegion {
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d cov = Eigen::Matrix2d::Identity();
+  double gate = 0;  // on d' cov⁻¹ d
+};
+
 struct PlaceHypothesis {
   bool found = false;
   std::string reason;  // why not found
@@ -58,8 +68,9 @@ class PlaceRecognizer {
  public:
   PlaceRecognizer(const Map& map, MapAreas& areas, PlaceRecognitionOptions options);
   // `scan`: the scan's points in the vehicle frame. `matcher`: the local matcher's options for
-  // the refinement.
-  PlaceHypothesis locate(const alignment::PointSet& scan, const alignment::PriorMatcherOptions& matcher);
+  // the refinement. `region`: search only there (none: the whole map).
+  PlaceHypothesis locate(const alignment::PointSet& scan, const alignment::PriorMatcherOptions& matcher,
+                         const std::optional<PlaceSearchRegion>& region = std::nullopt);
   size_t candidates() const { return centres_.size(); }
 
  private:
