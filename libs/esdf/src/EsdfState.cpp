@@ -67,7 +67,8 @@ void InformationState::read(common::BinaryReader& r) {
     }
   structure_stamp_ = r.u64();
   link_count_ = r.i64();
-  if (2 * link_count_ != links) r.fail("filter link count");
+  // Compared as links / 2 and parity: a count read from a file may be anything, and doubling it may overflow.
+  if (link_count_ < 0 || links % 2 != 0 || link_count_ != links / 2) r.fail("filter link count");
   rows_ = std::move(rows);
 }
 
