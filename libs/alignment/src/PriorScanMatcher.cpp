@@ -96,8 +96,7 @@ PriorMatchResult matchWithPrior(const MatchReference& reference, const PointSet&
       const LikelihoodGrid& grid = reference.grid();
       for (size_t i = 0; i < placed.size(); ++i) {
         if (scan_state[i] < BeamFreeSpace::kInView) continue;
-        const Eigen::Vector2i c = grid.cellOf(placed[i]);
-        sum += grid.value(0, c.x(), c.y());
+        sum += grid.score(placed[i]);
         ++k;
       }
       *in_view_score = {sum, k};
@@ -110,7 +109,7 @@ PriorMatchResult matchWithPrior(const MatchReference& reference, const PointSet&
   if (o.seen_through_rate > 0 && scan_beams.valid() && prior.gaussianWeight(prior.mahalanobis2(prior.difference(coarse.pose))) < 0.5) {
     // "The odometry is right": its Gaussian alone, over the same window.
     const MotionPrior odometry_right(prior_mean, prior_cov, 0.0, volume);
-    CorrelativeResult near = correlativeSearch(reference.grid(), thinned, odometry_right, window);
+    const CorrelativeResult near = correlativeSearch(reference.grid(), thinned, odometry_right, window);
     out.search_nodes += near.nodes;
     // Per point in view: log p(what it shows | right pose) / p(... | wrong pose).
     const double right = std::clamp(o.seen_through_rate, 1e-6, 0.5);
@@ -128,17 +127,12 @@ PriorMatchResult matchWithPrior(const MatchReference& reference, const PointSet&
     // scan down for what it sees of new ground.
     CorrelativeResult at_prior;
     at_prior.pose = prior_mean;
-    at_prior.scan_score = 0;
-    {
-      const Rigid2 to_ref = Rigid2::fromPose(prior_mean);
-      const LikelihoodGrid& grid = reference.grid();
-      for (const auto& p : thinned) {
-        const Eigen::Vector2i c = grid.cellOf(to_ref * p);
-        at_prior.scan_score += grid.value(0, c.x(), c.y());
-      }
-    }
-    if (full(at_prior) > full(near)) near = at_prior;
-    if (full(near) >= full(coarse)) coarse = near;
+    const Rigid2 to_ref = Rigid2::fromPose(prior_mean);
+    for (const auto& p : thinned) at_prior.scan_score += reference.grid().score(to_ref * p);
+    // Each weighing classifies both sides' free space: once per candidate.
+    const double full_prior = full(at_prior), full_near = full(near);
+    const CorrelativeResult& best_near = full_prior > full_near ? at_prior : near;
+    if (std::max(full_prior, full_near) >= full(coarse)) coarse = best_near;
   }
   out.search_pose = coarse.pose;
   out.scan_log_likelihood = coarse.scan_score;
