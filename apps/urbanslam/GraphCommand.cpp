@@ -115,11 +115,7 @@ int graphCommand(const Argv& args) {
   j["memory_bytes_per_pose"] = r.poses.empty() ? 0.0 : static_cast<double>(r.memory_bytes) / r.poses.size();
   j["peak_rss_bytes"] = common::peakResidentBytes();
 
-  if (ap.has("stats")) {
-    common::AtomicFile f(ap.option("stats"));
-    f.stream() << j.dump(2) << "\n";
-    f.commit();
-  }
+  if (ap.has("stats")) common::writeTextAtomically(ap.option("stats"), j.dump(2) + "\n");
   if (ap.flag("json")) {
     std::cout << j.dump() << "\n";
   } else {

@@ -61,6 +61,12 @@ void AtomicFile::commit() {
   committed_ = true;
 }
 
+void writeTextAtomically(const std::string& path, const std::string& text) {
+  AtomicFile f(path);
+  f.stream() << text;
+  f.commit();
+}
+
 void writeAtomically(const std::string& path, const std::function<void(const std::string& tmp)>& write) {
   removeStaleTemporaries(path);
   const std::string tmp = temporaryPathFor(path);

@@ -111,9 +111,7 @@ common::Json writeLocalizationOutputs(const std::vector<LocalizedScan>& scans, c
     f.commit();
   }
   common::Json j = localizationStats(scans, stats, info);
-  common::AtomicFile f(path("stats.json"));
-  f.stream() << j.dump(2) << "\n";
-  f.commit();
+  common::writeTextAtomically(path("stats.json"), j.dump(2) + "\n");
   folder.commit();
   return j;
 }

@@ -86,11 +86,8 @@ std::optional<CameraMeasurement> Pipeline::measureCamera(const ImageCamera& a, c
                                                          const vision_loop::ImageFeatures& fb) const {
   if (!a.calibration || !b.calibration) return std::nullopt;
   // One camera seen twice: the relative pose of two different cameras is not this measurement.
-  const auto& ca = *a.calibration;
   const auto& cb = *b.calibration;
-  if (a.width != b.width || ca.fx_px != cb.fx_px || ca.fy_px != cb.fy_px || ca.cx_px != cb.cx_px || ca.cy_px != cb.cy_px ||
-      ca.mount.x != cb.mount.x || ca.mount.y != cb.mount.y || ca.mount.phi != cb.mount.phi)
-    return std::nullopt;
+  if (a.width != b.width || !(*a.calibration == cb)) return std::nullopt;
   CameraMeasurement m;
   m.mount = cb.mount;
   m.relative = vision_loop::planarRelativePose(fa, fb, image_detector_->vocabulary().descriptorType(),

@@ -185,9 +185,7 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   if (grid.size() > 0) j["grid"] = grid;
   j["files"] = files;
   j["config"] = optionsToJson(o);
-  common::AtomicFile f(path("stats.json"));
-  f.stream() << j.dump(2) << "\n";
-  f.commit();
+  common::writeTextAtomically(path("stats.json"), j.dump(2) + "\n");
   folder.commit();
   return j;
 }

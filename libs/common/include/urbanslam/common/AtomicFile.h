@@ -27,6 +27,9 @@ class AtomicFile {
   bool committed_ = false;
 };
 
+// `text` written to `path` through an AtomicFile (stats.json and the like).
+void writeTextAtomically(const std::string& path, const std::string& text);
+
 // For writers that insist on a filename (MRPT's savers): `write` gets the temporary path.
 // The extension is kept so writers that infer a format from it still work.
 void writeAtomically(const std::string& path, const std::function<void(const std::string& tmp)>& write);

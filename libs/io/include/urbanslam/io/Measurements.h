@@ -32,6 +32,10 @@ struct DriveReading {
 struct CameraCalibration {
   double fx_px = 0, fy_px = 0, cx_px = 0, cy_px = 0;
   common::Pose2 mount;
+  bool operator==(const CameraCalibration& o) const {
+    return fx_px == o.fx_px && fy_px == o.fy_px && cx_px == o.cx_px && cy_px == o.cy_px && mount.x == o.mount.x &&
+           mount.y == o.mount.y && mount.phi == o.mount.phi;
+  }
 };
 
 // 8-bit grayscale image. Pixels are loaded eagerly by the readers (images stored externally
