@@ -63,7 +63,17 @@ std::string PipelineWorker::error() const {
 
 void PipelineWorker::withPipeline(const std::function<void(const slam::Pipeline&)>& f) {
   std::lock_guard<std::mutex> lock(mutex_);
+  waitForGlobalSlam();
   f(*pipeline_);
+}
+
+void PipelineWorker::waitForGlobalSlam() {
+  if (finished_) return;
+  try {
+    pipeline_->waitForGlobalSlam(*source_);
+  } catch (const std::exception& e) {
+    if (error_.empty()) error_ = e.what();
+  }
 }
 
 void PipelineWorker::loop() {
@@ -79,7 +89,7 @@ void PipelineWorker::loop() {
       wall0 = clock::now();
       log0 = -1;
     }
-    const size_t keyframes_before = pipeline_->keyframes().size();
+    const size_t keyframes_before = pipeline_->keyframesMade();
     bool more = false;
     try {
       more = pipeline_->step(*source_);
@@ -88,15 +98,20 @@ void PipelineWorker::loop() {
       more = false;
     }
     if (!more) {
-      pipeline_->finish();
+      try {
+        pipeline_->finish(*source_);
+      } catch (const std::exception& e) {
+        if (error_.empty()) error_ = e.what();  // else global SLAM stopped at the same failure
+      }
       finished_ = true;
       running_ = false;
       was_running = false;
       continue;
     }
-    if (step_request_ && pipeline_->keyframes().size() > keyframes_before) {
+    if (step_request_ && pipeline_->keyframesMade() > keyframes_before) {
       step_request_ = false;
       running_ = false;
+      waitForGlobalSlam();  // paused on a keyframe: show it with its closures
     }
     was_running = running_;
     const double speed = speed_;

@@ -45,6 +45,8 @@ class PipelineWorker {
 
  private:
   void loop();
+  // Global SLAM may run behind on a thread of its own: paused or exporting, the map is whole.
+  void waitForGlobalSlam();
 
   std::string log_path_, ini_path_, resolved_ini_, format_, default_laser_model_;
   std::unique_ptr<io::DataSource> source_;

@@ -150,7 +150,7 @@ GlobalSlam::Admission GlobalSlam::admit(LoopClosureRecord r, size_t current) {
   return accepted ? Admission::Accepted : Admission::Rejected;
 }
 
-void GlobalSlam::closeLoops(size_t current) {
+void GlobalSlam::closeLoops(size_t current, SteadyTime handed_over) {
   if (!map_.filter() || !options_.loop_closure.enabled || current % static_cast<size_t>(options_.loop_closure.every_n_keyframes) != 0)
     return;
   common::Stopwatch sw;
@@ -174,11 +174,11 @@ void GlobalSlam::closeLoops(size_t current) {
     }
   }
   // 10. Full recovery after a closure (with relinearisation), then the corrected poses.
-  if (accepted) recoverAll();
+  if (accepted) recoverAll(std::make_pair(current, handed_over));
   stats_.closure_ms.push_back(sw.milliseconds());
 }
 
-void GlobalSlam::recoverAll() {
+void GlobalSlam::recoverAll(std::optional<std::pair<size_t, SteadyTime>> closure) {
   map_.filter()->recover();
   map_.pullPoses(0);
   map_.reindex();
@@ -186,10 +186,17 @@ void GlobalSlam::recoverAll() {
   poses.reserve(map_.size());
   for (const auto& k : map_.keyframes()) poses.push_back(k.pose);
   dirty_since_recovery_ = false;
-  for (auto* o : observers_) o->onPosesUpdated({&poses});
+  PosesUpdatedEvent e{&poses};
+  if (closure) {
+    e.keyframe = closure->first;
+    e.latency_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - closure->second).count();
+    stats_.global_latency_ms.push_back(e.latency_ms);
+  }
+  for (auto* o : observers_) o->onPosesUpdated(e);
 }
 
-void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double score, const std::optional<CameraMeasurement>& camera) {
+void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double score, const std::optional<CameraMeasurement>& camera,
+                                     SteadyTime handed_over) {
   ++stats_.image_proposals;
   ImageMatchEvent ev{current, earlier, score, false, ""};
   const bool filter = map_.filter() != nullptr;
@@ -217,7 +224,7 @@ void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double scor
     ev.fate = a == Admission::Accepted  ? "accepted"
               : a == Admission::Pending ? "pending"
                                         : (reason == ClosureReason::None ? "gating" : reasonName(reason));
-    if (ev.accepted) recoverAll();
+    if (ev.accepted) recoverAll(std::make_pair(current, handed_over));
     stats_.closure_ms.push_back(sw.milliseconds());
   } else {
     // Neither scans nor a camera relative pose (or no filter): a proposal on record, never a

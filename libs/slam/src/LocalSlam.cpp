@@ -28,20 +28,20 @@ bool LocalSlam::addDrive(const io::DriveReading& m) {
   return true;
 }
 
-bool LocalSlam::isKeyframe(const Map& map) const {
+bool LocalSlam::isKeyframe() const {
   const common::Pose2& d = motion_.increment();
-  return map.empty() || !have_scan_keyframe_ || std::hypot(d.x, d.y) >= keyframe_options_.min_translation_m ||
+  return keyframes_ == 0 || !have_scan_keyframe_ || std::hypot(d.x, d.y) >= keyframe_options_.min_translation_m ||
          std::abs(d.phi) >= keyframe_options_.min_rotation_deg * kDeg;
 }
 
-KeyframeConstraint LocalSlam::keyframeConstraint(const io::LaserScan& scan, const Map& map) const {
+KeyframeConstraint LocalSlam::keyframeConstraint(const io::LaserScan& scan) const {
   KeyframeConstraint c;
   c.z = motion_.increment();
   c.cov = motion_.covariance();
   c.cov.diagonal() += Eigen::Vector3d(1e-8, 1e-8, 1e-10);  // no motion at all is still a valid constraint
   // Scan matching needs scans on both sides (camera-only keyframes have none).
-  if (!options_.scan_matching || scan.ranges.empty() || map.empty() || !map.back().hasScan()) return c;
-  const alignment::PriorMatchResult r = matchSubmap(scan, c.z, c.cov, map);
+  if (!options_.scan_matching || scan.ranges.empty() || !last_keyframe_has_scan_) return c;
+  const alignment::PriorMatchResult r = matchSubmap(scan, c.z, c.cov);
   if (!r.valid) {
     c.match = KeyframeConstraint::Match::Rejected;
     return c;
@@ -57,31 +57,36 @@ KeyframeConstraint LocalSlam::keyframeConstraint(const io::LaserScan& scan, cons
   return c;
 }
 
-std::optional<ScanAnchor> LocalSlam::placeScan(const io::LaserScan& scan, const Map& map) const {
-  if (!options_.scan_matching || !options_.match_every_scan || scan.ranges.empty() || map.empty() || !map.back().hasScan())
-    return std::nullopt;
-  if (map.anchors() > 0 && std::abs(scan.timestamp - map.lastAnchorTime()) < options_.match_min_interval_s) return std::nullopt;
+std::optional<ScanAnchor> LocalSlam::placeScan(const io::LaserScan& scan) {
+  if (!options_.scan_matching || !options_.match_every_scan || scan.ranges.empty() || !last_keyframe_has_scan_) return std::nullopt;
+  if (have_anchor_ && std::abs(scan.timestamp - last_anchor_time_) < options_.match_min_interval_s) return std::nullopt;
   // Its pose in the last keyframe's frame, for the trajectory at sensor times only (the filter
   // keeps one pose per keyframe).
   Eigen::Matrix3d cov = motion_.covariance();
   cov.diagonal() += Eigen::Vector3d(1e-8, 1e-8, 1e-10);
-  const alignment::PriorMatchResult r = matchSubmap(scan, motion_.increment(), cov, map);
+  const alignment::PriorMatchResult r = matchSubmap(scan, motion_.increment(), cov);
   if (!r.valid) return std::nullopt;
-  return ScanAnchor{scan.timestamp, map.size() - 1, r.pose, motion_.odometryPose()};
+  last_anchor_time_ = scan.timestamp;
+  have_anchor_ = true;
+  return ScanAnchor{scan.timestamp, keyframes_ - 1, r.pose, motion_.odometryPose()};
 }
 
-void LocalSlam::keyframeAdded(const io::LaserScan& scan) {
-  if (options_.scan_matching) submap_.addKeyframe(scan);
+void LocalSlam::keyframeAdded(const io::LaserScan& scan, const common::Pose2& z) {
+  if (options_.scan_matching) {
+    submap_.addKeyframe(scan);
+    local_poses_.push_back(local_poses_.empty() ? common::Pose2{} : common::compose(local_poses_.back(), z));
+    while (local_poses_.size() > submap_.size()) local_poses_.pop_front();
+  }
   have_scan_keyframe_ = have_scan_keyframe_ || !scan.ranges.empty();
+  ++keyframes_;
+  last_keyframe_has_scan_ = !scan.ranges.empty();
+  last_anchor_time_ = scan.timestamp;  // every keyframe anchors the trajectory
+  have_anchor_ = true;
   motion_.reset();
 }
 
-alignment::PriorMatchResult LocalSlam::matchSubmap(const io::LaserScan& scan, const common::Pose2& z, const Eigen::Matrix3d& cov,
-                                                   const Map& map) const {
-  std::vector<common::Pose2> poses;
-  const auto& kf = map.keyframes();
-  for (size_t i = kf.size() - std::min(kf.size(), submap_.size()); i < kf.size(); ++i) poses.push_back(kf[i].pose);
-  return submap_.match(scan, z, cov, poses);
+alignment::PriorMatchResult LocalSlam::matchSubmap(const io::LaserScan& scan, const common::Pose2& z, const Eigen::Matrix3d& cov) const {
+  return submap_.match(scan, z, cov, std::vector<common::Pose2>(local_poses_.begin(), local_poses_.end()));
 }
 
 }  // namespace urbanslam::slam

@@ -15,6 +15,15 @@ namespace urbanslam::slam {
 
 namespace {
 
+// A filter failure in a job global SLAM took from local SLAM, with the measurement that made
+// the job: the error names it however late global SLAM got to the job.
+struct FilterFailureAt : std::runtime_error {
+  FilterFailureAt(const std::string& what, size_t measurement, double timestamp)
+      : std::runtime_error(what), measurement(measurement), timestamp(timestamp) {}
+  size_t measurement;
+  double timestamp;
+};
+
 // The filter behind the map (none in dead reckoning).
 std::unique_ptr<esdf::Esdf> makeFilter(const PipelineOptions& options) {
   if (options.estimator.type != EstimatorOptions::Type::Esdf) return nullptr;
@@ -33,7 +42,8 @@ Pipeline::Pipeline(PipelineOptions options)
       map_(makeFilter(options_), std::max(1.0, options_.loop_closure.search_radius_m)),
       local_(options_),
       global_(options_, map_, stats_, observers_),
-      images_(options_.loop_closure.image_max_offset_s) {}
+      images_(options_.loop_closure.image_max_offset_s),
+      global_worker_(options_.estimator.global_thread) {}
 
 Pipeline::~Pipeline() = default;
 
@@ -51,24 +61,53 @@ void Pipeline::setCandidateScorer(CandidateScorer scorer, std::string name) {
   global_.setCandidateScorer(std::move(scorer), std::move(name));
 }
 
+template <typename Body>
+void Pipeline::reportingFilterFailures(const io::DataSource& source, const std::string& where, Body&& body) {
+  // Values that are each in range can still be too extreme together for the filter's
+  // arithmetic (an odometry jump of thousands of km): that is the log's fault, not a bug.
+  const std::string hint = " (a pose, odometry or range far out of line with the rest of the log?)";
+  try {
+    body();
+  } catch (const FilterFailureAt& e) {
+    std::ostringstream at;
+    at.precision(15);
+    at << source.path() << ": measurement " << e.measurement << " (t = " << e.timestamp << " s): the filter's " << e.what() << " after it";
+    throw common::InputError(at.str() + hint);
+  } catch (const esdf::NotPositiveDefinite& e) {
+    throw common::InputError(source.path() + ": " + where + ": the filter's " + e.what() + hint);
+  }
+}
+
+void Pipeline::postToGlobalSlam(std::function<void()> body) {
+  global_worker_.post([body = std::move(body), measurement = stats_.measurements, t = stats_.last_timestamp]() mutable {
+    try {
+      body();
+    } catch (const esdf::NotPositiveDefinite& e) {
+      throw FilterFailureAt(e.what(), measurement, t);
+    }
+  });
+}
+
 bool Pipeline::step(io::DataSource& source) {
   // Processing time (reading included) accumulates here, so a paused GUI run reports the same
   // real-time factor as a batch run.
   common::Stopwatch sw;
   bool more = false;
-  try {
-    more = stepOnce(source);
-  } catch (const esdf::NotPositiveDefinite& e) {
-    // Values that are each in range can still be too extreme together for the filter's
-    // arithmetic (an odometry jump of thousands of km): that is the log's fault, not a bug.
-    std::ostringstream where;
-    where.precision(15);
-    where << source.path() << ": measurement " << stats_.measurements << " (t = " << stats_.last_timestamp << " s)";
-    throw common::InputError(where.str() + ": the filter's " + e.what() +
-                             " after it (a pose, odometry or range far out of line with the rest of the log?)");
-  }
+  reportingFilterFailures(source, "measurement " + std::to_string(stats_.measurements + 1), [&] { more = stepOnce(source); });
   stats_.wall_s += sw.seconds();
   return more;
+}
+
+void Pipeline::writeState(common::BinaryWriter& w) const {
+  global_worker_.drain();  // the state global SLAM is working towards
+  writeStateNow(w);
+}
+
+void Pipeline::waitForGlobalSlam(const io::DataSource& source) {
+  common::Stopwatch sw;
+  reportingFilterFailures(source, "up to measurement " + std::to_string(stats_.measurements), [&] { global_worker_.drain(); });
+  stats_.global_backlog_max = std::max(stats_.global_backlog_max, global_worker_.maxBacklog());
+  stats_.wall_s += sw.seconds();
 }
 
 bool Pipeline::stepOnce(io::DataSource& source) {
@@ -111,22 +150,20 @@ void Pipeline::run(io::DataSource& source) {
 void Pipeline::runInput(io::DataSource& source) {
   while (step(source)) {
   }
+  waitForGlobalSlam(source);
 }
 
 void Pipeline::finish(const io::DataSource& source) {
-  try {
-    finish();
-  } catch (const esdf::NotPositiveDefinite& e) {
-    throw common::InputError(source.path() + ": the filter's " + e.what() +
-                             " at the end of the log (a pose, odometry or range far out of line with the rest?)");
-  }
+  reportingFilterFailures(source, "at the end of the log", [&] { finish(); });
 }
 
 void Pipeline::finish() {
   finished_ = true;
   common::Stopwatch sw;
-  if (auto last = images_.finish()) attachImage(*last);  // the last keyframe's image is final now
-  global_.finish();
+  if (auto last = images_.finish()) postImage(std::move(*last));  // the last keyframe's image is final now
+  global_worker_.post([this] { global_.finish(); });
+  global_worker_.drain();
+  stats_.global_backlog_max = std::max(stats_.global_backlog_max, global_worker_.maxBacklog());
   stats_.wall_s += sw.seconds();
   stats_.keyframes = map_.size();
   for (auto* o : observers_) o->onFinished();
@@ -137,44 +174,47 @@ void Pipeline::onScan(io::LaserScan scan, double progress) {
   if (!input_.accepts(scan.label)) return;
   ++stats_.scans_used;
   input_.limitRanges(scan);
-  if (local_.isKeyframe(map_)) {
+  if (local_.isKeyframe()) {
     common::Stopwatch kw;
     addKeyframe(std::move(scan));
     stats_.keyframe_ms.push_back(kw.milliseconds());
-  } else if (const auto anchor = local_.placeScan(scan, map_)) {
+  } else if (const auto anchor = local_.placeScan(scan)) {
     ++stats_.scans_anchored;
     map_.addAnchor(*anchor);
   }
   const double ms = sw.milliseconds();
-  stats_.recordStep(ms, map_.size());
-  StepEvent ev{stats_.scans_used, map_.size(), stats_.last_timestamp, ms, progress};
+  stats_.recordStep(ms, local_.keyframes());
+  StepEvent ev{stats_.scans_used, local_.keyframes(), stats_.last_timestamp, ms, progress};
   for (auto* o : observers_) o->onStep(ev);
 }
 
 void Pipeline::addKeyframe(io::LaserScan scan, const std::optional<CameraMeasurement>& camera_motion) {
-  const size_t k = map_.size();
+  const size_t k = local_.keyframes();
   // 1. The previous keyframe's image is final once this keyframe exists (it may be nearer in time).
-  if (auto done = images_.keyframeAdded(k, scan.timestamp)) attachImage(*done);
+  if (auto done = images_.keyframeAdded(k, scan.timestamp)) postImage(std::move(*done));
   // 2. Local SLAM: the motion since the previous keyframe, refined by the submap match.
-  KeyframeConstraint c = local_.keyframeConstraint(scan, map_);
+  KeyframeConstraint c = local_.keyframeConstraint(scan);
   if (c.match == KeyframeConstraint::Match::Used) ++stats_.scan_matches_used;
   if (c.match == KeyframeConstraint::Match::Rejected) ++stats_.scan_matches_rejected;
   //    Without scans, the camera's view of the motion refines it instead.
-  if (camera_motion && !map_.empty()) {
+  if (camera_motion && k > 0) {
     const CameraMotionResult r = fuseCameraMotion(c, *camera_motion, 1.0 - options_.local.odometry_outlier_probability);
     c = r.constraint;
     ++(r.used ? stats_.camera_motions_used : stats_.camera_motions_rejected);
   }
-  // 3. Global SLAM: the keyframe into the filter as a delayed pose.
+  // 3. The keyframe anchors the trajectory at sensor times and joins the local submap.
   const double timestamp = scan.timestamp;
-  const std::array<double, 9> cov = global_.addKeyframe(Keyframe{k, timestamp, {}, std::move(scan), false, {}}, c);
-  // 4. The keyframe anchors the trajectory at sensor times and joins the local submap.
-  const Keyframe& added = map_.back();
   map_.addAnchor({timestamp, k, common::Pose2{}, local_.motion().odometryPose()});
-  local_.keyframeAdded(added.scan);
-  for (auto* o : observers_) o->onKeyframe({added.index, added.timestamp, added.pose, cov, &added.scan});
-  // 5. Global SLAM: loop closures against earlier keyframes.
-  global_.closeLoops(k);
+  local_.keyframeAdded(scan, c.z);
+  // 4. Global SLAM, in order: the keyframe into the filter as a delayed pose, then loop closures
+  //    against earlier keyframes.
+  postToGlobalSlam([this, kf = Keyframe{k, timestamp, {}, std::move(scan), false, {}}, c,
+                    handed_over = std::chrono::steady_clock::now()]() mutable {
+    const std::array<double, 9> cov = global_.addKeyframe(std::move(kf), c);
+    const Keyframe& added = map_.back();
+    for (auto* o : observers_) o->onKeyframe({added.index, added.timestamp, added.pose, cov, &added.scan});
+    global_.closeLoops(added.index, handed_over);
+  });
 }
 
 }  // namespace urbanslam::slam

@@ -36,8 +36,11 @@ void Pipeline::onCameraImage(const io::CameraImage& image, double progress) {
   std::optional<CameraMeasurement> camera_motion;
   if (image_detector_) {
     prepared = prepareImage(image);
+    // The previous image's features are in the image database, which global SLAM fills: this
+    // keyframe waits for it (camera-only logs run in step with global SLAM).
+    global_worker_.drain();
     const size_t previous = image_keyframes_.size();
-    if (previous > 0 && image_keyframes_.back() + 1 == map_.size())
+    if (previous > 0 && image_keyframes_.back() + 1 == local_.keyframes())
       camera_motion = measureCamera(image_cameras_[previous - 1], image_detector_->features(static_cast<vision_loop::ImageId>(previous - 1)),
                                     {image.calibration, image.width}, prepared->features);
   }
@@ -45,11 +48,11 @@ void Pipeline::onCameraImage(const io::CameraImage& image, double progress) {
   none.timestamp = image.timestamp;
   none.label = image.label;
   addKeyframe(std::move(none), camera_motion);
-  attachImage(images_.imageKeyframe(map_.size() - 1, image), std::move(prepared));
+  postImage(images_.imageKeyframe(local_.keyframes() - 1, image), std::move(prepared));
   const double ms = sw.milliseconds();
   stats_.keyframe_ms.push_back(ms);
-  stats_.recordStep(ms, map_.size());
-  StepEvent ev{stats_.scans_used, map_.size(), stats_.last_timestamp, ms, progress};
+  stats_.recordStep(ms, local_.keyframes());
+  StepEvent ev{stats_.scans_used, local_.keyframes(), stats_.last_timestamp, ms, progress};
   for (auto* o : observers_) o->onStep(ev);
 }
 
@@ -61,7 +64,12 @@ Pipeline::PreparedImage Pipeline::prepareImage(const io::CameraImage& im) const 
   return p;
 }
 
-void Pipeline::attachImage(const AssignedImage& assigned, std::optional<PreparedImage> prepared) {
+void Pipeline::postImage(AssignedImage assigned, std::optional<PreparedImage> prepared) {
+  postToGlobalSlam([this, assigned = std::move(assigned), prepared = std::move(prepared),
+                    handed_over = std::chrono::steady_clock::now()]() mutable { attachImage(assigned, std::move(prepared), handed_over); });
+}
+
+void Pipeline::attachImage(const AssignedImage& assigned, std::optional<PreparedImage> prepared, SteadyTime handed_over) {
   Keyframe& kf = map_.keyframe(assigned.keyframe);
   kf.has_image = true;
   ++stats_.image_keyframes;
@@ -79,7 +87,8 @@ void Pipeline::attachImage(const AssignedImage& assigned, std::optional<Prepared
   const auto id = [](size_t i) { return static_cast<vision_loop::ImageId>(i); };
   global_.proposeImageClosure(image_keyframes_[r.match], assigned.keyframe, r.normalized_score,
                               measureCamera(image_cameras_[r.match], image_detector_->features(id(r.match)), image_cameras_[r.query],
-                                            image_detector_->features(id(r.query))));
+                                            image_detector_->features(id(r.query))),
+                              handed_over);
 }
 
 std::optional<CameraMeasurement> Pipeline::measureCamera(const ImageCamera& a, const vision_loop::ImageFeatures& fa, const ImageCamera& b,

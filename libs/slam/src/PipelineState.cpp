@@ -168,7 +168,8 @@ LoopClosureRecord readRecord(BinaryReader& r, size_t keyframes) {
 void writeStats(BinaryWriter& w, const PipelineStats& s) {
   for (size_t v : {s.measurements, s.scans, s.scans_used, s.odometry, s.drive, s.images, s.gps, s.reference, s.keyframes,
                    s.scan_matches_used, s.scan_matches_rejected, s.scans_anchored, s.closures_tried, s.closures_accepted,
-                   s.closures_rejected, s.image_keyframes, s.image_proposals, s.camera_motions_used, s.camera_motions_rejected})
+                   s.closures_rejected, s.image_keyframes, s.image_proposals, s.camera_motions_used, s.camera_motions_rejected,
+                   s.global_backlog_max})
     w.size(v);
   w.f64(s.first_timestamp);
   w.f64(s.last_timestamp);
@@ -178,13 +179,14 @@ void writeStats(BinaryWriter& w, const PipelineStats& s) {
   for (const auto& d : s.step_ms_by_decade) writeDoubles(w, d);
   writeDoubles(w, s.keyframe_ms);
   writeDoubles(w, s.closure_ms);
+  writeDoubles(w, s.global_latency_ms);
 }
 
 void readStats(BinaryReader& r, PipelineStats& s) {
   for (size_t* v : {&s.measurements, &s.scans, &s.scans_used, &s.odometry, &s.drive, &s.images, &s.gps, &s.reference, &s.keyframes,
                     &s.scan_matches_used, &s.scan_matches_rejected, &s.scans_anchored, &s.closures_tried, &s.closures_accepted,
                     &s.closures_rejected, &s.image_keyframes, &s.image_proposals, &s.camera_motions_used,
-                    &s.camera_motions_rejected})
+                    &s.camera_motions_rejected, &s.global_backlog_max})
     *v = r.size();
   s.first_timestamp = r.f64();
   s.last_timestamp = r.f64();
@@ -194,6 +196,7 @@ void readStats(BinaryReader& r, PipelineStats& s) {
   for (auto& d : s.step_ms_by_decade) d = readDoubles(r);
   s.keyframe_ms = readDoubles(r);
   s.closure_ms = readDoubles(r);
+  s.global_latency_ms = readDoubles(r);
 }
 
 void writePointSet(BinaryWriter& w, const alignment::PointSet& points) {
@@ -405,12 +408,25 @@ void LocalSlam::writeState(BinaryWriter& w) const {
   motion_.writeState(w);
   submap_.writeState(w);
   w.boolean(have_scan_keyframe_);
+  w.size(local_poses_.size());
+  for (const auto& p : local_poses_) writePose(w, p);
+  w.size(keyframes_);
+  w.boolean(last_keyframe_has_scan_);
+  w.boolean(have_anchor_);
+  w.f64(last_anchor_time_);
 }
 
 void LocalSlam::readState(BinaryReader& r) {
   motion_.readState(r);
   submap_.readState(r);
   have_scan_keyframe_ = r.boolean();
+  local_poses_.resize(r.count(24));
+  for (auto& p : local_poses_) p = readPose(r);
+  if (local_poses_.size() != submap_.size()) r.fail("local submap poses");
+  keyframes_ = r.size();
+  last_keyframe_has_scan_ = r.boolean();
+  have_anchor_ = r.boolean();
+  last_anchor_time_ = r.f64();
 }
 
 // --- Global SLAM ---
@@ -494,7 +510,7 @@ void KeyframeImageAssigner::readState(BinaryReader& r, size_t keyframes) {
 
 // --- The pipeline ---
 
-void Pipeline::writeState(BinaryWriter& w) const {
+void Pipeline::writeStateNow(BinaryWriter& w) const {
   if (finished_) throw std::logic_error("Pipeline::writeState after finish(): that state cannot be continued");
   w.beginSection(kStatsTag);
   writeStats(w, stats_);

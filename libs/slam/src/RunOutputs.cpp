@@ -180,6 +180,10 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   t["keyframe_ms_p99"] = common::percentile(s.keyframe_ms, 99);
   t["loop_search_ms_p50"] = common::percentile(s.closure_ms, 50);
   t["loop_search_ms_p99"] = common::percentile(s.closure_ms, 99);
+  // Closure → corrected map, as the front end sees it (queue included on the global thread).
+  t["global_latency_ms_p50"] = common::percentile(s.global_latency_ms, 50);
+  t["global_latency_ms_p99"] = common::percentile(s.global_latency_ms, 99);
+  t["global_backlog_max"] = s.global_backlog_max;
   t["outputs_s"] = sw.seconds();
   t["peak_rss_mb"] = static_cast<double>(common::peakResidentBytes()) / (1024.0 * 1024.0);
   if (grid.size() > 0) j["grid"] = grid;

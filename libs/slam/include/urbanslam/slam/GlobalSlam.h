@@ -6,6 +6,7 @@
 // update, and the full recovery after it. Tree of Words proposals take the same path from the
 // alignment on.
 #include <array>
+#include <chrono>
 #include <deque>
 #include <memory>
 #include <optional>
@@ -25,6 +26,8 @@ class LoopDetector;
 
 namespace urbanslam::slam {
 
+using SteadyTime = std::chrono::steady_clock::time_point;
+
 class GlobalSlam {
  public:
   // Reports closures and corrected poses to `observers` and counts them in `stats` (both owned
@@ -37,12 +40,14 @@ class GlobalSlam {
   // covariance (row-major; zero without a filter or for the first keyframe).
   std::array<double, 9> addKeyframe(Keyframe kf, const KeyframeConstraint& constraint);
   // Loop closures of keyframe `current` with earlier ones, when [loop_closure] asks for it now.
-  void closeLoops(size_t current);
+  // `handed_over`: when local SLAM handed the keyframe over, for the correction's latency.
+  void closeLoops(size_t current, SteadyTime handed_over);
   // A Tree of Words proposal between two keyframes, through alignment, gating and confirmation
   // when both have scans, else through gating and confirmation with the camera's relative pose
   // (`camera`: when both images are calibrated; invalid when the images gave none); otherwise
   // recorded with the reason it cannot be. Observers hear its fate.
-  void proposeImageClosure(size_t earlier, size_t current, double score, const std::optional<CameraMeasurement>& camera);
+  void proposeImageClosure(size_t earlier, size_t current, double score, const std::optional<CameraMeasurement>& camera,
+                           SteadyTime handed_over);
   // End of input: hypotheses still awaiting confirmation are dropped, the last poses recovered.
   void finish();
 
@@ -60,7 +65,9 @@ class GlobalSlam {
   void expirePending(size_t current);
   bool consistent(const LoopClosureRecord& a, const LoopClosureRecord& b) const;
   void reportClosure(const LoopClosureRecord& r);
-  void recoverAll();
+  // Full recovery; after a closure (`closure`: its keyframe and when it was handed over) the
+  // correction's latency is recorded.
+  void recoverAll(std::optional<std::pair<size_t, SteadyTime>> closure = std::nullopt);
 
   const PipelineOptions& options_;
   Map& map_;

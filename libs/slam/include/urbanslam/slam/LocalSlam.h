@@ -1,10 +1,12 @@
 #pragma once
 // Local SLAM (Cartographer's split): the motion since the last keyframe from odometry or the
 // steering model, the keyframe decision, and the one matcher that weighs that motion against
-// the scan's fit to the local submap. It reads the map (the submap keyframes' poses) and never
-// changes the filter: it hands global SLAM a constraint for each new keyframe and places the
-// scans between keyframes relative to the last one.
+// the scan's fit to the local submap. It works in its own frame, the chain of the constraints it
+// handed on, and never reads global SLAM's estimates: it hands global SLAM a constraint for each
+// new keyframe and places the scans between keyframes relative to the last one, whenever global
+// SLAM gets to them.
 #include <Eigen/Core>
+#include <deque>
 #include <optional>
 
 #include "urbanslam/io/Measurements.h"
@@ -34,29 +36,39 @@ class LocalSlam {
 
   // Has the vehicle moved or turned enough since the last keyframe for this scan to be one?
   // (The first scan after camera-only keyframes starts the laser map.)
-  bool isKeyframe(const Map& map) const;
-  // The constraint for a new keyframe at `scan` from the last one in `map`.
-  KeyframeConstraint keyframeConstraint(const io::LaserScan& scan, const Map& map) const;
+  bool isKeyframe() const;
+  // The constraint for a new keyframe at `scan` from the last one.
+  KeyframeConstraint keyframeConstraint(const io::LaserScan& scan) const;
   // A scan between keyframes placed by its submap match, relative to the last keyframe; none
   // when not matched (disabled, too soon after the last anchor, or no valid match).
-  std::optional<ScanAnchor> placeScan(const io::LaserScan& scan, const Map& map) const;
-  // `scan` became the newest keyframe: it joins the submap, and the motion starts again there.
-  void keyframeAdded(const io::LaserScan& scan);
+  std::optional<ScanAnchor> placeScan(const io::LaserScan& scan);
+  // Keyframes so far (the index the next one gets).
+  size_t keyframes() const { return keyframes_; }
+  // `scan` became the newest keyframe, `z` the constraint from the previous one that global SLAM
+  // took: the scan joins the submap, and the motion starts again there.
+  void keyframeAdded(const io::LaserScan& scan, const common::Pose2& z);
 
   // Motion, submap and keyframe decision state (PipelineState.cpp).
   void writeState(common::BinaryWriter& w) const;
   void readState(common::BinaryReader& r);
 
  private:
-  alignment::PriorMatchResult matchSubmap(const io::LaserScan& scan, const common::Pose2& z, const Eigen::Matrix3d& cov,
-                                          const Map& map) const;
+  alignment::PriorMatchResult matchSubmap(const io::LaserScan& scan, const common::Pose2& z, const Eigen::Matrix3d& cov) const;
 
   KeyframeOptions keyframe_options_;
   LocalOptions options_;
   MotionOptions::Model motion_model_;
   MotionIntegrator motion_;
   LocalSubmap submap_;
+  // The submap keyframes' poses in local SLAM's own frame: the chain of the constraints it
+  // handed on. Global corrections never reach local matching (as in Cartographer), so local
+  // SLAM's results do not depend on when global SLAM finishes its work.
+  std::deque<common::Pose2> local_poses_;
   bool have_scan_keyframe_ = false;  // camera-only logs make a keyframe of every image until a scan comes
+  size_t keyframes_ = 0;
+  bool last_keyframe_has_scan_ = false;
+  double last_anchor_time_ = 0;  // of the newest scan with a pose (keyframe or matched scan)
+  bool have_anchor_ = false;
 };
 
 }  // namespace urbanslam::slam

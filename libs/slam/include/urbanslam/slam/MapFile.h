@@ -13,7 +13,7 @@
 namespace urbanslam::slam {
 
 constexpr const char* kMapFileName = "map.usmap";
-constexpr std::uint32_t kMapFormatVersion = 1;
+constexpr std::uint32_t kMapFormatVersion = 2;
 
 // The file's bytes for the pipeline's current state. Call it before finish() (after finish()
 // the state cannot be continued: std::logic_error).

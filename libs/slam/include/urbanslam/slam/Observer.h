@@ -1,7 +1,9 @@
 #pragma once
 // What the pipeline reports while it runs. The CLI (progress, stats) and the GUI subscribe;
-// the library never knows who listens. Callbacks run on the pipeline's thread and must be
-// quick: a GUI copies what it needs and redraws on its own thread.
+// the library never knows who listens. Callbacks must be quick: a GUI copies what it needs and
+// redraws on its own thread. onStep and onImage come from the thread that calls
+// Pipeline::step; the others from global SLAM, which may run on a thread of its own
+// ([estimator] global_thread): an observer of both guards its state with a mutex.
 #include <array>
 #include <cstddef>
 #include <string>
@@ -26,6 +28,10 @@ struct KeyframeEvent {
 // The estimates of earlier keyframes changed (after a loop closure): poses[i] is keyframe i.
 struct PosesUpdatedEvent {
   const std::vector<common::Pose2>* poses = nullptr;
+  // The keyframe whose closure brought the correction (none at the end of the run) and how long
+  // after local SLAM handed it over the corrected map was ready.
+  size_t keyframe = static_cast<size_t>(-1);
+  double latency_ms = 0;
 };
 
 // A loop-closure hypothesis between the current keyframe and an earlier one, and its fate.

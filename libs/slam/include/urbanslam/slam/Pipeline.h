@@ -3,9 +3,17 @@
 // (motion, keyframe decision, the scan matched against the local submap) → global SLAM (the
 // keyframe into the filter, loop closures) → the map. Camera images attach to keyframes and
 // feed Tree of Words proposals to global SLAM. Observers see every step.
+//
+// Local SLAM runs in step(); global SLAM takes its keyframes and images in order, on a thread of
+// its own with [estimator] global_thread (a queue between them, so a closure's recovery never
+// holds up the sensors), else inline. Local SLAM never reads what global SLAM estimates, so both
+// give the same map. Until runInput() or finish() returns, the map is global SLAM's: read it
+// through observers.
+#include <functional>
 #include <memory>
 #include <vector>
 
+#include "urbanslam/common/SerialWorker.h"
 #include "urbanslam/io/DataSource.h"
 #include "urbanslam/io/MapOutputs.h"
 #include "urbanslam/slam/GlobalSlam.h"
@@ -38,10 +46,13 @@ class Pipeline {
   bool step(io::DataSource& source);
   // Runs to the end of the input, then finish().
   void run(io::DataSource& source);
-  // Runs to the end of the input without finish(): a run that saves its map (MapFile.h) saves
-  // it here, since finish() drops the hypotheses awaiting confirmation that a continued run
-  // still confirms.
+  // Runs to the end of the input without finish(), and waits for global SLAM: a run that saves
+  // its map (MapFile.h) saves it here, since finish() drops the hypotheses awaiting confirmation
+  // that a continued run still confirms.
   void runInput(io::DataSource& source);
+  // Waits until global SLAM has taken everything handed over so far (a filter failure there is
+  // reported against `source`).
+  void waitForGlobalSlam(const io::DataSource& source);
   // Final full recovery; tells observers the run is complete.
   void finish();
   // finish(), a filter failure reported as bad input against `source` (as run() does).
@@ -54,6 +65,8 @@ class Pipeline {
   void writeState(common::BinaryWriter& w) const;
   void readState(common::BinaryReader& r);
 
+  // Keyframes made so far by local SLAM (global SLAM may not have taken them all yet).
+  size_t keyframesMade() const { return local_.keyframes(); }
   const Map& map() const { return map_; }
   const std::vector<Keyframe>& keyframes() const { return map_.keyframes(); }
   // Estimated pose at every odometry (or drive) reading's time and at every scan placed by
@@ -75,6 +88,12 @@ class Pipeline {
 
  private:
   bool stepOnce(io::DataSource& source);
+  // Runs `body`, a filter failure (in it or in global SLAM's queue) reported against `source`.
+  template <typename Body>
+  void reportingFilterFailures(const io::DataSource& source, const std::string& where, Body&& body);
+  // Hands `body` to global SLAM; a filter failure in it names the measurement being read now.
+  void postToGlobalSlam(std::function<void()> body);
+  void writeStateNow(common::BinaryWriter& w) const;
   void onScan(io::LaserScan scan, double progress);
   // `camera_motion`: the camera's view of the motion since the previous keyframe (camera-only logs).
   void addKeyframe(io::LaserScan scan, const std::optional<CameraMeasurement>& camera_motion = std::nullopt);
@@ -91,7 +110,9 @@ class Pipeline {
   void startImageDetector();  // [loop_closure] image_detector, at the first image
   void onCameraImage(const io::CameraImage& image, double progress);
   PreparedImage prepareImage(const io::CameraImage& image) const;
-  void attachImage(const AssignedImage& assigned, std::optional<PreparedImage> prepared = std::nullopt);
+  // Hands the image to global SLAM's queue (attachImage there).
+  void postImage(AssignedImage assigned, std::optional<PreparedImage> prepared = std::nullopt);
+  void attachImage(const AssignedImage& assigned, std::optional<PreparedImage> prepared, SteadyTime handed_over);
   // The camera's relative pose between two images, when both are calibrated (the same camera);
   // invalid when the images give none.
   std::optional<CameraMeasurement> measureCamera(const ImageCamera& a, const vision_loop::ImageFeatures& fa, const ImageCamera& b,
@@ -111,6 +132,8 @@ class Pipeline {
   KeyframeImageAssigner images_;
   bool have_first_ts_ = false;
   bool finished_ = false;
+  // Last: it stops before what its jobs use goes away. Mutable: reading the state waits for it.
+  mutable common::SerialWorker global_worker_;
 };
 
 }  // namespace urbanslam::slam

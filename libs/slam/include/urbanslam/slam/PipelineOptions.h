@@ -116,6 +116,10 @@ struct EstimatorOptions {
   enum class Type { Esdf, DeadReckoning } type = Type::Esdf;
   bool relinearise = true;  // relinearise moved factors after a loop closure
   int recent_window = 30;   // poses recovered after each keyframe (constant time)
+  // Global SLAM (filter updates, loop closures, recoveries) on a thread of its own, so that
+  // local SLAM keeps up with the sensors while a closure is being worked in. Local SLAM never
+  // reads global SLAM's estimates, so the results are the same either way.
+  bool global_thread = true;
 };
 
 struct MapOptions {

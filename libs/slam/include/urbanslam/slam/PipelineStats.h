@@ -21,6 +21,10 @@ struct PipelineStats {
   std::vector<std::vector<double>> step_ms_by_decade;
   void recordStep(double ms, size_t keyframes);
   std::vector<double> keyframe_ms, closure_ms;
+  // From local SLAM handing over a keyframe to the map corrected by the closure it brought, per
+  // accepted closure (global SLAM's queue included when it runs on its own thread).
+  std::vector<double> global_latency_ms;
+  size_t global_backlog_max = 0;  // most keyframes and images waiting for global SLAM at once
 };
 
 }  // namespace urbanslam::slam
