@@ -75,6 +75,23 @@ void GlobalSlam::finish() {
   if (dirty_since_recovery_) recoverAll();
 }
 
+void GlobalSlam::closureAdded(size_t current, SteadyTime handed_over) {
+  if (!unrecovered_closure_) unrecovered_closure_ = std::make_pair(current, handed_over);
+  // A full recovery costs O(n): after a closure only once the map has grown by a fraction of
+  // what it was at the last one, which bounds its amortised cost per keyframe by a constant
+  // however large the map. Between them the closure's information is in the filter, and the
+  // recent poses (where the next candidates and closures are) are recovered.
+  const double growth = options_.estimator.full_recovery_min_growth;
+  if (static_cast<double>(map_.size() - last_full_size_) >= growth * static_cast<double>(last_full_size_)) {
+    recoverAll();
+    return;
+  }
+  const size_t window = static_cast<size_t>(options_.estimator.recent_window);
+  const size_t first = map_.size() > window ? map_.size() - window : 0;
+  map_.filter()->recoverRecent(static_cast<int>(first));
+  map_.pullPoses(first);
+}
+
 void GlobalSlam::reportClosure(const LoopClosureRecord& r) {
   ++(r.accepted ? stats_.closures_accepted : stats_.closures_rejected);
   closures_.push_back(r);
@@ -174,12 +191,13 @@ void GlobalSlam::closeLoops(size_t current, SteadyTime handed_over) {
     }
   }
   // 10. Full recovery after a closure (with relinearisation), then the corrected poses.
-  if (accepted) recoverAll(std::make_pair(current, handed_over));
+  if (accepted) closureAdded(current, handed_over);
   stats_.closure_ms.push_back(sw.milliseconds());
 }
 
-void GlobalSlam::recoverAll(std::optional<std::pair<size_t, SteadyTime>> closure) {
+void GlobalSlam::recoverAll() {
   map_.filter()->recover();
+  last_full_size_ = map_.size();
   map_.pullPoses(0);
   map_.reindex();
   std::vector<common::Pose2> poses;
@@ -187,10 +205,11 @@ void GlobalSlam::recoverAll(std::optional<std::pair<size_t, SteadyTime>> closure
   for (const auto& k : map_.keyframes()) poses.push_back(k.pose);
   dirty_since_recovery_ = false;
   PosesUpdatedEvent e{&poses};
-  if (closure) {
-    e.keyframe = closure->first;
-    e.latency_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - closure->second).count();
+  if (unrecovered_closure_) {
+    e.keyframe = unrecovered_closure_->first;
+    e.latency_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - unrecovered_closure_->second).count();
     stats_.global_latency_ms.push_back(e.latency_ms);
+    unrecovered_closure_.reset();
   }
   for (auto* o : observers_) o->onPosesUpdated(e);
 }
@@ -224,7 +243,7 @@ void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double scor
     ev.fate = a == Admission::Accepted  ? "accepted"
               : a == Admission::Pending ? "pending"
                                         : (reason == ClosureReason::None ? "gating" : reasonName(reason));
-    if (ev.accepted) recoverAll(std::make_pair(current, handed_over));
+    if (ev.accepted) closureAdded(current, handed_over);
     stats_.closure_ms.push_back(sw.milliseconds());
   } else {
     // Neither scans nor a camera relative pose (or no filter): a proposal on record, never a

@@ -128,6 +128,8 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("relinearise", o.estimator.relinearise, "relinearise moved factors after a loop closure (reaches the batch optimum)");
   s.add("recent_window", o.estimator.recent_window, 1, 100000, "poses", "poses recovered after each keyframe");
   s.add("global_thread", o.estimator.global_thread, "global SLAM on a thread of its own: local SLAM never waits (same results)");
+  s.add("full_recovery_min_growth", o.estimator.full_recovery_min_growth, 0.0, 10.0, "",
+        "full recovery after a closure once the map grew by this fraction since the last (0: every closure)");
 
   s.section("map", "Map products");
   s.add("grid_resolution_m", o.map.grid_resolution_m, 0.01, 2.0, "m", "occupancy grid cell size");

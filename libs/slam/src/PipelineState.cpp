@@ -461,6 +461,7 @@ void GlobalSlam::writeState(BinaryWriter& w) const {
   w.size(closures_.size());
   for (const auto& c : closures_) writeRecord(w, c);
   w.boolean(dirty_since_recovery_);
+  w.size(last_full_size_);
 }
 
 void GlobalSlam::readState(BinaryReader& r) {
@@ -472,6 +473,7 @@ void GlobalSlam::readState(BinaryReader& r) {
   closures_.clear();
   for (size_t i = 0, count = r.count(kRecordBytes); i < count; ++i) closures_.push_back(readRecord(r, n));
   dirty_since_recovery_ = r.boolean();
+  last_full_size_ = r.size();
   // The classifier's keyframe features: a function of each keyframe's scan.
   if (laser_detector_)
     for (const Keyframe& k : map_.keyframes()) laser_detector_->addKeyframe(k.scan);

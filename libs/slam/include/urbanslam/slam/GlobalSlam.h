@@ -65,9 +65,11 @@ class GlobalSlam {
   void expirePending(size_t current);
   bool consistent(const LoopClosureRecord& a, const LoopClosureRecord& b) const;
   void reportClosure(const LoopClosureRecord& r);
-  // Full recovery; after a closure (`closure`: its keyframe and when it was handed over) the
-  // correction's latency is recorded.
-  void recoverAll(std::optional<std::pair<size_t, SteadyTime>> closure = std::nullopt);
+  // After an accepted closure of keyframe `current`: a full recovery when the map has grown
+  // enough since the last one ([estimator] full_recovery_min_growth), else the recent poses.
+  void closureAdded(size_t current, SteadyTime handed_over);
+  // Full recovery; the latency of the oldest closure it brings into the whole map is recorded.
+  void recoverAll();
 
   const PipelineOptions& options_;
   Map& map_;
@@ -78,6 +80,10 @@ class GlobalSlam {
   std::deque<LoopClosureRecord> pending_;                     // passed alignment + gate, awaiting confirmation
   std::vector<LoopClosureRecord> closures_;
   bool dirty_since_recovery_ = false;
+  size_t last_full_size_ = 0;  // keyframes at the last full recovery
+  // The first closure since the last full recovery: its keyframe and when local SLAM handed
+  // that over (not saved: a resumed run has no clock of the earlier one's).
+  std::optional<std::pair<size_t, SteadyTime>> unrecovered_closure_;
 };
 
 }  // namespace urbanslam::slam

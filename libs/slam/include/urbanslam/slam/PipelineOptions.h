@@ -120,6 +120,9 @@ struct EstimatorOptions {
   // local SLAM keeps up with the sensors while a closure is being worked in. Local SLAM never
   // reads global SLAM's estimates, so the results are the same either way.
   bool global_thread = true;
+  // A full recovery after a loop closure only once the map has grown by this fraction since the
+  // last one (0: after every closure): amortised constant time per keyframe at any map size.
+  double full_recovery_min_growth = 0.01;
 };
 
 struct MapOptions {
