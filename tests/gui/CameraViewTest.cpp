@@ -86,6 +86,7 @@ TEST(CameraView, SnapshotsShareImageBuffers) {
   p.addObserver(&c);
   auto src = io::openDataSource(test::repoPath("rawlogs/rtabmap-loop-excerpt"));
   for (int i = 0; i < 4; ++i) p.step(*src);
+  p.waitForGlobalSlam(*src);  // the keyframes' images are attached by global SLAM
   const gui::MapSnapshot a = c.snapshot(), b = c.snapshot();
   ASSERT_GE(a.keyframes.size(), 3u);
   for (size_t i = 0; i < a.keyframes.size(); ++i) {

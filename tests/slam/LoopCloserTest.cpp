@@ -35,8 +35,8 @@ Pair logPair(const std::string& log, size_t a, size_t b) {
   }
   Pair p;
   if (std::max(a, b) >= scans.size() || scans.size() != ref.size()) return p;
-  p.keyframes.push_back({0, scans[a].timestamp, ref[a], scans[a], false, {}});
-  p.keyframes.push_back({1, scans[b].timestamp, ref[b], scans[b], false, {}});
+  p.keyframes.push_back({0, scans[a].timestamp, ref[a], io::CompactScan(scans[a]), false, {}});
+  p.keyframes.push_back({1, scans[b].timestamp, ref[b], io::CompactScan(scans[b]), false, {}});
   p.truth = common::between(ref[a], ref[b]);
   return p;
 }
@@ -123,5 +123,5 @@ TEST(LoopCloser, CorridorSlideConflictsWithFreeSpace) {
   // At the reference pose the two scans agree on free space. (PL-ICP started there slides to the
   // aliased minimum, which matches more points: this pair cannot be closed correctly from these
   // two scans alone, so it must not be closed at all.)
-  EXPECT_LT(alignment::mutualFreeSpaceConflict(p.keyframes[0].scan, p.keyframes[1].scan, p.truth), 0.05);
+  EXPECT_LT(alignment::mutualFreeSpaceConflict(p.keyframes[0].scan.expand(), p.keyframes[1].scan.expand(), p.truth), 0.05);
 }

@@ -164,6 +164,7 @@ TEST(MapFile, MapWithAnImageDatabaseIsRefused) {
   slam::Pipeline p(o);
   auto src = io::openDataSource(test::repoPath("rawlogs/rtabmap-loop-excerpt"));
   for (int i = 0; i < 4; ++i) p.step(*src);
+  p.waitForGlobalSlam(*src);
   ASSERT_GT(p.keyframes().size(), 0u);
   const std::string e = loadError("images", slam::encodeMap(p));
   EXPECT_NE(e.find("image_detector = tree_of_words"), std::string::npos) << e;

@@ -109,9 +109,9 @@ void PipelineWorker::loop() {
       continue;
     }
     if (step_request_ && pipeline_->keyframesMade() > keyframes_before) {
+      waitForGlobalSlam();  // paused on a keyframe: show it with its closures
       step_request_ = false;
       running_ = false;
-      waitForGlobalSlam();  // paused on a keyframe: show it with its closures
     }
     was_running = running_;
     const double speed = speed_;

@@ -4,6 +4,7 @@
 #include <mrpt/maps/CSimpleMap.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/poses/CPose3DPDFGaussian.h>
+#include <mrpt/serialization/CArchive.h>
 
 #include <cmath>
 #include <cstdio>
@@ -16,15 +17,38 @@
 
 namespace urbanslam::io {
 
-void writeSimpleMap(const std::string& path, const std::vector<PosedScan>& scans) {
-  mrpt::maps::CSimpleMap sm;
-  for (const auto& ps : scans) {
-    auto pose = mrpt::poses::CPose3DPDFGaussian::Create();
-    pose->mean = mrpt::poses::CPose3D(ps.pose.x, ps.pose.y, 0, ps.pose.phi, 0, 0);
-    auto sf = mrpt::obs::CSensoryFrame::Create();
-    sf->insert(detail::toMrptScan(*ps.scan));
-    sm.insert(pose, sf);
+namespace {
+
+// A CSimpleMap whose entries are made as they are written: MRPT's serialisation of CSimpleMap
+// (version 1: the entry count, then each entry's pose PDF and sensory frame as objects), one
+// keyframe at a time, so that the output never holds every keyframe's MRPT observation (a few KB
+// each) at once. It is read back as an ordinary CSimpleMap.
+class StreamedSimpleMap : public mrpt::maps::CSimpleMap {
+ public:
+  explicit StreamedSimpleMap(const std::vector<PosedScan>& scans) : scans_(scans) {}
+
+ protected:
+  uint8_t serializeGetVersion() const override { return 1; }
+  void serializeTo(mrpt::serialization::CArchive& out) const override {
+    out.WriteAs<uint32_t>(scans_.size());
+    LaserScan buffer;
+    for (const auto& ps : scans_) {
+      mrpt::poses::CPose3DPDFGaussian pose;
+      pose.mean = mrpt::poses::CPose3D(ps.pose.x, ps.pose.y, 0, ps.pose.phi, 0, 0);
+      mrpt::obs::CSensoryFrame sf;
+      sf.insert(detail::toMrptScan(ps.get(buffer)));
+      out << pose << sf;
+    }
   }
+
+ private:
+  const std::vector<PosedScan>& scans_;
+};
+
+}  // namespace
+
+void writeSimpleMap(const std::string& path, const std::vector<PosedScan>& scans) {
+  const StreamedSimpleMap sm(scans);
   common::writeAtomically(path, [&](const std::string& tmp) {
     if (!sm.saveToFile(tmp)) throw common::InputError(path + ": cannot write");
   });
@@ -55,20 +79,23 @@ std::vector<KeyframeScan> readSimpleMap(const std::string& path) {
 
 std::pair<int, int> writeOccupancyGrid(const std::string& prefix, const std::vector<PosedScan>& scans, const OccupancyGridOptions& options,
                                        double* resolution_used) {
-  // Bounds first, so the grid is allocated once instead of growing scan by scan.
+  // Bounds first, so the grid is allocated once instead of growing scan by scan (the points
+  // scan by scan: the whole cloud is not needed for its bounds).
   double x0 = 0, x1 = 0, y0 = 0, y1 = 0;
   bool first = true;
-  for (const auto& p : mapPoints(scans)) {
-    if (first) {
-      x0 = x1 = p.x;
-      y0 = y1 = p.y;
-      first = false;
+  forEachMapPoint(scans, 1, [&](const std::vector<MapPoint>& pts) {
+    for (const auto& p : pts) {
+      if (first) {
+        x0 = x1 = p.x;
+        y0 = y1 = p.y;
+        first = false;
+      }
+      x0 = std::min<double>(x0, p.x);
+      x1 = std::max<double>(x1, p.x);
+      y0 = std::min<double>(y0, p.y);
+      y1 = std::max<double>(y1, p.y);
     }
-    x0 = std::min<double>(x0, p.x);
-    x1 = std::max<double>(x1, p.x);
-    y0 = std::min<double>(y0, p.y);
-    y1 = std::max<double>(y1, p.y);
-  }
+  });
   for (const auto& ps : scans) {
     x0 = std::min(x0, ps.pose.x);
     x1 = std::max(x1, ps.pose.x);
@@ -89,8 +116,9 @@ std::pair<int, int> writeOccupancyGrid(const std::string& prefix, const std::vec
                                        static_cast<float>(y1 + margin), static_cast<float>(resolution));
   grid.insertionOptions.maxDistanceInsertion = 80.f;
   grid.insertionOptions.wideningBeamsWithDistance = false;
+  LaserScan buffer;
   for (const auto& ps : scans) {
-    const auto obs = detail::toMrptScan(*ps.scan);
+    const auto obs = detail::toMrptScan(ps.get(buffer));
     const mrpt::poses::CPose3D robot(ps.pose.x, ps.pose.y, 0, ps.pose.phi, 0, 0);
     grid.insertObservation(*obs, robot);
   }

@@ -1,70 +1,148 @@
 // Point-cloud files written by hand: MRPT's PCD writer needs PCL (not in the dependency set)
 // and its PLY writer adds an empty face element; these are the plain forms every viewer
-// (CloudCompare, MeshLab, Open3D, PCL) reads.
+// (CloudCompare, MeshLab, Open3D, PCL) reads. Each is written from a whole cloud or streamed
+// from the posed scans, one scan's points at a time (the count in the header comes first, from
+// the validity flags).
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <ostream>
 
 #include "urbanslam/common/AtomicFile.h"
 #include "urbanslam/io/MapOutputs.h"
 
 namespace urbanslam::io {
 
-std::vector<MapPoint> mapPoints(const std::vector<PosedScan>& scans, int decimation) {
-  std::vector<MapPoint> pts;
-  size_t k = 0;
-  const size_t step = decimation < 1 ? 1 : static_cast<size_t>(decimation);
-  for (const auto& ps : scans) {
-    const double c = std::cos(ps.pose.phi), s = std::sin(ps.pose.phi);
-    for (const auto& p : scanToPoints(*ps.scan, true)) {
-      if (k++ % step) continue;
-      pts.push_back({static_cast<float>(ps.pose.x + c * p.x - s * p.y), static_cast<float>(ps.pose.y + s * p.x + c * p.y), 0.f});
+namespace {
+
+size_t decimationStep(int decimation) { return decimation < 1 ? 1 : static_cast<size_t>(decimation); }
+
+// A cloud's points to a file in pieces: the whole cloud is one piece, a streamed map one per scan.
+using PointsSource = std::function<void(const std::function<void(const std::vector<MapPoint>&)>&)>;
+
+void writePlyBody(std::ostream& os, size_t count, PlyEncoding encoding, const PointsSource& points) {
+  const bool binary = encoding == PlyEncoding::BinaryLittleEndian;
+  os << "ply\nformat " << (binary ? "binary_little_endian" : "ascii") << " 1.0\n"
+     << "comment urbanslam map\nelement vertex " << count << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+  points([&](const std::vector<MapPoint>& pts) {
+    if (binary) {
+      static_assert(sizeof(MapPoint) == 12, "MapPoint must be three packed floats");
+      // x86-64 is little-endian, as the header says.
+      os.write(reinterpret_cast<const char*>(pts.data()), static_cast<std::streamsize>(pts.size() * sizeof(MapPoint)));
+    } else {
+      char buf[96];
+      for (const auto& p : pts) {
+        std::snprintf(buf, sizeof buf, "%.4f %.4f %.4f\n", p.x, p.y, p.z);
+        os << buf;
+      }
     }
-  }
-  return pts;
+  });
 }
 
-void writePly(const std::string& path, const std::vector<MapPoint>& pts, PlyEncoding encoding) {
-  const bool binary = encoding == PlyEncoding::BinaryLittleEndian;
-  common::AtomicFile f(path, binary);
-  auto& os = f.stream();
-  os << "ply\nformat " << (binary ? "binary_little_endian" : "ascii") << " 1.0\n"
-     << "comment urbanslam map\nelement vertex " << pts.size() << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
-  if (binary) {
-    static_assert(sizeof(MapPoint) == 12, "MapPoint must be three packed floats");
-    // x86-64 is little-endian, as the header says.
-    os.write(reinterpret_cast<const char*>(pts.data()), static_cast<std::streamsize>(pts.size() * sizeof(MapPoint)));
-  } else {
+void writeXyzLines(std::ostream& os, const PointsSource& points) {
+  points([&](const std::vector<MapPoint>& pts) {
     char buf[96];
     for (const auto& p : pts) {
       std::snprintf(buf, sizeof buf, "%.4f %.4f %.4f\n", p.x, p.y, p.z);
       os << buf;
     }
+  });
+}
+
+void writePcdBody(std::ostream& os, size_t count, const PointsSource& points) {
+  os << "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\n"
+     << "TYPE F F F\nCOUNT 1 1 1\nWIDTH " << count << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << count << "\nDATA ascii\n";
+  writeXyzLines(os, points);
+}
+
+PointsSource whole(const std::vector<MapPoint>& pts) {
+  return [&pts](const std::function<void(const std::vector<MapPoint>&)>& visit) { visit(pts); };
+}
+
+PointsSource streamed(const std::vector<PosedScan>& scans, int decimation) {
+  return
+      [&scans, decimation](const std::function<void(const std::vector<MapPoint>&)>& visit) { forEachMapPoint(scans, decimation, visit); };
+}
+
+}  // namespace
+
+const LaserScan& PosedScan::get(LaserScan& buffer) const {
+  if (scan) return *scan;
+  if (compact)
+    compact->expandInto(buffer);
+  else
+    buffer = LaserScan{};
+  return buffer;
+}
+
+size_t forEachMapPoint(const std::vector<PosedScan>& scans, int decimation,
+                       const std::function<void(const std::vector<MapPoint>&)>& visit) {
+  const size_t step = decimationStep(decimation);
+  size_t k = 0, n = 0;
+  LaserScan buffer;
+  std::vector<MapPoint> pts;
+  for (const auto& ps : scans) {
+    const double c = std::cos(ps.pose.phi), s = std::sin(ps.pose.phi);
+    pts.clear();
+    for (const auto& p : scanToPoints(ps.get(buffer), true)) {
+      if (k++ % step) continue;
+      pts.push_back({static_cast<float>(ps.pose.x + c * p.x - s * p.y), static_cast<float>(ps.pose.y + s * p.x + c * p.y), 0.f});
+    }
+    n += pts.size();
+    if (!pts.empty()) visit(pts);
   }
+  return n;
+}
+
+size_t countMapPoints(const std::vector<PosedScan>& scans, int decimation) {
+  size_t valid = 0;
+  LaserScan buffer;
+  for (const auto& ps : scans) valid += ps.get(buffer).validCount();
+  // Points k = 0, step, 2 step, ... of the valid beams in order.
+  const size_t step = decimationStep(decimation);
+  return (valid + step - 1) / step;
+}
+
+std::vector<MapPoint> mapPoints(const std::vector<PosedScan>& scans, int decimation) {
+  std::vector<MapPoint> out;
+  out.reserve(countMapPoints(scans, decimation));
+  forEachMapPoint(scans, decimation, [&](const std::vector<MapPoint>& pts) { out.insert(out.end(), pts.begin(), pts.end()); });
+  return out;
+}
+
+void writePly(const std::string& path, const std::vector<MapPoint>& pts, PlyEncoding encoding) {
+  common::AtomicFile f(path, encoding == PlyEncoding::BinaryLittleEndian);
+  writePlyBody(f.stream(), pts.size(), encoding, whole(pts));
+  f.commit();
+}
+
+void writePly(const std::string& path, const std::vector<PosedScan>& scans, int decimation, PlyEncoding encoding) {
+  common::AtomicFile f(path, encoding == PlyEncoding::BinaryLittleEndian);
+  writePlyBody(f.stream(), countMapPoints(scans, decimation), encoding, streamed(scans, decimation));
   f.commit();
 }
 
 void writePcd(const std::string& path, const std::vector<MapPoint>& pts) {
   common::AtomicFile f(path);
-  auto& os = f.stream();
-  os << "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\n"
-     << "TYPE F F F\nCOUNT 1 1 1\nWIDTH " << pts.size() << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << pts.size() << "\nDATA ascii\n";
-  char buf[96];
-  for (const auto& p : pts) {
-    std::snprintf(buf, sizeof buf, "%.4f %.4f %.4f\n", p.x, p.y, p.z);
-    os << buf;
-  }
+  writePcdBody(f.stream(), pts.size(), whole(pts));
+  f.commit();
+}
+
+void writePcd(const std::string& path, const std::vector<PosedScan>& scans, int decimation) {
+  common::AtomicFile f(path);
+  writePcdBody(f.stream(), countMapPoints(scans, decimation), streamed(scans, decimation));
   f.commit();
 }
 
 void writeXyz(const std::string& path, const std::vector<MapPoint>& pts) {
   common::AtomicFile f(path);
-  auto& os = f.stream();
-  char buf[96];
-  for (const auto& p : pts) {
-    std::snprintf(buf, sizeof buf, "%.4f %.4f %.4f\n", p.x, p.y, p.z);
-    os << buf;
-  }
+  writeXyzLines(f.stream(), whole(pts));
+  f.commit();
+}
+
+void writeXyz(const std::string& path, const std::vector<PosedScan>& scans, int decimation) {
+  common::AtomicFile f(path);
+  writeXyzLines(f.stream(), streamed(scans, decimation));
   f.commit();
 }
 

@@ -55,7 +55,7 @@ std::array<double, 9> GlobalSlam::addKeyframe(Keyframe kf, const KeyframeConstra
   // Window recovery moved the last `recent_window` keyframes too.
   const size_t window = static_cast<size_t>(options_.estimator.recent_window);
   if (filter && k > 0) map_.pullPoses(k > window ? k - window : 0);
-  if (laser_detector_) laser_detector_->addKeyframe(kf.scan);  // features once per keyframe
+  if (laser_detector_) laser_detector_->addKeyframe(kf.scan.expand());  // features once per keyframe
   map_.addKeyframe(std::move(kf));
   std::array<double, 9> c{};
   if (filter && k > 0) {

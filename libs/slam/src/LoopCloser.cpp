@@ -117,15 +117,15 @@ std::vector<size_t> LoopCloser::candidates(esdf::Esdf& filter, const std::vector
 // axis by ambiguity_offset_m, then twice, four and eight times that, as far as the innovation
 // gate could admit such a shift (3 sigma of the relative position): if one converges elsewhere
 // and matches clearly more points, the alignment is not the best explanation of the two scans.
-bool LoopCloser::ambiguous(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current,
-                           const alignment::AlignmentResult& a, alignment::AlignerOptions ao) {
+bool LoopCloser::ambiguous(esdf::Esdf& filter, const io::LaserScan& earlier_scan, const io::LaserScan& current_scan, size_t earlier,
+                           size_t current, const alignment::AlignmentResult& a, alignment::AlignerOptions ao) {
   const double reach = 3 * largestPositionSigma(relativeCovariance(filter, earlier, current));
   ao.method = alignment::Method::PlIcp;
   const auto& t = a.transform;
   for (double d = options_.ambiguity_offset_m; d <= 8 * options_.ambiguity_offset_m && 0.5 * d <= reach; d *= 2) {
     for (const common::Pose2& g : {common::Pose2{t.x + d, t.y, t.phi}, common::Pose2{t.x - d, t.y, t.phi},
                                    common::Pose2{t.x, t.y + d, t.phi}, common::Pose2{t.x, t.y - d, t.phi}}) {
-      const auto b = alignment::align(keyframes[earlier].scan, keyframes[current].scan, g, ao);
+      const auto b = alignment::align(earlier_scan, current_scan, g, ao);
       if (!b.converged || b.rms_residual_m > options_.max_rms_m) continue;
       const common::Pose2 e = common::between(t, b.transform);
       if (std::hypot(e.x, e.y) < 0.25 * options_.ambiguity_offset_m) continue;  // back to the same minimum
@@ -179,7 +179,9 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
   };
   // (Trying PL-ICP first on an uncertain guess was measured worse: it lands in wrong local
   // minima that pass the residual test — ATE 2.96 m vs 0.26 m on Intel.)
-  const alignment::AlignmentResult a = alignment::align(keyframes[earlier].scan, keyframes[current].scan, guess, ao);
+  // The keyframes keep their scans compact: expanded once for this candidate's alignments.
+  const io::LaserScan earlier_scan = keyframes[earlier].scan.expand(), current_scan = keyframes[current].scan.expand();
+  const alignment::AlignmentResult a = alignment::align(earlier_scan, current_scan, guess, ao);
   r.measurement = a.transform;
   r.rms_m = a.rms_residual_m;
   const double matched = a.matchedFraction();
@@ -188,14 +190,14 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
     r.reason = ClosureReason::Alignment;
     return r;
   }
-  if (options_.ambiguity_offset_m > 0 && ambiguous(filter, keyframes, earlier, current, a, ao)) {
+  if (options_.ambiguity_offset_m > 0 && ambiguous(filter, earlier_scan, current_scan, earlier, current, a, ao)) {
     r.reason = ClosureReason::Ambiguous;
     return r;
   }
   alignment::FreeSpaceOptions fo;
   fo.margin_m = options_.free_space_margin_m;
   fo.no_return_free_m = options_.free_space_no_return_m;
-  r.free_space_conflict = alignment::mutualFreeSpaceConflict(keyframes[earlier].scan, keyframes[current].scan, a.transform, fo);
+  r.free_space_conflict = alignment::mutualFreeSpaceConflict(earlier_scan, current_scan, a.transform, fo);
   if (r.free_space_conflict > options_.max_free_space_conflict) {
     r.reason = ClosureReason::FreeSpace;
     return r;
@@ -229,8 +231,9 @@ LoopClosureRecord LoopCloser::tryCloseMeasured(esdf::Esdf& filter, const std::ve
   r.prior_sigma_m = largestPositionSigma(relativeCovariance(filter, earlier, current));
   r.measurement = esdf::toPose(z);
   r.information = information;
-  const esdf::GateResult gate = commit ? filter.observeRelative(static_cast<int>(earlier), static_cast<int>(current), z, information, true).gate
-                                       : filter.gateRelative(static_cast<int>(earlier), static_cast<int>(current), z, information);
+  const esdf::GateResult gate =
+      commit ? filter.observeRelative(static_cast<int>(earlier), static_cast<int>(current), z, information, true).gate
+             : filter.gateRelative(static_cast<int>(earlier), static_cast<int>(current), z, information);
   r.mahalanobis2 = gate.mahalanobis2;
   r.gate_threshold = gate.threshold;
   r.accepted = gate.accepted;

@@ -104,7 +104,7 @@ std::vector<io::StampedPose> Map::scanTrajectory() const {
 std::vector<io::PosedScan> Map::posedKeyframes() const {
   std::vector<io::PosedScan> out;
   out.reserve(keyframes_.size());
-  for (const auto& k : keyframes_) out.push_back({k.pose, &k.scan});
+  for (const auto& k : keyframes_) out.push_back({k.pose, nullptr, &k.scan});
   return out;
 }
 

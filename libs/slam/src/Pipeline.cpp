@@ -204,15 +204,22 @@ void Pipeline::addKeyframe(io::LaserScan scan, const std::optional<CameraMeasure
   }
   // 3. The keyframe anchors the trajectory at sensor times and joins the local submap.
   const double timestamp = scan.timestamp;
+  // From here on the scan is the one the map keeps (ranges to the millimetre), as a map read
+  // back from its file has it: a continued run rebuilds the submap from those.
+  io::CompactScan kept(scan);
+  kept.expandInto(scan);
   map_.addAnchor({timestamp, k, common::Pose2{}, local_.motion().odometryPose()});
   local_.keyframeAdded(scan, c.z);
   // 4. Global SLAM, in order: the keyframe into the filter as a delayed pose, then loop closures
   //    against earlier keyframes.
-  postToGlobalSlam([this, kf = Keyframe{k, timestamp, {}, std::move(scan), false, {}}, c,
+  postToGlobalSlam([this, kf = Keyframe{k, timestamp, {}, std::move(kept), false, {}}, c,
                     handed_over = std::chrono::steady_clock::now()]() mutable {
     const std::array<double, 9> cov = global_.addKeyframe(std::move(kf), c);
     const Keyframe& added = map_.back();
-    for (auto* o : observers_) o->onKeyframe({added.index, added.timestamp, added.pose, cov, &added.scan});
+    if (!observers_.empty()) {
+      const io::LaserScan scan = added.scan.expand();
+      for (auto* o : observers_) o->onKeyframe({added.index, added.timestamp, added.pose, cov, &scan});
+    }
     global_.closeLoops(added.index, handed_over);
   });
 }

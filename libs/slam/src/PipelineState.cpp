@@ -268,7 +268,7 @@ void Map::writeState(BinaryWriter& w) const {
     w.size(k.index);
     w.f64(k.timestamp);
     writePose(w, k.pose);
-    writeScan(w, k.scan);
+    writeScan(w, k.scan.expand());
     w.boolean(k.has_image);
     w.size(k.image_words.entries.size());
     for (const auto& e : k.image_words.entries) {
@@ -308,7 +308,7 @@ void Map::readState(BinaryReader& r) {
     if (k.index != i) r.fail("keyframe " + std::to_string(i) + " numbered " + std::to_string(k.index));
     k.timestamp = r.f64();
     k.pose = readPose(r);
-    k.scan = readScan(r);
+    k.scan = io::CompactScan(readScan(r));
     k.has_image = r.boolean();
     k.image_words.entries.resize(r.count(8));
     for (auto& e : k.image_words.entries) {
@@ -476,7 +476,7 @@ void GlobalSlam::readState(BinaryReader& r) {
   last_full_size_ = r.size();
   // The classifier's keyframe features: a function of each keyframe's scan.
   if (laser_detector_)
-    for (const Keyframe& k : map_.keyframes()) laser_detector_->addKeyframe(k.scan);
+    for (const Keyframe& k : map_.keyframes()) laser_detector_->addKeyframe(k.scan.expand());
 }
 
 // --- Camera images ---

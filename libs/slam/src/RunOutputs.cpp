@@ -101,22 +101,25 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
     files.push("loop_closures.csv");
   }
 
+  // The clouds are streamed from the keyframes, scan by scan: a city's cloud held whole would be
+  // the largest thing in memory.
   const auto posed = p.posedKeyframes();
-  const auto pts = io::mapPoints(posed, o.map.point_decimation);
+  const int decimation = o.map.point_decimation;
+  const size_t map_points = io::countMapPoints(posed, decimation);
   if (o.output.write_ply_binary) {
-    io::writePly(path("map.ply"), pts, io::PlyEncoding::BinaryLittleEndian);
+    io::writePly(path("map.ply"), posed, decimation, io::PlyEncoding::BinaryLittleEndian);
     files.push("map.ply");
   }
   if (o.output.write_ply_ascii) {
-    io::writePly(path("map_ascii.ply"), pts, io::PlyEncoding::Ascii);
+    io::writePly(path("map_ascii.ply"), posed, decimation, io::PlyEncoding::Ascii);
     files.push("map_ascii.ply");
   }
   if (o.output.write_pcd) {
-    io::writePcd(path("map.pcd"), pts);
+    io::writePcd(path("map.pcd"), posed, decimation);
     files.push("map.pcd");
   }
   if (o.output.write_xyz) {
-    io::writeXyz(path("map.xyz"), pts);
+    io::writeXyz(path("map.xyz"), posed, decimation);
     files.push("map.xyz");
   }
   if (o.output.write_simplemap) {
@@ -124,7 +127,7 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
     files.push("map.simplemap");
   }
   Json grid = Json::object();
-  if (o.output.write_grid && !pts.empty()) {  // camera-only runs have no map points
+  if (o.output.write_grid && map_points > 0) {  // camera-only runs have no map points
     io::OccupancyGridOptions g;
     g.resolution_m = o.map.grid_resolution_m;
     double resolution = g.resolution_m;
@@ -153,7 +156,7 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   c["gps"] = s.gps;
   c["reference_poses"] = s.reference;
   c["keyframes"] = p.keyframes().size();
-  c["map_points"] = pts.size();
+  c["map_points"] = map_points;
   c["scan_matches_used"] = s.scan_matches_used;
   c["scan_matches_rejected"] = s.scan_matches_rejected;
   c["camera_motions_used"] = s.camera_motions_used;

@@ -2,10 +2,12 @@
 // The map products of a run, all built from scans placed at (estimated) vehicle poses:
 // trajectory (TUM), point cloud (PLY binary/ASCII, PCD, XYZ), MRPT .simplemap, and an occupancy
 // grid as PNG + YAML (ROS map_server convention). Every writer writes atomically.
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "urbanslam/common/Pose2.h"
+#include "urbanslam/io/CompactScan.h"
 #include "urbanslam/io/LaserScan.h"
 
 namespace urbanslam::io {
@@ -15,10 +17,14 @@ struct StampedPose {
   common::Pose2 pose;
 };
 
-// A scan and the vehicle pose it was taken from.
+// A scan and the vehicle pose it was taken from: a LaserScan, or a CompactScan (a map's
+// keyframes) that the writers expand one at a time, never all at once.
 struct PosedScan {
   common::Pose2 pose;
   const LaserScan* scan = nullptr;
+  const CompactScan* compact = nullptr;  // used when scan is null
+  // The scan itself, or the compact one expanded into `buffer`.
+  const LaserScan& get(LaserScan& buffer) const;
 };
 
 struct MapPoint {
@@ -32,11 +38,20 @@ std::vector<StampedPose> readTum(const std::string& path);
 
 // World-frame points of all valid beams, optionally keeping every `decimation`-th point.
 std::vector<MapPoint> mapPoints(const std::vector<PosedScan>& scans, int decimation = 1);
+// The same points one scan at a time, for writers that stream them (a city's cloud is tens of
+// bytes a beam held whole): `visit` gets each scan's points. Returns how many there were.
+size_t forEachMapPoint(const std::vector<PosedScan>& scans, int decimation, const std::function<void(const std::vector<MapPoint>&)>& visit);
+// How many points mapPoints would give, without building them.
+size_t countMapPoints(const std::vector<PosedScan>& scans, int decimation = 1);
 
 enum class PlyEncoding { Ascii, BinaryLittleEndian };
 void writePly(const std::string& path, const std::vector<MapPoint>& pts, PlyEncoding encoding);
 void writePcd(const std::string& path, const std::vector<MapPoint>& pts);  // PCD v0.7, ASCII
 void writeXyz(const std::string& path, const std::vector<MapPoint>& pts);  // "x y z" per line
+// The same files for mapPoints(scans, decimation), streamed scan by scan.
+void writePly(const std::string& path, const std::vector<PosedScan>& scans, int decimation, PlyEncoding encoding);
+void writePcd(const std::string& path, const std::vector<PosedScan>& scans, int decimation);
+void writeXyz(const std::string& path, const std::vector<PosedScan>& scans, int decimation);
 
 // MRPT CSimpleMap: one (pose, sensory frame with the scan) per keyframe.
 void writeSimpleMap(const std::string& path, const std::vector<PosedScan>& scans);

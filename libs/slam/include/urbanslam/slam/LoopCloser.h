@@ -88,7 +88,7 @@ class LoopCloser {
 
  private:
   Eigen::Matrix3d relativeCovariance(esdf::Esdf& filter, size_t i, size_t k);
-  bool ambiguous(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current,
+  bool ambiguous(esdf::Esdf& filter, const io::LaserScan& earlier_scan, const io::LaserScan& current_scan, size_t earlier, size_t current,
                  const alignment::AlignmentResult& a, alignment::AlignerOptions ao);
 
   LoopClosureOptions options_;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "urbanslam/common/BinaryStream.h"
+#include "urbanslam/io/CompactScan.h"
 #include "urbanslam/io/MapOutputs.h"
 #include "urbanslam/slam/KeyframeGrid.h"
 #include "urbanslam/vision_loop/BagOfWords.h"
@@ -22,12 +23,14 @@ namespace urbanslam::slam {
 struct Keyframe {
   size_t index = 0;
   double timestamp = 0;
-  common::Pose2 pose;                   // current estimate
-  io::LaserScan scan;                   // kept so the map can be rebuilt from the current estimates; empty
-                                        // for keyframes made from camera images alone
+  common::Pose2 pose;  // current estimate
+  // Kept so the map can be rebuilt from the current estimates; empty for keyframes made from
+  // camera images alone. Held compact (ranges to the millimetre, about 2 bytes a beam) because
+  // every keyframe of a run keeps it: scan.expand() gives the io::LaserScan to align or draw.
+  io::CompactScan scan;
   bool has_image = false;               // an image was attached (nearest in time)
   vision_loop::BagOfWords image_words;  // its Tree of Words vector (tree_of_words only); no pixels
-  bool hasScan() const { return !scan.ranges.empty(); }
+  bool hasScan() const { return !scan.empty(); }
 };
 
 // A constraint between two keyframes as it went into the filter (for the g2o output).
