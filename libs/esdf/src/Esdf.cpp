@@ -249,6 +249,7 @@ void Esdf::ensureFactor() {
   chain_cov_.clear();
   chain_valid_ = true;
   base_columns_.resize(0, 0);
+  factored_marginals_.clear();
 }
 
 RecoveryStats Esdf::recover(int max_passes) {
@@ -407,8 +408,12 @@ Mat6 Esdf::conservativeJoint(int i, int j) {
   auto chainPhi = [&](int p) -> const Mat3& { return chain_phi_[static_cast<size_t>(p - m)]; };
   auto marginal = [&](int p) -> Mat3 {
     if (p >= m) return chainPhi(p) * base * chainPhi(p).transpose() + chain_cov_[static_cast<size_t>(p - m)];
+    // A solve over the whole map: kept until the next factorisation, since the keyframes of an
+    // earlier visit are candidates again and again while the vehicle drives along it.
+    const auto known = factored_marginals_.find(p);
+    if (known != factored_marginals_.end()) return known->second;
     Eigen::MatrixXd cols;
-    return covarianceColumnsBlock(p, &cols);
+    return factored_marginals_[p] = covarianceColumnsBlock(p, &cols);
   };
   auto cross = [&](int a, int b) -> Mat3 {  // Sigma(a, b) for a < b
     if (b < m) {

@@ -176,6 +176,7 @@ void Esdf::readState(common::BinaryReader& r) {
       chain_phi_.size() > static_cast<size_t>(n - chain_base_))
     r.fail("filter dead-reckoning chain");
   base_columns_ = r.dense();
+  factored_marginals_.clear();
   if (base_columns_.size() != 0 && (!full_factor_.valid() || base_columns_.rows() != 3 * full_factor_.last() || base_columns_.cols() != 3))
     r.fail("filter covariance columns");
 }

@@ -19,6 +19,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
+#include <unordered_map>
 #include <vector>
 
 #include "urbanslam/esdf/EnvelopeCholesky.h"
@@ -215,6 +216,7 @@ class Esdf {
   std::vector<Mat3> chain_phi_, chain_cov_;
   bool chain_valid_ = true;
   Eigen::MatrixXd base_columns_;  // stale Sigma(:, base-1), from the last full factorisation
+  std::unordered_map<int, Mat3> factored_marginals_;  // Sigma(p, p) of older poses from the same factorisation
 };
 
 }  // namespace urbanslam::esdf
