@@ -9,6 +9,7 @@
 #include "urbanslam/common/Progress.h"
 #include "urbanslam/sim/SimOptions.h"
 #include "urbanslam/sim/SimulatedSource.h"
+#include "urbanslam/common/AtomicFile.h"
 #include "urbanslam/slam/MapFile.h"
 #include "urbanslam/slam/Pipeline.h"
 #include "urbanslam/slam/RunOutputs.h"
@@ -90,8 +91,27 @@ int runCommand(const Argv& args) {
   pipeline->addObserver(&progress);
   pipeline->runInput(*source);
   // The map is saved before finish(): finish() drops the closures still awaiting confirmation,
-  // which a continued run may yet confirm.
-  std::string map_file = pipeline->keyframes().empty() ? std::string() : slam::encodeMap(*pipeline);
+  // which a continued run may yet confirm. It goes to a temporary file beside the run folder
+  // (streamed, never whole in memory), which the outputs move into the folder; a run that
+  // fails or is killed leaves only a temporary, removed now or by the next run.
+  std::string out = ap.option("out");
+  while (out.size() > 1 && out.back() == '/') out.pop_back();
+  const std::string map_target = out + ".usmap";
+  common::removeStaleTemporaries(map_target);
+  const std::string map_file = pipeline->keyframes().empty() ? std::string() : common::temporaryPathFor(map_target);
+  struct RemoveAtExit {
+    std::string path;
+    ~RemoveAtExit() {
+      std::error_code ec;
+      if (!path.empty()) std::filesystem::remove(path, ec);
+    }
+  } map_file_guard{map_file};
+  if (!map_file.empty()) {
+    std::error_code ec;
+    const auto parent = std::filesystem::path(out).parent_path();
+    if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+    slam::writeMapFile(*pipeline, map_file);
+  }
   pipeline->finish(*source);
   bar.finish();
   // A log without a single keyframe has nothing to map: outputs would only look like a run.
@@ -101,8 +121,7 @@ int runCommand(const Argv& args) {
                                                : ": none of its " + std::to_string(scans) + " laser scans could be used: nothing to map"));
   }
 
-  const std::string out = ap.option("out");
-  const common::Json stats = slam::writeRunOutputs(*pipeline, out, {log, source->format(), ini, resolved, std::move(map_file), map});
+  const common::Json stats = slam::writeRunOutputs(*pipeline, out, {log, source->format(), ini, resolved, map_file, map});
   if (ap.flag("json")) std::cout << stats.dump() << "\n";
   if (!quiet) {
     const auto& t = stats.at("timing");

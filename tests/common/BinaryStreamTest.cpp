@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 #include "urbanslam/common/Error.h"
 
@@ -121,4 +122,38 @@ TEST(BinaryStream, Fnv1a64MatchesTheReferenceValues) {
   EXPECT_EQ(fnv1a64("", 0), 0xcbf29ce484222325ull);
   EXPECT_EQ(fnv1a64("a", 1), 0xaf63dc4c8601ec8cull);
   EXPECT_EQ(fnv1a64("foobar", 6), 0x85944171f73967e8ull);
+}
+
+TEST(BinaryStream, Fnv1a64PieceByPieceEqualsWhole) {
+  const std::string s = "a payload hashed in three pieces";
+  const std::uint64_t h = fnv1a64(s.data() + 20, s.size() - 20, fnv1a64(s.data() + 7, 13, fnv1a64(s.data(), 7)));
+  EXPECT_EQ(h, fnv1a64(s.data(), s.size()));
+}
+
+// Written through a sink, a megabyte at a time with the sections' lengths patched in the stream,
+// the bytes are those of the writer that keeps everything in memory: nested sections, sections
+// that end long after their length went to the stream, and ones that end before.
+TEST(BinaryStream, StreamedWriterWritesTheSameBytes) {
+  const auto fill = [](BinaryWriter& w) {
+    w.beginSection(sectionTag("ONE "));
+    for (int i = 0; i < 300000; ++i) w.f64(std::sin(i));  // 2.4 MB: flushed inside the section
+    w.beginSection(sectionTag("TWO "));
+    w.string("inner");
+    w.endSection();
+    w.endSection();
+    w.beginSection(sectionTag("THRE"));
+    w.u32(7);
+    w.endSection();
+  };
+  BinaryWriter memory;
+  fill(memory);
+  std::stringstream s(std::ios::in | std::ios::out | std::ios::binary);
+  BinaryWriter streamed(&s);
+  fill(streamed);
+  streamed.flush();
+  EXPECT_EQ(streamed.position(), memory.bytes().size());
+  EXPECT_TRUE(s.str() == memory.bytes());
+  BinaryReader r(memory.bytes().data(), memory.bytes().size(), "x.bin");
+  BinaryReader one = r.section(sectionTag("ONE "));
+  EXPECT_EQ(one.remaining(), 300000u * 8 + 4 + 8 + 8 + 5);
 }

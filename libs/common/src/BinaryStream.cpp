@@ -7,9 +7,8 @@
 
 namespace urbanslam::common {
 
-std::uint64_t fnv1a64(const void* data, size_t size) {
+std::uint64_t fnv1a64(const void* data, size_t size, std::uint64_t h) {
   const auto* p = static_cast<const unsigned char*>(data);
-  std::uint64_t h = 14695981039346656037ull;
   for (size_t i = 0; i < size; ++i) {
     h ^= p[i];
     h *= 1099511628211ull;
@@ -53,15 +52,33 @@ void BinaryWriter::dense(const Eigen::MatrixXd& m) {
 
 void BinaryWriter::beginSection(std::uint32_t tag) {
   u32(tag);
-  open_sections_.push_back(bytes_.size());
+  open_sections_.push_back(position());
   u64(0);  // patched by endSection
+}
+
+void BinaryWriter::flush() {
+  if (!sink_ || bytes_.empty()) return;
+  sink_->write(bytes_.data(), static_cast<std::streamsize>(bytes_.size()));
+  if (!*sink_) throw InputError("cannot write the file (disk full?)");
+  flushed_ += bytes_.size();
+  bytes_.clear();
 }
 
 void BinaryWriter::endSection() {
   const size_t at = open_sections_.back();
   open_sections_.pop_back();
-  const std::uint64_t length = bytes_.size() - at - 8;
-  for (int i = 0; i < 8; ++i) bytes_[at + static_cast<size_t>(i)] = static_cast<char>(static_cast<std::uint8_t>(length >> (8 * i)));
+  const std::uint64_t length = position() - at - 8;
+  char field[8];
+  for (int i = 0; i < 8; ++i) field[i] = static_cast<char>(static_cast<std::uint8_t>(length >> (8 * i)));
+  if (at >= flushed_) {
+    std::memcpy(&bytes_[at - flushed_], field, 8);
+    return;
+  }
+  // The length field went to the sink already: patch it there.
+  sink_->seekp(static_cast<std::streamoff>(at));
+  sink_->write(field, 8);
+  sink_->seekp(0, std::ios::end);
+  if (!*sink_) throw InputError("cannot write the file (disk full?)");
 }
 
 BinaryReader::BinaryReader(const char* data, size_t size, std::string name, std::string problem)

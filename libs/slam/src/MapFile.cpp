@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
+#include <vector>
 
 #include "urbanslam/common/AtomicFile.h"
 #include "urbanslam/common/BinaryStream.h"
@@ -57,27 +59,67 @@ std::uint64_t readU64(const std::string& bytes, size_t at) {
 
 }  // namespace
 
-std::string encodeMap(const Pipeline& pipeline) {
-  common::BinaryWriter payload;
-  payload.beginSection(kOptionsTag);
-  payload.string(optionsToIni(pipeline.options()));
-  payload.endSection();
-  pipeline.writeState(payload);
-  const std::string body = payload.take();
-
-  common::BinaryWriter file;
-  file.raw(kMagic, sizeof kMagic);
-  file.u32(kMapFormatVersion);
-  file.size(body.size());
-  file.u64(common::fnv1a64(body.data(), body.size()));
-  file.raw(body.data(), body.size());
-  return file.take();
+void writeMap(const Pipeline& pipeline, std::iostream& out, const std::string& name) {
+  // The header with a zero length and checksum, the payload straight to the stream a megabyte at
+  // a time, then the payload read back for its checksum and the header completed: no copy of
+  // the map in memory, however large.
+  common::BinaryWriter w(&out);
+  w.raw(kMagic, sizeof kMagic);
+  w.u32(kMapFormatVersion);
+  w.size(0);
+  w.u64(0);
+  w.beginSection(kOptionsTag);
+  w.string(optionsToIni(pipeline.options()));
+  w.endSection();
+  pipeline.writeState(w);
+  w.flush();
+  const std::uint64_t length = w.position() - kHeaderBytes;
+  out.flush();
+  out.seekg(static_cast<std::streamoff>(kHeaderBytes));
+  std::uint64_t sum = common::kFnv1a64Start;
+  std::vector<char> chunk(1 << 20);
+  for (std::uint64_t left = length; left > 0;) {
+    const size_t n = static_cast<size_t>(std::min<std::uint64_t>(left, chunk.size()));
+    if (!out.read(chunk.data(), static_cast<std::streamsize>(n)))
+      throw common::InputError(name + ": cannot read back the map being written");
+    sum = common::fnv1a64(chunk.data(), n, sum);
+    left -= n;
+  }
+  common::BinaryWriter header;
+  header.size(length);
+  header.u64(sum);
+  out.clear();
+  out.seekp(12);
+  out.write(header.bytes().data(), static_cast<std::streamsize>(header.bytes().size()));
+  out.flush();
+  if (!out) throw common::InputError(name + ": cannot write the map file (disk full?)");
 }
 
-void writeMapFile(const std::string& bytes, const std::string& path) {
-  common::AtomicFile f(path, true);
-  f.stream().write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  f.commit();
+std::string encodeMap(const Pipeline& pipeline) {
+  std::stringstream s(std::ios::in | std::ios::out | std::ios::binary);
+  writeMap(pipeline, s, "map");
+  return s.str();
+}
+
+void writeMapFile(const Pipeline& pipeline, const std::string& path) {
+  std::fstream f(path, std::ios::in | std::ios::out | std::ios::trunc | std::ios::binary);
+  if (!f) throw common::InputError(path + ": cannot create the map file (is its folder writable?)");
+  writeMap(pipeline, f, path);
+  f.close();
+  if (f.fail()) throw common::InputError(path + ": cannot write the map file (disk full?)");
+}
+
+void saveMap(const Pipeline& pipeline, const std::string& path) {
+  common::removeStaleTemporaries(path);
+  const std::string tmp = common::temporaryPathFor(path);
+  try {
+    writeMapFile(pipeline, tmp);
+    std::filesystem::rename(tmp, path);
+  } catch (...) {
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);
+    throw;
+  }
 }
 
 std::string mapFilePath(const std::string& file_or_run_folder) {

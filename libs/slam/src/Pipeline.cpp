@@ -212,16 +212,16 @@ void Pipeline::addKeyframe(io::LaserScan scan, const std::optional<CameraMeasure
   local_.keyframeAdded(scan, c.z);
   // 4. Global SLAM, in order: the keyframe into the filter as a delayed pose, then loop closures
   //    against earlier keyframes.
-  postToGlobalSlam([this, kf = Keyframe{k, timestamp, {}, std::move(kept), false, {}}, c,
-                    handed_over = std::chrono::steady_clock::now()]() mutable {
-    const std::array<double, 9> cov = global_.addKeyframe(std::move(kf), c);
-    const Keyframe& added = map_.back();
-    if (!observers_.empty()) {
-      const io::LaserScan scan = added.scan.expand();
-      for (auto* o : observers_) o->onKeyframe({added.index, added.timestamp, added.pose, cov, &scan});
-    }
-    global_.closeLoops(added.index, handed_over);
-  });
+  postToGlobalSlam(
+      [this, kf = Keyframe{k, timestamp, {}, std::move(kept), false, {}}, c, handed_over = std::chrono::steady_clock::now()]() mutable {
+        const std::array<double, 9> cov = global_.addKeyframe(std::move(kf), c);
+        const Keyframe& added = map_.back();
+        if (!observers_.empty()) {
+          const io::LaserScan scan = added.scan.expand();
+          for (auto* o : observers_) o->onKeyframe({added.index, added.timestamp, added.pose, cov, &scan});
+        }
+        global_.closeLoops(added.index, handed_over);
+      });
 }
 
 }  // namespace urbanslam::slam

@@ -41,8 +41,9 @@ void Pipeline::onCameraImage(const io::CameraImage& image, double progress) {
     global_worker_.drain();
     const size_t previous = image_keyframes_.size();
     if (previous > 0 && image_keyframes_.back() + 1 == local_.keyframes())
-      camera_motion = measureCamera(image_cameras_[previous - 1], image_detector_->features(static_cast<vision_loop::ImageId>(previous - 1)),
-                                    {image.calibration, image.width}, prepared->features);
+      camera_motion =
+          measureCamera(image_cameras_[previous - 1], image_detector_->features(static_cast<vision_loop::ImageId>(previous - 1)),
+                        {image.calibration, image.width}, prepared->features);
   }
   io::LaserScan none;
   none.timestamp = image.timestamp;
@@ -99,8 +100,8 @@ std::optional<CameraMeasurement> Pipeline::measureCamera(const ImageCamera& a, c
   if (a.width != b.width || !(*a.calibration == cb)) return std::nullopt;
   CameraMeasurement m;
   m.mount = cb.mount;
-  m.relative = vision_loop::planarRelativePose(fa, fb, image_detector_->vocabulary().descriptorType(),
-                                               pinholeFor(cb, b.width, fb.image_size.width));
+  m.relative =
+      vision_loop::planarRelativePose(fa, fb, image_detector_->vocabulary().descriptorType(), pinholeFor(cb, b.width, fb.image_size.width));
   return m;
 }
 

@@ -83,7 +83,7 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   writePoseGraphG2o(p, path("pose_graph.g2o"));
   files.push("pose_graph.g2o");
   if (!info.map_file.empty()) {
-    writeMapFile(info.map_file, path(kMapFileName));
+    std::filesystem::rename(info.map_file, path(kMapFileName));  // beside the folder: the same file system
     files.push(kMapFileName);
   }
   {

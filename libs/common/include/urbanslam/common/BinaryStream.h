@@ -9,17 +9,29 @@
 // past the end.
 #include <Eigen/Core>
 #include <cstdint>
+#include <ostream>
 #include <string>
 #include <vector>
 
 namespace urbanslam::common {
 
-// FNV-1a, 64 bits: a payload checksum that needs no table and no library.
-std::uint64_t fnv1a64(const void* data, size_t size);
+// FNV-1a, 64 bits: a payload checksum that needs no table and no library. `h`: the hash of the
+// bytes before these, to hash a long payload piece by piece.
+constexpr std::uint64_t kFnv1a64Start = 14695981039346656037ull;
+std::uint64_t fnv1a64(const void* data, size_t size, std::uint64_t h = kFnv1a64Start);
 
+// Collects the bytes in memory, or (with a sink) passes them on to a seekable stream a
+// megabyte at a time, so that saving a map of any size needs no copy of it in memory; a
+// section's length is then patched in the stream.
 class BinaryWriter {
  public:
-  void u8(std::uint8_t v) { bytes_.push_back(static_cast<char>(v)); }
+  BinaryWriter() = default;
+  explicit BinaryWriter(std::ostream* sink) : sink_(sink) {}
+
+  void u8(std::uint8_t v) {
+    bytes_.push_back(static_cast<char>(v));
+    if (sink_ && bytes_.size() >= kFlushBytes) flush();
+  }
   void boolean(bool v) { u8(v ? 1 : 0); }
   void u32(std::uint32_t v);
   void u64(std::uint64_t v);
@@ -29,7 +41,10 @@ class BinaryWriter {
   void f32(float v);
   void f64(double v);
   void string(const std::string& s);
-  void raw(const void* data, size_t n) { bytes_.append(static_cast<const char*>(data), n); }
+  void raw(const void* data, size_t n) {
+    bytes_.append(static_cast<const char*>(data), n);
+    if (sink_ && bytes_.size() >= kFlushBytes) flush();
+  }
   template <int R, int C>
   void matrix(const Eigen::Matrix<double, R, C>& m) {
     static_assert(R > 0 && C > 0, "fixed-size matrices only; dynamic ones go through dense()");
@@ -44,12 +59,20 @@ class BinaryWriter {
   void beginSection(std::uint32_t tag);
   void endSection();
 
+  // In memory only (no sink).
   const std::string& bytes() const { return bytes_; }
   std::string take() { return std::move(bytes_); }
+  // Bytes written so far.
+  size_t position() const { return flushed_ + bytes_.size(); }
+  // Passes the bytes held to the sink (throws InputError when the stream fails).
+  void flush();
 
  private:
+  static constexpr size_t kFlushBytes = 1 << 20;
+  std::ostream* sink_ = nullptr;
   std::string bytes_;
-  std::vector<size_t> open_sections_;
+  size_t flushed_ = 0;                 // bytes already passed to the sink
+  std::vector<size_t> open_sections_;  // positions of the open sections' length fields
 };
 
 class BinaryReader {

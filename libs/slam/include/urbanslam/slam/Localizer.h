@@ -51,7 +51,7 @@ struct LocalizerOptions {
   double covariance_scale = 4.0;
   double min_sigma_xy_m = 0.02;
   double min_sigma_deg = 0.5;
-  double initial_sigma_xy_m = 0.5;    // the uncertainty of a given initial pose
+  double initial_sigma_xy_m = 0.5;  // the uncertainty of a given initial pose
   double initial_sigma_deg = 10.0;
   // While lost, a place search at most every relocalise_interval_s of log time, the interval
   // doubling after each failed search up to relocalise_max_interval_s, and only once the vehicle
@@ -99,8 +99,8 @@ struct LocalizerStats {
   size_t place_searches = 0, relocalisations = 0, lost_events = 0;
   size_t fixes_rejected = 0;  // place-search fixes the confirmed dead-reckoned pose ruled out
   double first_timestamp = 0, last_timestamp = 0;
-  double lost_s = 0;         // log time spent lost
-  double first_fix_s = -1;   // log time from the first scan to the first tracked one (-1: never)
+  double lost_s = 0;        // log time spent lost
+  double first_fix_s = -1;  // log time from the first scan to the first tracked one (-1: never)
   double wall_s = 0, place_search_wall_s = 0;
   size_t references_built = 0, coarse_grids_built = 0;
 };

@@ -19,14 +19,14 @@
 namespace urbanslam::slam {
 
 struct MapAreaOptions {
-  double tile_m = 10.0;             // tile side; a pose is matched against the reference of the tile it lies in
-  double keyframe_reach_m = 20.0;   // a tile's reference holds the keyframes this close to the tile (their scans reach into it)
-  double keyframe_spacing_m = 0.5;  // revisits thinned: one keyframe per cell this wide and heading quadrant
-  size_t cached_tiles = 6;          // tracking references kept (a few tens of MB each)
-  size_t cached_coarse_tiles = 64;  // coarse grids kept (about 1 MB each)
-  alignment::PriorMatcherOptions matcher;      // the tracking references' grid and search (grid radius set from the tile)
-  alignment::LikelihoodGridOptions coarse;     // the place-recognition grids (radius set from the tile)
-  alignment::ScanModelOptions scan_model;      // the keyframes' points, as local SLAM made them
+  double tile_m = 10.0;                     // tile side; a pose is matched against the reference of the tile it lies in
+  double keyframe_reach_m = 20.0;           // a tile's reference holds the keyframes this close to the tile (their scans reach into it)
+  double keyframe_spacing_m = 0.5;          // revisits thinned: one keyframe per cell this wide and heading quadrant
+  size_t cached_tiles = 6;                  // tracking references kept (a few tens of MB each)
+  size_t cached_coarse_tiles = 64;          // coarse grids kept (about 1 MB each)
+  alignment::PriorMatcherOptions matcher;   // the tracking references' grid and search (grid radius set from the tile)
+  alignment::LikelihoodGridOptions coarse;  // the place-recognition grids (radius set from the tile)
+  alignment::ScanModelOptions scan_model;   // the keyframes' points, as local SLAM made them
 };
 
 class MapAreas {
@@ -61,7 +61,7 @@ class MapAreas {
 
   const Map& map_;
   MapAreaOptions options_;
-  KeyframeGrid index_;  // the keyframes' final poses (the map's own index may predate its last recovery)
+  KeyframeGrid index_;             // the keyframes' final poses (the map's own index may predate its last recovery)
   std::list<Tile> fine_, coarse_;  // most recently used first
   size_t built_fine_ = 0, built_coarse_ = 0;
 };

@@ -5,6 +5,7 @@
 // sections (the resolved options first, then Pipeline::writeState). libs/slam/README.md ("The
 // map file") documents every byte.
 #include <cstdint>
+#include <iostream>
 #include <memory>
 #include <string>
 
@@ -15,12 +16,16 @@ namespace urbanslam::slam {
 constexpr const char* kMapFileName = "map.usmap";
 constexpr std::uint32_t kMapFormatVersion = 2;
 
-// The file's bytes for the pipeline's current state. Call it before finish() (after finish()
-// the state cannot be continued: std::logic_error).
+// The map of the pipeline's current state written to `out` from its start, streamed (the
+// stream is read back for the checksum); `name` for errors. Call it before finish() (after
+// finish() the state cannot be continued: std::logic_error).
+void writeMap(const Pipeline& pipeline, std::iostream& out, const std::string& name);
+// The same as bytes in memory (tests, fuzzing).
 std::string encodeMap(const Pipeline& pipeline);
-// Writes `bytes` (encodeMap's) atomically: a temporary beside `path`, renamed when complete.
-void writeMapFile(const std::string& bytes, const std::string& path);
-inline void saveMap(const Pipeline& pipeline, const std::string& path) { writeMapFile(encodeMap(pipeline), path); }
+// The same written to `path` as it is (the caller renames it into place).
+void writeMapFile(const Pipeline& pipeline, const std::string& path);
+// The same written atomically: a temporary beside `path`, renamed when complete.
+void saveMap(const Pipeline& pipeline, const std::string& path);
 
 // The map file named by the user: the file itself, or the run folder holding map.usmap.
 std::string mapFilePath(const std::string& file_or_run_folder);

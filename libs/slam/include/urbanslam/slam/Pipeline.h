@@ -128,7 +128,7 @@ class Pipeline {
   GlobalSlam global_;
   std::unique_ptr<vision_loop::LoopDetector> image_detector_;  // [loop_closure] image_detector = tree_of_words
   std::vector<size_t> image_keyframes_;                        // image database id -> keyframe
-  std::vector<ImageCamera> image_cameras_;  // image database id -> its camera
+  std::vector<ImageCamera> image_cameras_;                     // image database id -> its camera
   KeyframeImageAssigner images_;
   bool have_first_ts_ = false;
   bool finished_ = false;

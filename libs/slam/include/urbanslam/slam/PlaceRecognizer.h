@@ -39,7 +39,7 @@ struct PlaceRecognitionOptions {
   // percent (people, glass; about 3 % on FR079), at a wrong one that looks alike, walls stand
   // in open space (8-12 % measured for Intel scans placed in the FR079 map).
   double max_seen_through_share = 0.06;
-  double refine_sigma_m = 0.2;        // the coarse pose's uncertainty as the refinement's prior
+  double refine_sigma_m = 0.2;  // the coarse pose's uncertainty as the refinement's prior
   double refine_sigma_deg = 3.0;
 };
 

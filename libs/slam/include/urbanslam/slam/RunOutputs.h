@@ -4,7 +4,8 @@
 // replaced as a whole (common::AtomicFolder): it appears complete, holding one run, or not at
 // all; an existing folder that is neither empty nor a run's is refused (InputError), never
 // deleted. stats.json still comes last. map.usmap, the state another run can continue
-// (MapFile.h), is encoded before finish() and handed over in RunInfo.
+// (MapFile.h), is written before finish() to a temporary file, which RunInfo names and which is
+// moved into the folder.
 #include <string>
 
 #include "urbanslam/common/Json.h"
@@ -14,7 +15,7 @@ namespace urbanslam::slam {
 
 struct RunInfo {
   std::string input_path, input_format, ini_path, resolved_ini;
-  std::string map_file;     // map.usmap's bytes (encodeMap before finish()); empty: not written
+  std::string map_file;     // map.usmap written before finish() (writeMapFile), moved in; empty: none
   std::string resumed_map;  // the map this run continued, "" for a run from scratch
 };
 
