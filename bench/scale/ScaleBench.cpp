@@ -2,7 +2,8 @@
 // Runs the SLAM pipeline on a simulated city streamed from the simulator (no file) or on a log,
 // records every step's time with the map's size at that step, and writes DIR/steps.csv
 // (keyframes, step_ms, wall_s), DIR/step_time.png (p50 / p99 / max of the step time per bin of
-// map size), the run's usual outputs (the front end's and global SLAM's figures in stats.json),
+// map size), DIR/corrections.csv and DIR/global_latency.png (each full correction's latency
+// against the keyframe whose closure it brought in), the run's usual outputs (the front end's and global SLAM's figures in stats.json),
 // the CPU time of the mapping (both threads) (so `urbanslam eval DIR --truth SIM_DIR` scores it) and
 // one JSON summary on stdout.
 #include <sys/resource.h>
@@ -36,6 +37,14 @@ struct StepRecorder : slam::PipelineObserver {
   void onStep(const slam::StepEvent& e) override {
     keyframes.push_back(e.keyframes);
     step_ms.push_back(e.step_ms);
+  }
+  // From global SLAM's thread; read after the run.
+  std::vector<size_t> corrected_keyframe;
+  std::vector<double> latency_ms;
+  void onPosesUpdated(const slam::PosesUpdatedEvent& e) override {
+    if (e.keyframe == static_cast<size_t>(-1)) return;
+    corrected_keyframe.push_back(e.keyframe);
+    latency_ms.push_back(e.latency_ms);
   }
 };
 
@@ -97,6 +106,17 @@ int main(int argc, char** argv) {
       mx.x.push_back(x), mx.y.push_back(common::percentile(per[b], 100));
     }
     laser_loop::writePlotPng(out + "/step_time.png", {{"step time against map size", "keyframes", "ms", {p50, p99, mx}}});
+    // Global SLAM: each full correction, by the keyframe whose closure it brought in.
+    std::ofstream lat(out + "/corrections.csv");
+    lat << "keyframe,latency_ms\n";
+    laser_loop::PlotSeries latency{"closure -> corrected map", {}, {}, 0xc02020};
+    for (size_t i = 0; i < rec.latency_ms.size(); ++i) {
+      lat << rec.corrected_keyframe[i] << "," << rec.latency_ms[i] << "\n";
+      latency.x.push_back(static_cast<double>(rec.corrected_keyframe[i]));
+      latency.y.push_back(rec.latency_ms[i] / 1e3);
+    }
+    if (!latency.x.empty())
+      laser_loop::writePlotPng(out + "/global_latency.png", {{"global SLAM latency against map size", "keyframes", "s", {latency}}});
     common::Json j = common::Json::object();
     j["input"] = city.empty() ? log : city;
     j["keyframes"] = n;
