@@ -3,9 +3,9 @@
 // is the reference.
 #include <gtest/gtest.h>
 
-#include <map>
 #include <mutex>
 
+#include "MapFileSections.h"
 #include "TestPaths.h"
 #include "urbanslam/slam/MapFile.h"
 #include "urbanslam/slam/Pipeline.h"
@@ -76,17 +76,7 @@ TEST(GlobalThread, SameMapAsGlobalSlamInline) {
   for (size_t i = 0; i < ta.size(); ++i) EXPECT_EQ(ta[i].pose.x, tb[i].pose.x) << i;
   // The state before finish(), section by section, bar the options (global_thread differs) and
   // the statistics (processing times).
-  const auto sections = [](const std::string& file) {
-    std::map<std::string, std::string> out;
-    for (size_t at = 28; at + 12 <= file.size();) {
-      uint64_t length = 0;
-      for (int i = 7; i >= 0; --i) length = length << 8 | static_cast<unsigned char>(file[at + 4 + static_cast<size_t>(i)]);
-      out[file.substr(at, 4)] = file.substr(at + 12, length);
-      at += 12 + length;
-    }
-    return out;
-  };
-  const auto sa = sections(inline_run.state), sb = sections(threaded_run.state);
+  const auto sa = test::mapFileSections(inline_run.state), sb = test::mapFileSections(threaded_run.state);
   for (const char* tag : {"MAP ", "ESDF", "LOCL", "GLOB", "IMGS"}) {
     ASSERT_TRUE(sa.count(tag) && sb.count(tag)) << tag;
     EXPECT_TRUE(sa.at(tag) == sb.at(tag)) << "section " << tag << " differs";

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 
+#include "MapFileSections.h"
 #include "SkippingSource.h"
 #include "TestPaths.h"
 #include "urbanslam/slam/MapFile.h"
@@ -31,18 +32,6 @@ std::unique_ptr<slam::Pipeline> runToEnd(std::unique_ptr<slam::Pipeline> p, io::
 std::unique_ptr<slam::Pipeline> runWhole(const Case& c, const slam::PipelineOptions& o, std::string* map_bytes) {
   auto src = io::openDataSource(test::repoPath(c.log));
   return runToEnd(std::make_unique<slam::Pipeline>(o), *src, map_bytes);
-}
-
-// The sections of a map file's payload by tag (the layout of libs/slam/README.md).
-std::map<std::string, std::string> sections(const std::string& file) {
-  std::map<std::string, std::string> out;
-  for (size_t at = 28; at + 12 <= file.size();) {
-    uint64_t length = 0;
-    for (int i = 7; i >= 0; --i) length = length << 8 | static_cast<unsigned char>(file[at + 4 + static_cast<size_t>(i)]);
-    out[file.substr(at, 4)] = file.substr(at + 12, length);
-    at += 12 + length;
-  }
-  return out;
 }
 
 // The first `split` measurements, saved to `map`; then a fresh pipeline from the map over the
@@ -111,7 +100,7 @@ void expectResumeEqualsWholeRun(const Case& c) {
   // Beyond the results, the whole state at the end of the log is the same, byte for byte: the
   // map, the filter (down to its last factorisation), local and global SLAM. Only the statistics
   // differ (they hold processing times).
-  const auto a = sections(whole_map), b = sections(resumed_map);
+  const auto a = test::mapFileSections(whole_map), b = test::mapFileSections(resumed_map);
   EXPECT_EQ(a.size(), 7u);
   for (const char* tag : {"OPTS", "MAP ", "ESDF", "LOCL", "GLOB", "IMGS"}) {
     ASSERT_TRUE(a.count(tag) && b.count(tag)) << tag;
