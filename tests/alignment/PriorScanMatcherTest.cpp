@@ -130,6 +130,18 @@ TEST(PriorScanMatcher, GoodOdometryIsRefinedToTheTruth) {
   EXPECT_GT(r.prior_weight, 0.5);
 }
 
+TEST(PriorScanMatcher, SpreadIsTheSearchsDisagreementWithTheRefinement) {
+  // Where the search and the refinement agree (to within the search's grid) the spread is as
+  // small as that; it is always the second moment of the search's pose about the estimate.
+  const common::Pose2 truth{0.45, 0.1, 0.05};
+  const auto r = matchRoom(test::roomWorld(), truth, {0.5, 0.08, 0.06}, Eigen::Vector3d(0.025 * 0.025, 0.025 * 0.025, 1e-4).asDiagonal());
+  ASSERT_TRUE(r.valid) << r.failure_reason;
+  const Eigen::Vector3d d(r.search_pose.x - r.pose.x, r.search_pose.y - r.pose.y, common::wrapToPi(r.search_pose.phi - r.pose.phi));
+  EXPECT_TRUE(r.spread.isApprox(d * d.transpose(), 1e-12) || d.norm() < 1e-12);
+  const double cell = PriorMatcherOptions{}.grid.resolution_m;
+  EXPECT_LE(std::sqrt(r.spread(0, 0) + r.spread(1, 1)), cell);
+}
+
 TEST(PriorScanMatcher, ClearScanMatchBeatsWrongOdometry) {
   // Reversing reported as driving forwards: the odometry says +0.5 m, the vehicle went -0.5 m;
   // and a missed 25° turn. The prior's covariance knows nothing of either.

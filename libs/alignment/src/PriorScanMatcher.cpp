@@ -200,6 +200,9 @@ PriorMatchResult matchWithPrior(const MatchReference& reference, const PointSet&
   out.valid = true;
   out.pose = x;
   out.cov = 0.5 * (cov + cov.transpose());
+  // 4. The disagreement of the search and the refinement (header, step 4).
+  const Eigen::Vector3d d(coarse.pose.x - x.x, coarse.pose.y - x.y, common::wrapToPi(coarse.pose.phi - x.phi));
+  out.spread = d * d.transpose();
   out.matched = matched;
   out.rms_residual_m = matched > 0 ? std::sqrt(sum_d2 / matched) : 0.0;
   out.odometry_outvoted = out.prior_weight < 0.5;

@@ -54,6 +54,12 @@ KeyframeConstraint LocalSlam::keyframeConstraint(const io::LaserScan& scan) cons
   c.cov(0, 0) = std::max(c.cov(0, 0), sxy * sxy);
   c.cov(1, 1) = std::max(c.cov(1, 1), sxy * sxy);
   c.cov(2, 2) = std::max(c.cov(2, 2), sphi * sphi);
+  // The search and the refinement disagreeing is doubt of another kind: added after the floors
+  // (which bound the Hessian's optimism along every axis; added before them, a rank-one spread
+  // would lift the diagonal past them and leave the other directions as tight as the Hessian),
+  // and not scaled (the scale stands for matches sharing the submap's points, which the spread
+  // does not come from).
+  c.cov += r.spread;
   return c;
 }
 

@@ -21,7 +21,15 @@
 //  3. the covariance: the inverse of that Hessian, i.e. the posterior of the relative pose given
 //     the odometry and the scan. Where the scan leaves a direction free (a corridor) the prior
 //     holds it; a clear match far from a wrong odometry pays only the prior's bounded outlier
-//     cost.
+//     cost;
+//  4. the spread the Hessian does not see: the search and the refinement estimate the same pose
+//     from two models of the evidence (the likelihood grid of the thinned scan, the point-to-line
+//     residuals of every point with their nearest-neighbour associations). Where they part (the
+//     refinement's associations pulling it along a wall or round a turn the search had placed
+//     right, mostly with sparse scans after a large turn) one of them is wrong by that much and
+//     nothing in the match says which: the caller adds the second moment of the search's pose
+//     about the estimate to the covariance, so that the filter's innovation gate admits the
+//     loop closures that correct it and the correction goes where the doubt is.
 // The search scores the scan's points thinned to one per voxel (a cheaper search whose
 // evidence is not dominated by the many beams on the nearest wall); the refinement uses every
 // point.
@@ -65,7 +73,8 @@ struct PriorMatchResult {
   bool valid = false;  // false: too few points, the prior is the answer
   std::string failure_reason;
   common::Pose2 pose;                                     // posterior mode: the scan's pose in the reference's frame
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Identity();      // posterior covariance (x, y, phi)
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Identity();      // posterior covariance (x, y, phi) about pose, given its associations
+  Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();       // what cov leaves out (step 4): (search_pose - pose)(search_pose - pose)'
   common::Pose2 search_pose;                              // the correlative search's pose
   double scan_log_likelihood = 0;                         // at search_pose
   double prior_weight = 1;                                // the prior's Gaussian share at the result (0: odometry outvoted)
