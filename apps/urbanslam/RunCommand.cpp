@@ -109,7 +109,8 @@ int runCommand(const Argv& args) {
   if (!map_file.empty()) {
     std::error_code ec;
     const auto parent = std::filesystem::path(out).parent_path();
-    if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+    if (!parent.empty() && !std::filesystem::is_directory(parent, ec) && !std::filesystem::create_directories(parent, ec))
+      throw common::InputError(out + ": cannot create the output folder (is its parent writable?)");
     slam::writeMapFile(*pipeline, map_file);
   }
   pipeline->finish(*source);
