@@ -29,7 +29,10 @@ TEST_P(SerialWorkerTest, RunsJobsInPostingOrderAndDrainWaitsForAll) {
   for (int i = 0; i < 200; ++i) EXPECT_EQ(order[static_cast<size_t>(i)], i);
   EXPECT_EQ(on_poster.load(), GetParam() ? 0 : 200);
   EXPECT_EQ(w.backlog(), 0u);
-  EXPECT_GE(w.maxBacklog(), GetParam() ? 1u : 0u);
+  if (GetParam())
+    EXPECT_GE(w.maxBacklog(), 1u);
+  else
+    EXPECT_EQ(w.maxBacklog(), 0u);  // inline: nothing ever waits
 }
 
 TEST_P(SerialWorkerTest, AFailedJobStopsTheWorkerAndReachesThePoster) {

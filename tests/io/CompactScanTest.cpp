@@ -32,7 +32,8 @@ TEST(CompactScan, RoundTripWithinHalfAStep) {
   const io::LaserScan s = makeScan(80.0, 361);
   const io::CompactScan c(s);
   float longest = 0, longest_invalid = 0;
-  for (size_t i = 0; i < s.size(); ++i) (s.valid[i] ? longest : longest_invalid) = std::max(s.valid[i] ? longest : longest_invalid, s.ranges[i]);
+  for (size_t i = 0; i < s.size(); ++i)
+    (s.valid[i] ? longest : longest_invalid) = std::max(s.valid[i] ? longest : longest_invalid, s.ranges[i]);
   EXPECT_NEAR(c.stepM(), longest / 65533.0, 1e-12);
   const io::LaserScan back = c.expand();
   ASSERT_EQ(back.size(), s.size());
@@ -52,6 +53,9 @@ TEST(CompactScan, RoundTripWithinHalfAStep) {
     else
       EXPECT_NEAR(back.ranges[i], s.ranges[i], c.stepM() / 2 + 1e-5) << "beam " << i;
   }
+  // Its valid beams are counted from the flags alone, as the expanded scan counts them.
+  EXPECT_EQ(c.validCount(), s.validCount());
+  EXPECT_EQ(c.validCount(), back.validCount());
   // Compacting the expanded scan again gives it back exactly (a map written and read back).
   const io::LaserScan again = io::CompactScan(back).expand();
   for (size_t i = 0; i < s.size(); ++i) EXPECT_EQ(again.ranges[i], back.ranges[i]) << "beam " << i;

@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <iterator>
 
 #include "TestPaths.h"
 #include "urbanslam/common/Error.h"
@@ -209,4 +211,44 @@ TEST(MapOutputs, TumValuesMustBeFiniteDecimalsInRange) {
   expectError("1 0x10 0 0 0 0 0 1", "bad.tum:3: position '0x10' is not a number");
   expectError("1 0 1e8 0 0 0 0 1", "bad.tum:3: position 1e8 is out of range");
   expectError("nan 0 0 0 0 0 0 1", "bad.tum:3: timestamp 'nan'");
+}
+
+// The clouds a run writes are streamed from its keyframes' compact scans, one scan at a time;
+// the reference is the whole cloud built from the same scans expanded, written by the writers
+// that take a cloud: the files are the same, byte for byte, and so is the count.
+TEST(MapOutputs, StreamedCloudsFromCompactScansEqualTheWholeCloud) {
+  const Excerpt e = loadExcerpt();
+  std::vector<io::CompactScan> compact;
+  std::vector<io::LaserScan> expanded;
+  for (const auto& s : e.scans) {
+    compact.emplace_back(s);
+    expanded.push_back(compact.back().expand());
+  }
+  std::vector<io::PosedScan> streamed, whole;
+  for (size_t i = 0; i < e.scans.size(); ++i) {
+    streamed.push_back({e.reference[i].pose, nullptr, &compact[i]});
+    whole.push_back({e.reference[i].pose, &expanded[i]});
+  }
+  const int decimation = 3;
+  const auto pts = io::mapPoints(whole, decimation);
+  ASSERT_GT(pts.size(), 1000u);
+  EXPECT_EQ(io::countMapPoints(streamed, decimation), pts.size());
+  const auto d = test::scratchDir("streamed_clouds");
+  const auto bytes = [](const std::filesystem::path& f) {
+    std::ifstream in(f, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  };
+  io::writePly((d / "whole.ply").string(), pts, io::PlyEncoding::BinaryLittleEndian);
+  io::writePly((d / "streamed.ply").string(), streamed, decimation, io::PlyEncoding::BinaryLittleEndian);
+  io::writePly((d / "whole_ascii.ply").string(), pts, io::PlyEncoding::Ascii);
+  io::writePly((d / "streamed_ascii.ply").string(), streamed, decimation, io::PlyEncoding::Ascii);
+  io::writePcd((d / "whole.pcd").string(), pts);
+  io::writePcd((d / "streamed.pcd").string(), streamed, decimation);
+  io::writeXyz((d / "whole.xyz").string(), pts);
+  io::writeXyz((d / "streamed.xyz").string(), streamed, decimation);
+  for (const char* ext : {".ply", "_ascii.ply", ".pcd", ".xyz"}) {
+    const std::string a = bytes(d / (std::string("whole") + ext)), b = bytes(d / (std::string("streamed") + ext));
+    EXPECT_GT(a.size(), 1000u) << ext;
+    EXPECT_TRUE(a == b) << ext << " differs";
+  }
 }

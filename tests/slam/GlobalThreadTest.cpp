@@ -24,12 +24,14 @@ struct Recorder : slam::PipelineObserver {
   void onPosesUpdated(const slam::PosesUpdatedEvent& e) override {
     std::lock_guard<std::mutex> lock(mutex);
     if (e.keyframe != static_cast<size_t>(-1)) {
+      // Corrections land in the order of the closures that brought them.
+      if (corrections > 0 && e.keyframe <= last_corrected) out_of_order = true;
+      last_corrected = e.keyframe;
       ++corrections;
-      if (e.latency_ms < 0) out_of_order = true;
     }
   }
   std::mutex mutex;
-  size_t keyframes = 0, corrections = 0;
+  size_t keyframes = 0, corrections = 0, last_corrected = 0;
   bool out_of_order = false;
 };
 

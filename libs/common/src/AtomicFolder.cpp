@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 
 #include "urbanslam/common/AtomicFile.h"
 #include "urbanslam/common/Error.h"
@@ -94,6 +95,20 @@ void AtomicFolder::commit() {
     throw InputError(path_ + ": cannot replace the earlier outputs (" + std::strerror(errno) + ")");
   }
   committed_ = true;
+}
+
+bool isReplaceableOutputFolder(const std::string& dir, const std::string& marker_file,
+                               const std::function<bool(const std::string& first_line)>& is_marker) {
+  std::error_code ec;
+  if (fs::is_empty(dir, ec) && !ec) return true;
+  std::ifstream marker(fs::path(dir) / marker_file);
+  std::string first;
+  if (marker && std::getline(marker, first) && is_marker(first)) return true;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name != ".urbanslam-write-test" && (name.empty() || name[0] != '.' || name.find(".partial-") == std::string::npos)) return false;
+  }
+  return !ec;
 }
 
 }  // namespace urbanslam::common

@@ -68,6 +68,12 @@ void CompactScan::expandInto(LaserScan& out) const {
   }
 }
 
+size_t CompactScan::validCount() const {
+  size_t n = 0;
+  for (size_t w = beams_; w < data_.size(); ++w) n += static_cast<size_t>(__builtin_popcount(data_[w]));
+  return n;
+}
+
 LaserScan CompactScan::expand() const {
   LaserScan s;
   expandInto(s);

@@ -20,25 +20,6 @@ size_t decimationStep(int decimation) { return decimation < 1 ? 1 : static_cast<
 // A cloud's points to a file in pieces: the whole cloud is one piece, a streamed map one per scan.
 using PointsSource = std::function<void(const std::function<void(const std::vector<MapPoint>&)>&)>;
 
-void writePlyBody(std::ostream& os, size_t count, PlyEncoding encoding, const PointsSource& points) {
-  const bool binary = encoding == PlyEncoding::BinaryLittleEndian;
-  os << "ply\nformat " << (binary ? "binary_little_endian" : "ascii") << " 1.0\n"
-     << "comment urbanslam map\nelement vertex " << count << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
-  points([&](const std::vector<MapPoint>& pts) {
-    if (binary) {
-      static_assert(sizeof(MapPoint) == 12, "MapPoint must be three packed floats");
-      // x86-64 is little-endian, as the header says.
-      os.write(reinterpret_cast<const char*>(pts.data()), static_cast<std::streamsize>(pts.size() * sizeof(MapPoint)));
-    } else {
-      char buf[96];
-      for (const auto& p : pts) {
-        std::snprintf(buf, sizeof buf, "%.4f %.4f %.4f\n", p.x, p.y, p.z);
-        os << buf;
-      }
-    }
-  });
-}
-
 void writeXyzLines(std::ostream& os, const PointsSource& points) {
   points([&](const std::vector<MapPoint>& pts) {
     char buf[96];
@@ -46,6 +27,21 @@ void writeXyzLines(std::ostream& os, const PointsSource& points) {
       std::snprintf(buf, sizeof buf, "%.4f %.4f %.4f\n", p.x, p.y, p.z);
       os << buf;
     }
+  });
+}
+
+void writePlyBody(std::ostream& os, size_t count, PlyEncoding encoding, const PointsSource& points) {
+  const bool binary = encoding == PlyEncoding::BinaryLittleEndian;
+  os << "ply\nformat " << (binary ? "binary_little_endian" : "ascii") << " 1.0\n"
+     << "comment urbanslam map\nelement vertex " << count << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+  if (!binary) {
+    writeXyzLines(os, points);  // ASCII PLY's vertex lines are XYZ lines
+    return;
+  }
+  points([&](const std::vector<MapPoint>& pts) {
+    static_assert(sizeof(MapPoint) == 12, "MapPoint must be three packed floats");
+    // x86-64 is little-endian, as the header says.
+    os.write(reinterpret_cast<const char*>(pts.data()), static_cast<std::streamsize>(pts.size() * sizeof(MapPoint)));
   });
 }
 
@@ -75,6 +71,8 @@ const LaserScan& PosedScan::get(LaserScan& buffer) const {
   return buffer;
 }
 
+size_t PosedScan::validCount() const { return scan ? scan->validCount() : compact ? compact->validCount() : 0; }
+
 size_t forEachMapPoint(const std::vector<PosedScan>& scans, int decimation,
                        const std::function<void(const std::vector<MapPoint>&)>& visit) {
   const size_t step = decimationStep(decimation);
@@ -96,8 +94,7 @@ size_t forEachMapPoint(const std::vector<PosedScan>& scans, int decimation,
 
 size_t countMapPoints(const std::vector<PosedScan>& scans, int decimation) {
   size_t valid = 0;
-  LaserScan buffer;
-  for (const auto& ps : scans) valid += ps.get(buffer).validCount();
+  for (const auto& ps : scans) valid += ps.validCount();
   // Points k = 0, step, 2 step, ... of the valid beams in order.
   const size_t step = decimationStep(decimation);
   return (valid + step - 1) / step;

@@ -190,7 +190,8 @@ void GlobalSlam::closeLoops(size_t current, SteadyTime handed_over) {
       break;  // one closure per keyframe; the next keyframe sees the corrected map
     }
   }
-  // 10. Full recovery after a closure (with relinearisation), then the corrected poses.
+  // 10. Recovery after a closure: the whole map (with relinearisation) when it has grown enough
+  //     since the last, else the recent poses.
   if (accepted) closureAdded(current, handed_over);
   stats_.closure_ms.push_back(sw.milliseconds());
 }

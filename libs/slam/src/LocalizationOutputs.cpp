@@ -13,24 +13,15 @@ namespace urbanslam::slam {
 
 namespace fs = std::filesystem;
 
-const char* const kLocalizationCsvHeader = "time,x,y,phi,cov_xx,cov_xy,cov_xphi,cov_yy,cov_yphi,cov_phiphi,state,matched_fraction,mahalanobis2";
+const char* const kLocalizationCsvHeader =
+    "time,x,y,phi,cov_xx,cov_xy,cov_xphi,cov_yy,cov_yphi,cov_phiphi,state,matched_fraction,mahalanobis2";
 
 namespace {
 
-// Replaced only when empty or an earlier localization's (its localization.csv says so), or what
-// an interrupted writer left (only its hidden temporaries).
+// An earlier localization's folder: its localization.csv says so.
 bool isLocalizationFolder(const std::string& dir) {
-  std::error_code ec;
-  if (fs::is_empty(dir, ec) && !ec) return true;
-  std::ifstream csv(fs::path(dir) / "localization.csv");
-  std::string first;
-  std::getline(csv, first);
-  if (first == kLocalizationCsvHeader) return true;
-  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
-    const std::string name = it->path().filename().string();
-    if (name != ".urbanslam-write-test" && (name.empty() || name[0] != '.' || name.find(".partial-") == std::string::npos)) return false;
-  }
-  return !ec;
+  return common::isReplaceableOutputFolder(dir, "localization.csv",
+                                           [](const std::string& first) { return first == kLocalizationCsvHeader; });
 }
 
 }  // namespace
@@ -101,10 +92,11 @@ common::Json writeLocalizationOutputs(const std::vector<LocalizedScan>& scans, c
       if (r.has_pose) {
         const Eigen::Matrix3d& c = r.cov;
         std::snprintf(buf, sizeof buf, "%.6f,%.6f,%.6f,%.6f,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%s,%.4f,%.4g\n", r.timestamp, r.pose.x, r.pose.y,
-                      r.pose.phi, c(0, 0), c(0, 1), c(0, 2), c(1, 1), c(1, 2), c(2, 2), stateName(r.state), r.matched_fraction, r.mahalanobis2);
-      } else {
-        std::snprintf(buf, sizeof buf, "%.6f,nan,nan,nan,nan,nan,nan,nan,nan,nan,%s,%.4f,%.4g\n", r.timestamp, stateName(r.state), r.matched_fraction,
+                      r.pose.phi, c(0, 0), c(0, 1), c(0, 2), c(1, 1), c(1, 2), c(2, 2), stateName(r.state), r.matched_fraction,
                       r.mahalanobis2);
+      } else {
+        std::snprintf(buf, sizeof buf, "%.6f,nan,nan,nan,nan,nan,nan,nan,nan,nan,%s,%.4f,%.4g\n", r.timestamp, stateName(r.state),
+                      r.matched_fraction, r.mahalanobis2);
       }
       f.stream() << buf;
     }

@@ -20,6 +20,7 @@ namespace {
 // that stops at end-of-file characters breaks the signature rather than the payload.
 constexpr char kMagic[8] = {'U', 'S', 'M', 'A', 'P', '\r', '\n', '\x1a'};
 constexpr size_t kHeaderBytes = 8 + 4 + 8 + 8;  // magic, version, payload length, checksum
+constexpr size_t kLengthOffset = 8 + 4;         // where the payload length and checksum go
 constexpr std::uint32_t kOptionsTag = common::sectionTag("OPTS");
 
 // Sections whose keys only change what is written, not what is computed.
@@ -89,7 +90,7 @@ void writeMap(const Pipeline& pipeline, std::iostream& out, const std::string& n
   header.size(length);
   header.u64(sum);
   out.clear();
-  out.seekp(12);
+  out.seekp(static_cast<std::streamoff>(kLengthOffset));
   out.write(header.bytes().data(), static_cast<std::streamsize>(header.bytes().size()));
   out.flush();
   if (!out) throw common::InputError(name + ": cannot write the map file (disk full?)");
@@ -110,16 +111,7 @@ void writeMapFile(const Pipeline& pipeline, const std::string& path) {
 }
 
 void saveMap(const Pipeline& pipeline, const std::string& path) {
-  common::removeStaleTemporaries(path);
-  const std::string tmp = common::temporaryPathFor(path);
-  try {
-    writeMapFile(pipeline, tmp);
-    std::filesystem::rename(tmp, path);
-  } catch (...) {
-    std::error_code ec;
-    std::filesystem::remove(tmp, ec);
-    throw;
-  }
+  common::writeAtomically(path, [&](const std::string& tmp) { writeMapFile(pipeline, tmp); });
 }
 
 std::string mapFilePath(const std::string& file_or_run_folder) {
@@ -146,7 +138,7 @@ std::unique_ptr<Pipeline> loadMap(const std::string& path, const PipelineOptions
   if (version != kMapFormatVersion)
     throw common::InputError(path + ": map format version " + std::to_string(version) + ", but this urbanslam reads version " +
                              std::to_string(kMapFormatVersion) + " only");
-  const std::uint64_t length = readU64(bytes, 12), checksum = readU64(bytes, 20);
+  const std::uint64_t length = readU64(bytes, kLengthOffset), checksum = readU64(bytes, kLengthOffset + 8);
   const size_t available = bytes.size() - kHeaderBytes;
   if (length > available)
     throw common::InputError(path + ": truncated map: " + std::to_string(available) + " of its " + std::to_string(length) +

@@ -105,9 +105,13 @@ void Pipeline::writeState(common::BinaryWriter& w) const {
 
 void Pipeline::waitForGlobalSlam(const io::DataSource& source) {
   common::Stopwatch sw;
-  reportingFilterFailures(source, "up to measurement " + std::to_string(stats_.measurements), [&] { global_worker_.drain(); });
-  stats_.global_backlog_max = std::max(stats_.global_backlog_max, global_worker_.maxBacklog());
+  reportingFilterFailures(source, "up to measurement " + std::to_string(stats_.measurements), [&] { drainGlobalSlam(); });
   stats_.wall_s += sw.seconds();
+}
+
+void Pipeline::drainGlobalSlam() {
+  global_worker_.drain();
+  stats_.global_backlog_max = std::max(stats_.global_backlog_max, global_worker_.maxBacklog());
 }
 
 bool Pipeline::stepOnce(io::DataSource& source) {
@@ -162,8 +166,7 @@ void Pipeline::finish() {
   common::Stopwatch sw;
   if (auto last = images_.finish()) postImage(std::move(*last));  // the last keyframe's image is final now
   global_worker_.post([this] { global_.finish(); });
-  global_worker_.drain();
-  stats_.global_backlog_max = std::max(stats_.global_backlog_max, global_worker_.maxBacklog());
+  drainGlobalSlam();
   stats_.wall_s += sw.seconds();
   stats_.keyframes = map_.size();
   for (auto* o : observers_) o->onFinished();
@@ -212,16 +215,15 @@ void Pipeline::addKeyframe(io::LaserScan scan, const std::optional<CameraMeasure
   local_.keyframeAdded(scan, c.z);
   // 4. Global SLAM, in order: the keyframe into the filter as a delayed pose, then loop closures
   //    against earlier keyframes.
-  postToGlobalSlam(
-      [this, kf = Keyframe{k, timestamp, {}, std::move(kept), false, {}}, c, handed_over = std::chrono::steady_clock::now()]() mutable {
-        const std::array<double, 9> cov = global_.addKeyframe(std::move(kf), c);
-        const Keyframe& added = map_.back();
-        if (!observers_.empty()) {
-          const io::LaserScan scan = added.scan.expand();
-          for (auto* o : observers_) o->onKeyframe({added.index, added.timestamp, added.pose, cov, &scan});
-        }
-        global_.closeLoops(added.index, handed_over);
-      });
+  // The observers get the keyframe's scan as the map keeps it: the expanded copy local SLAM used
+  // goes along rather than being expanded again there.
+  postToGlobalSlam([this, kf = Keyframe{k, timestamp, {}, std::move(kept), false, {}}, c, scan = std::move(scan),
+                    handed_over = std::chrono::steady_clock::now()]() mutable {
+    const std::array<double, 9> cov = global_.addKeyframe(std::move(kf), c);
+    const Keyframe& added = map_.back();
+    for (auto* o : observers_) o->onKeyframe({added.index, added.timestamp, added.pose, cov, &scan});
+    global_.closeLoops(added.index, handed_over);
+  });
 }
 
 }  // namespace urbanslam::slam

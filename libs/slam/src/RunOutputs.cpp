@@ -20,22 +20,9 @@ namespace {
 
 constexpr const char* kConfigHeader = "// Resolved configuration of this run";
 
-// Whether an existing folder may be replaced by a new run's outputs: it is empty or holds an
-// earlier run (its config.ini says so; extra files a bench added belong to that run). Anything
-// else may be a user's folder, and is never deleted.
+// An earlier run's folder: its config.ini says so (extra files a bench added belong to that run).
 bool isRunFolder(const std::string& dir) {
-  std::error_code ec;
-  if (fs::is_empty(dir, ec) && !ec) return true;
-  std::ifstream config(fs::path(dir) / "config.ini");
-  std::string first;
-  std::getline(config, first);
-  if (first.rfind(kConfigHeader, 0) == 0) return true;
-  // A folder an interrupted run (or a killed writer) left with only its hidden temporaries.
-  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
-    const std::string name = it->path().filename().string();
-    if (name != ".urbanslam-write-test" && (name.empty() || name[0] != '.' || name.find(".partial-") == std::string::npos)) return false;
-  }
-  return !ec;
+  return common::isReplaceableOutputFolder(dir, "config.ini", [](const std::string& first) { return first.rfind(kConfigHeader, 0) == 0; });
 }
 
 }  // namespace

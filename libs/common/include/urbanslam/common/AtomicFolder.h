@@ -28,4 +28,11 @@ class AtomicFolder {
   bool committed_ = false;
 };
 
+// Whether an existing folder may be replaced by a writer's outputs: it is empty, or its
+// `marker_file` has a first line that `is_marker` accepts (an earlier output of that writer), or
+// it holds only the hidden temporaries an interrupted writer left. Anything else may be a
+// user's folder, and is never deleted.
+bool isReplaceableOutputFolder(const std::string& dir, const std::string& marker_file,
+                               const std::function<bool(const std::string& first_line)>& is_marker);
+
 }  // namespace urbanslam::common

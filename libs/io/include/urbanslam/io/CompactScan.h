@@ -33,6 +33,8 @@ class CompactScan {
   bool empty() const { return beams_ == 0; }
   double timestamp() const { return timestamp_; }
   double stepM() const { return step_m_; }
+  // Beams flagged valid (the expanded scan's validCount(), without expanding it).
+  size_t validCount() const;
 
  private:
   double timestamp_ = 0;

@@ -25,6 +25,7 @@ struct PosedScan {
   const CompactScan* compact = nullptr;  // used when scan is null
   // The scan itself, or the compact one expanded into `buffer`.
   const LaserScan& get(LaserScan& buffer) const;
+  size_t validCount() const;  // without expanding
 };
 
 struct MapPoint {

@@ -3,7 +3,7 @@
 // delayed pose (ESDF prediction with augmentation, constant time) with local SLAM's constraint;
 // then the loop-closure candidates (near the estimate, Mahalanobis-gated), the optional laser
 // classifier, alignment, the innovation gate, confirmation by a second agreeing closure, the
-// update, and the full recovery after it. Tree of Words proposals take the same path from the
+// update, and the recovery after it. Tree of Words proposals take the same path from the
 // alignment on.
 #include <array>
 #include <chrono>

@@ -93,6 +93,8 @@ class Pipeline {
   void reportingFilterFailures(const io::DataSource& source, const std::string& where, Body&& body);
   // Hands `body` to global SLAM; a filter failure in it names the measurement being read now.
   void postToGlobalSlam(std::function<void()> body);
+  // Waits for global SLAM's queue to run dry; records the most it ever held.
+  void drainGlobalSlam();
   void writeStateNow(common::BinaryWriter& w) const;
   void onScan(io::LaserScan scan, double progress);
   // `camera_motion`: the camera's view of the motion since the previous keyframe (camera-only logs).
