@@ -14,6 +14,7 @@ inline std::string sharedDataPath(const std::string& rel) {
   return std::filesystem::exists(p) ? p : std::string();
 }
 
+// `name` must be unique to one test: ctest runs tests in parallel and this clears the folder.
 inline std::filesystem::path scratchDir(const std::string& name) {
   const auto d = std::filesystem::path(URBANSLAM_BINARY_DIR) / "test_tmp" / name;
   std::filesystem::remove_all(d);

@@ -66,7 +66,10 @@ void expectResumeEqualsWholeRun(const Case& c) {
   std::string whole_map, resumed_map;
   const auto whole = runWhole(c, o, &whole_map);
   double split_time = 0;
-  const auto resumed = runSplit(c, o, (test::scratchDir("map_resume") / "map.usmap").string(), &split_time, &resumed_map);
+  // One folder per test: ctest runs the cases in parallel, and each clears its folder.
+  const std::string test_name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  const auto map_path = test::scratchDir("map_resume_" + test_name) / "map.usmap";
+  const auto resumed = runSplit(c, o, map_path.string(), &split_time, &resumed_map);
 
   // The split is worth testing only when the second part closes loops of its own.
   ASSERT_LT(c.split, whole->stats().measurements);
