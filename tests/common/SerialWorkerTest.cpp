@@ -99,3 +99,35 @@ TEST(SerialWorker, DestructionDropsWaitingJobs) {
 
 INSTANTIATE_TEST_SUITE_P(Threads, SerialWorkerTest, ::testing::Values(false, true),
                          [](const auto& info) { return info.param ? "Threaded" : "Inline"; });
+
+TEST(SerialWorker, WaitForReturnsOnceThatJobHasRunNotTheLaterOnes) {
+  SerialWorker w(true);
+  std::atomic<bool> release{false};
+  std::atomic<int> ran{0};
+  const size_t first = w.post([&] { ++ran; });
+  const size_t second = w.post([&] {
+    while (!release) std::this_thread::yield();
+    ++ran;
+  });
+  EXPECT_EQ(second, first + 1);
+  w.waitFor(first);
+  EXPECT_GE(ran.load(), 1);
+  EXPECT_EQ(w.backlog(), 1u);  // the second still runs: waitFor did not wait for it
+  release = true;
+  w.waitFor(second);
+  EXPECT_EQ(ran.load(), 2);
+}
+
+TEST_P(SerialWorkerTest, WaitingForAJobAfterAFailedOneRethrowsInsteadOfHanging) {
+  SerialWorker w(GetParam());
+  try {
+    w.post([] { throw std::runtime_error("job 1 failed"); });
+  } catch (const std::runtime_error&) {  // inline: at once
+  }
+  size_t later = 2;
+  try {
+    later = w.post([] {});
+  } catch (const std::runtime_error&) {
+  }
+  EXPECT_THROW(w.waitFor(later), std::runtime_error);
+}

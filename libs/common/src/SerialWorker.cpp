@@ -19,24 +19,37 @@ SerialWorker::~SerialWorker() {
   thread_.join();
 }
 
-void SerialWorker::post(std::function<void()> job) {
+size_t SerialWorker::post(std::function<void()> job) {
   if (!threaded_) {
     rethrowIfFailed();
+    ++posted_;
     try {
       job();
     } catch (...) {
       failure_ = std::current_exception();
       throw;
     }
-    return;
+    ++done_;
+    return posted_;
   }
+  size_t ticket = 0;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (failure_) std::rethrow_exception(failure_);
     jobs_.push_back(std::move(job));
+    ticket = ++posted_;
     max_backlog_ = std::max(max_backlog_, jobs_.size() + running_);
   }
   wake_.notify_one();
+  return ticket;
+}
+
+void SerialWorker::waitFor(size_t ticket) {
+  if (threaded_) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    idle_.wait(lock, [&] { return done_ >= ticket || failure_; });
+  }
+  rethrowIfFailed();
 }
 
 void SerialWorker::drain() {
@@ -79,11 +92,12 @@ void SerialWorker::loop() {
     }
     lock.lock();
     running_ = 0;
+    ++done_;
     if (failed) {
       failure_ = failed;
       jobs_.clear();
     }
-    if (jobs_.empty()) idle_.notify_all();
+    idle_.notify_all();
   }
 }
 

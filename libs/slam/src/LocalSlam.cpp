@@ -91,8 +91,18 @@ void LocalSlam::keyframeAdded(const io::LaserScan& scan, const common::Pose2& z)
   motion_.reset();
 }
 
+void LocalSlam::correctSubmap(const SubmapEstimate& e) {
+  // local_poses_[i] is keyframe first + i; the estimate's poses[j] is keyframe e_first + j.
+  const size_t first = keyframes_ - local_poses_.size();
+  if (e.poses.empty() || e.keyframe < first || e.keyframe >= keyframes_) return;  // the anchor left the submap
+  const size_t e_first = e.keyframe + 1 - e.poses.size();
+  const common::Pose2 to_local = common::compose(local_poses_[e.keyframe - first], common::inverse(e.poses.back()));
+  for (size_t k = std::max(first, e_first); k < e.keyframe; ++k)
+    local_poses_[k - first] = common::compose(to_local, e.poses[k - e_first]);
+}
+
 alignment::PriorMatchResult LocalSlam::matchSubmap(const io::LaserScan& scan, const common::Pose2& z, const Eigen::Matrix3d& cov) const {
-  return submap_.match(scan, z, cov, std::vector<common::Pose2>(local_poses_.begin(), local_poses_.end()));
+  return submap_.match(scan, z, cov, submapPoses());
 }
 
 }  // namespace urbanslam::slam

@@ -78,8 +78,8 @@ void Pipeline::reportingFilterFailures(const io::DataSource& source, const std::
   }
 }
 
-void Pipeline::postToGlobalSlam(std::function<void()> body) {
-  global_worker_.post([body = std::move(body), measurement = stats_.measurements, t = stats_.last_timestamp]() mutable {
+size_t Pipeline::postToGlobalSlam(std::function<void()> body) {
+  return global_worker_.post([body = std::move(body), measurement = stats_.measurements, t = stats_.last_timestamp]() mutable {
     try {
       body();
     } catch (const esdf::NotPositiveDefinite& e) {
@@ -195,7 +195,9 @@ void Pipeline::addKeyframe(io::LaserScan scan, const std::optional<CameraMeasure
   const size_t k = local_.keyframes();
   // 1. The previous keyframe's image is final once this keyframe exists (it may be nearer in time).
   if (auto done = images_.keyframeAdded(k, scan.timestamp)) postImage(std::move(*done));
-  // 2. Local SLAM: the motion since the previous keyframe, refined by the submap match.
+  // 2. Local SLAM: the motion since the previous keyframe, refined by the submap match (the
+  //    submap as global SLAM saw it a few keyframes ago).
+  correctSubmap(k);
   KeyframeConstraint c = local_.keyframeConstraint(scan);
   if (c.match == KeyframeConstraint::Match::Used) ++stats_.scan_matches_used;
   if (c.match == KeyframeConstraint::Match::Rejected) ++stats_.scan_matches_rejected;
@@ -217,13 +219,41 @@ void Pipeline::addKeyframe(io::LaserScan scan, const std::optional<CameraMeasure
   //    against earlier keyframes.
   // The observers get the keyframe's scan as the map keeps it: the expanded copy local SLAM used
   // goes along rather than being expanded again there.
-  postToGlobalSlam([this, kf = Keyframe{k, timestamp, {}, std::move(kept), false, {}}, c, scan = std::move(scan),
-                    handed_over = std::chrono::steady_clock::now()]() mutable {
+  //    Then the submap's keyframes as global SLAM sees them, for local SLAM to take later.
+  const size_t ticket = postToGlobalSlam([this, kf = Keyframe{k, timestamp, {}, std::move(kept), false, {}}, c, scan = std::move(scan),
+                                          handed_over = std::chrono::steady_clock::now()]() mutable {
     const std::array<double, 9> cov = global_.addKeyframe(std::move(kf), c);
     const Keyframe& added = map_.back();
     for (auto* o : observers_) o->onKeyframe({added.index, added.timestamp, added.pose, cov, &scan});
     global_.closeLoops(added.index, handed_over);
+    if (options_.local.correction_lag_keyframes > 0 && options_.local.scan_matching) {
+      SubmapEstimate e{added.index, {}};
+      const size_t n = std::min(map_.size(), static_cast<size_t>(options_.local.submap_keyframes));
+      for (size_t i = map_.size() - n; i < map_.size(); ++i) e.poses.push_back(map_.keyframes()[i].pose);
+      submap_corrections_.publish(std::move(e));
+    }
   });
+  if (options_.local.correction_lag_keyframes > 0) {
+    keyframe_tickets_.emplace_back(k, ticket);
+    while (keyframe_tickets_.size() > static_cast<size_t>(options_.local.correction_lag_keyframes) + 1) keyframe_tickets_.pop_front();
+  }
+}
+
+void Pipeline::correctSubmap(size_t k) {
+  const size_t lag = static_cast<size_t>(options_.local.correction_lag_keyframes);
+  if (lag == 0 || !options_.local.scan_matching || k < lag) return;
+  const size_t j = k - lag;
+  std::optional<SubmapEstimate> e = submap_corrections_.take(j);
+  if (!e) {
+    // Global SLAM is more than the lag behind (a continued run has every estimate it needs).
+    const auto job = std::find_if(keyframe_tickets_.begin(), keyframe_tickets_.end(), [&](const auto& t) { return t.first == j; });
+    if (job == keyframe_tickets_.end()) return;
+    common::Stopwatch sw;
+    global_worker_.waitFor(job->second);
+    stats_.global_wait_s += sw.seconds();
+    e = submap_corrections_.take(j);
+  }
+  if (e) local_.correctSubmap(*e);
 }
 
 }  // namespace urbanslam::slam

@@ -36,6 +36,9 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("scan_matching", o.local.scan_matching,
         "match each scan with the local submap of the last keyframes, weighed against the odometry");
   s.add("submap_keyframes", o.local.submap_keyframes, 1, 100, "keyframes", "match against a local submap of the last this many keyframes");
+  s.add("correction_lag_keyframes", o.local.correction_lag_keyframes, 0, 100, "keyframes",
+        "the submap takes global SLAM's estimate of its keyframes (loop closures included) this many keyframes late; local SLAM waits "
+        "only when global SLAM is further behind (0: never, the submap stays in local SLAM's own frame)");
   s.add("match_every_scan", o.local.match_every_scan,
         "also match the scans between keyframes with the submap; the trajectory at odometry times follows them (the map holds keyframes "
         "only)");

@@ -174,6 +174,7 @@ void writeStats(BinaryWriter& w, const PipelineStats& s) {
   w.f64(s.first_timestamp);
   w.f64(s.last_timestamp);
   w.f64(s.wall_s);
+  w.f64(s.global_wait_s);
   writeDoubles(w, s.step_ms);
   w.size(s.step_ms_by_decade.size());
   for (const auto& d : s.step_ms_by_decade) writeDoubles(w, d);
@@ -191,6 +192,7 @@ void readStats(BinaryReader& r, PipelineStats& s) {
   s.first_timestamp = r.f64();
   s.last_timestamp = r.f64();
   s.wall_s = r.f64();
+  s.global_wait_s = r.f64();
   s.step_ms = readDoubles(r);
   s.step_ms_by_decade.resize(r.count(8));
   for (auto& d : s.step_ms_by_decade) d = readDoubles(r);
@@ -429,6 +431,27 @@ void LocalSlam::readState(BinaryReader& r) {
   last_anchor_time_ = r.f64();
 }
 
+void SubmapCorrections::writeState(BinaryWriter& w) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  w.size(published_.size());
+  for (const auto& e : published_) {
+    w.size(e.keyframe);
+    w.size(e.poses.size());
+    for (const auto& p : e.poses) writePose(w, p);
+  }
+}
+
+void SubmapCorrections::readState(BinaryReader& r) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  published_.resize(r.count(16));
+  for (auto& e : published_) {
+    e.keyframe = r.size();
+    e.poses.resize(r.count(24));
+    for (auto& p : e.poses) p = readPose(r);
+    if (e.poses.size() > e.keyframe + 1) r.fail("submap estimate of keyframe " + std::to_string(e.keyframe));
+  }
+}
+
 // --- Global SLAM ---
 
 void LoopCloser::writeState(BinaryWriter& w) const {
@@ -535,6 +558,7 @@ void Pipeline::writeStateNow(BinaryWriter& w) const {
 
   w.beginSection(kLocalTag);
   local_.writeState(w);
+  submap_corrections_.writeState(w);
   w.endSection();
 
   w.beginSection(kGlobalTag);
@@ -583,6 +607,7 @@ void Pipeline::readState(BinaryReader& r) {
   {
     BinaryReader s = r.section(kLocalTag);
     local_.readState(s);
+    submap_corrections_.readState(s);
     s.expectEnd();
   }
   {

@@ -174,6 +174,7 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   t["global_latency_ms_p50"] = common::percentile(s.global_latency_ms, 50);
   t["global_latency_ms_p99"] = common::percentile(s.global_latency_ms, 99);
   t["global_backlog_max"] = s.global_backlog_max;
+  t["global_wait_s"] = s.global_wait_s;
   t["outputs_s"] = sw.seconds();
   t["peak_rss_mb"] = static_cast<double>(common::peakResidentBytes()) / (1024.0 * 1024.0);
   if (grid.size() > 0) j["grid"] = grid;

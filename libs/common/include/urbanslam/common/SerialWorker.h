@@ -23,9 +23,12 @@ class SerialWorker {
   SerialWorker& operator=(const SerialWorker&) = delete;
 
   bool threaded() const { return threaded_; }
-  void post(std::function<void()> job);
+  // Returns the job's ticket, for waitFor().
+  size_t post(std::function<void()> job);
   // Waits until every posted job has run.
   void drain();
+  // Waits until the job with this ticket (and so every job before it) has run.
+  void waitFor(size_t ticket);
   void rethrowIfFailed();
   // Jobs posted and not finished yet, and the most there ever were.
   size_t backlog() const;
@@ -37,9 +40,10 @@ class SerialWorker {
   const bool threaded_;
   mutable std::mutex mutex_;
   std::condition_variable wake_;  // a job or the stop for the thread
-  std::condition_variable idle_;  // the queue ran dry, for drain()
+  std::condition_variable idle_;  // a job finished, for drain() and waitFor()
   std::deque<std::function<void()>> jobs_;
   size_t running_ = 0;
+  size_t posted_ = 0, done_ = 0;  // jobs posted and run: a job's ticket is posted_ after its post
   size_t max_backlog_ = 0;
   bool stop_ = false;
   std::exception_ptr failure_;

@@ -14,6 +14,7 @@
 #include "urbanslam/slam/Map.h"
 #include "urbanslam/slam/MotionIntegrator.h"
 #include "urbanslam/slam/PipelineOptions.h"
+#include "urbanslam/slam/SubmapCorrections.h"
 
 namespace urbanslam::slam {
 
@@ -47,6 +48,14 @@ class LocalSlam {
   // `scan` became the newest keyframe, `z` the constraint from the previous one that global SLAM
   // took: the scan joins the submap, and the motion starts again there.
   void keyframeAdded(const io::LaserScan& scan, const common::Pose2& z);
+  // Global SLAM's estimate of the submap's keyframes up to `e.keyframe`: their geometry replaces
+  // the chain's there, anchored at that keyframe (so the chain's frame does not move, and the
+  // keyframes after it keep their constraints).
+  void correctSubmap(const SubmapEstimate& e);
+
+  // The submap keyframes' poses in local SLAM's frame, oldest first; the newest is keyframe
+  // keyframes() - 1.
+  std::vector<common::Pose2> submapPoses() const { return {local_poses_.begin(), local_poses_.end()}; }
 
   // Motion, submap and keyframe decision state (PipelineState.cpp).
   void writeState(common::BinaryWriter& w) const;
@@ -61,8 +70,9 @@ class LocalSlam {
   MotionIntegrator motion_;
   LocalSubmap submap_;
   // The submap keyframes' poses in local SLAM's own frame: the chain of the constraints it
-  // handed on. Global corrections never reach local matching (as in Cartographer), so local
-  // SLAM's results do not depend on when global SLAM finishes its work.
+  // handed on, corrected by global SLAM's estimates at a fixed lag (correctSubmap), never by
+  // whatever global SLAM holds at the moment: local SLAM's results do not depend on when global
+  // SLAM finishes its work.
   std::deque<common::Pose2> local_poses_;
   bool have_scan_keyframe_ = false;  // camera-only logs make a keyframe of every image until a scan comes
   size_t keyframes_ = 0;

@@ -9,6 +9,7 @@
 // holds up the sensors), else inline. Local SLAM never reads what global SLAM estimates, so both
 // give the same map. Until runInput() or finish() returns, the map is global SLAM's: read it
 // through observers.
+#include <deque>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -92,7 +93,11 @@ class Pipeline {
   template <typename Body>
   void reportingFilterFailures(const io::DataSource& source, const std::string& where, Body&& body);
   // Hands `body` to global SLAM; a filter failure in it names the measurement being read now.
-  void postToGlobalSlam(std::function<void()> body);
+  // Returns the job's ticket (SerialWorker::waitFor).
+  size_t postToGlobalSlam(std::function<void()> body);
+  // Local SLAM takes global SLAM's estimate of the submap as it stood after keyframe
+  // k - [local] correction_lag_keyframes, waiting for it if global SLAM is not that far yet.
+  void correctSubmap(size_t k);
   // Waits for global SLAM's queue to run dry; records the most it ever held.
   void drainGlobalSlam();
   void writeStateNow(common::BinaryWriter& w) const;
@@ -132,6 +137,8 @@ class Pipeline {
   std::vector<size_t> image_keyframes_;                        // image database id -> keyframe
   std::vector<ImageCamera> image_cameras_;                     // image database id -> its camera
   KeyframeImageAssigner images_;
+  SubmapCorrections submap_corrections_;
+  std::deque<std::pair<size_t, size_t>> keyframe_tickets_;  // keyframe -> its global SLAM job's ticket
   bool have_first_ts_ = false;
   bool finished_ = false;
   // Last: it stops before what its jobs use goes away. Mutable: reading the state waits for it.

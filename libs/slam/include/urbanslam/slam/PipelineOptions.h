@@ -43,6 +43,9 @@ struct MotionOptions {
 struct LocalOptions {
   bool scan_matching = true;
   int submap_keyframes = 5;  // the scan is matched against the last this many keyframes
+  // The submap takes global SLAM's estimate of its keyframes this many keyframes late (0:
+  // never; SubmapCorrections.h).
+  int correction_lag_keyframes = 1;
   // The scans between keyframes are matched with the submap too, and the trajectory at odometry
   // times follows them (the filter and the map still hold keyframes only).
   bool match_every_scan = true;

@@ -25,6 +25,9 @@ struct PipelineStats {
   // accepted closure (global SLAM's queue included when it runs on its own thread).
   std::vector<double> global_latency_ms;
   size_t global_backlog_max = 0;  // most keyframes and images waiting for global SLAM at once
+  // Local SLAM waited this long for global SLAM's estimate of the submap ([local]
+  // correction_lag_keyframes): global SLAM was further behind than the lag.
+  double global_wait_s = 0;
 };
 
 }  // namespace urbanslam::slam
