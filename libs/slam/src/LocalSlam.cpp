@@ -97,8 +97,20 @@ void LocalSlam::correctSubmap(const SubmapEstimate& e) {
   if (e.poses.empty() || e.keyframe < first || e.keyframe >= keyframes_) return;  // the anchor left the submap
   const size_t e_first = e.keyframe + 1 - e.poses.size();
   const common::Pose2 to_local = common::compose(local_poses_[e.keyframe - first], common::inverse(e.poses.back()));
-  for (size_t k = std::max(first, e_first); k < e.keyframe; ++k)
-    local_poses_[k - first] = common::compose(to_local, e.poses[k - e_first]);
+  std::vector<std::pair<size_t, common::Pose2>> moved;
+  double most_m = 0;  // the farthest a submap point moves: the offset plus the turn at the grid's reach
+  for (size_t k = std::max(first, e_first); k < e.keyframe; ++k) {
+    const common::Pose2 p = common::compose(to_local, e.poses[k - e_first]);
+    const common::Pose2& old = local_poses_[k - first];
+    most_m = std::max(most_m, std::hypot(p.x - old.x, p.y - old.y) + options_.grid_radius_m * std::abs(common::wrapToPi(p.phi - old.phi)));
+    moved.emplace_back(k - first, p);
+  }
+  // Between closures global SLAM's estimate is local SLAM's chain, up to rounding: a correction
+  // that moves nothing by a micrometre would only cost a new likelihood grid. (Skipping larger
+  // ones is not free: on Victoria Park, skipping those under a quarter of a grid cell took the
+  // ATE from 12.9 m to 19.1 m.)
+  if (most_m <= 1e-6) return;
+  for (const auto& [i, p] : moved) local_poses_[i] = p;
 }
 
 alignment::PriorMatchResult LocalSlam::matchSubmap(const io::LaserScan& scan, const common::Pose2& z, const Eigen::Matrix3d& cov) const {

@@ -177,15 +177,19 @@ void Pipeline::onScan(io::LaserScan scan, double progress) {
   if (!input_.accepts(scan.label)) return;
   ++stats_.scans_used;
   input_.limitRanges(scan);
+  // Local SLAM's own time: waiting for global SLAM's submap estimate is counted apart
+  // (timing.global_wait_s), or a batch run, which always catches up with global SLAM, would
+  // report global SLAM's time as the front end's.
+  const double waited_before_ms = stats_.global_wait_s * 1e3;
   if (local_.isKeyframe()) {
     common::Stopwatch kw;
     addKeyframe(std::move(scan));
-    stats_.keyframe_ms.push_back(kw.milliseconds());
+    stats_.keyframe_ms.push_back(kw.milliseconds() - (stats_.global_wait_s * 1e3 - waited_before_ms));
   } else if (const auto anchor = local_.placeScan(scan)) {
     ++stats_.scans_anchored;
     map_.addAnchor(*anchor);
   }
-  const double ms = sw.milliseconds();
+  const double ms = sw.milliseconds() - (stats_.global_wait_s * 1e3 - waited_before_ms);
   stats_.recordStep(ms, local_.keyframes());
   StepEvent ev{stats_.scans_used, local_.keyframes(), stats_.last_timestamp, ms, progress};
   for (auto* o : observers_) o->onStep(ev);
