@@ -14,7 +14,7 @@
 namespace urbanslam::slam {
 
 constexpr const char* kMapFileName = "map.usmap";
-constexpr std::uint32_t kMapFormatVersion = 2;
+constexpr std::uint32_t kMapFormatVersion = 3;
 
 // The map of the pipeline's current state written to `out` from its start, streamed (the
 // stream is read back for the checksum); `name` for errors. Call it before finish() (after
