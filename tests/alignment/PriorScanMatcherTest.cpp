@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <random>
 
 #include "SyntheticScan.h"
@@ -110,6 +111,68 @@ TEST(CorrelativeSearch, BranchAndBoundFindsTheExhaustiveOptimum) {
   EXPECT_LE(floored.nodes, r.nodes);
   window.min_score = best + 0.01;
   EXPECT_TRUE(correlativeSearch(grid, pts, prior, window).below_min_score);
+}
+
+// A place search's window: no prior (flat), every heading, and a reach past the grid's edge, so
+// that blocks inside the grid and blocks partly outside it are both scored; whole, and trimmed on
+// some sides (a neighbouring window covers those). The answer is the best scan score over every
+// pose of the lattice the window keeps, and the prior adds the same constant to every pose.
+TEST(CorrelativeSearch, AFlatPriorFindsTheBestScanScoreOverEveryHeading) {
+  const test::World world = test::roomWorld();
+  const PointSet ref = scanPoints(world, {0, 0, 0});
+  const PointSet cur = scanPoints(world, {0.3, 0.2, 2.0}, 9);
+  std::vector<Eigen::Vector2d> pts;
+  for (size_t i = 0; i < cur.size(); i += 8) pts.push_back(cur[i].p);
+  const MotionPrior prior({0.2, 0.1, 0.0}, Eigen::Vector3d(1e8, 1e8, 1e8).asDiagonal(), 0.0, 1.0);
+  struct Case {
+    double radius;               // the grid's
+    std::array<double, 4> trim;  // -x, +x, -y, +y
+  };
+  for (const Case& c :
+       {Case{40.0, {0, 0, 0, 0}}, Case{6.0, {0, 0, 0, 0}}, Case{40.0, {0.4, 0.0, 0.0, 0.7}}, Case{40.0, {0.0, 0.5, 0.3, 0.0}}}) {
+    SCOPED_TRACE(::testing::Message() << "radius " << c.radius << " trim " << c.trim[0] << " " << c.trim[1] << " " << c.trim[2] << " "
+                                      << c.trim[3]);
+    LikelihoodGridOptions go;
+    go.resolution_m = 0.1;
+    go.hit_sigma_m = 0.1;
+    go.max_radius_m = c.radius;
+    const LikelihoodGrid grid(ref, Eigen::Vector2d::Zero(), go);
+    CorrelativeWindow window;
+    window.half_width_m = 1.0;
+    window.half_angle_rad = M_PI;
+    window.flat_prior = true;
+    window.trim_m = c.trim;
+    const CorrelativeResult r = correlativeSearch(grid, pts, prior, window);
+    std::vector<double> ranges;
+    for (const auto& p : pts) ranges.push_back(p.norm());
+    std::sort(ranges.begin(), ranges.end());
+    const double far = std::max(grid.resolution(), ranges[static_cast<size_t>(0.5 * static_cast<double>(ranges.size() - 1))]);
+    const double step = std::acos(1.0 - grid.resolution() * grid.resolution() / (2 * far * far));
+    const int k = static_cast<int>(std::ceil(window.half_angle_rad / step)),
+              w = static_cast<int>(std::ceil(window.half_width_m / grid.resolution()));
+    const auto cells = [&](double trim) { return static_cast<int>(std::lround(trim / grid.resolution())); };
+    double best = -1e300;
+    common::Pose2 best_pose;
+    for (int a = -k; a <= k; ++a)
+      for (int i = -w + cells(c.trim[0]); i <= w - cells(c.trim[1]); ++i)
+        for (int j = -w + cells(c.trim[2]); j <= w - cells(c.trim[3]); ++j) {
+          const common::Pose2 x{0.2 + i * grid.resolution(), 0.1 + j * grid.resolution(), a * step};
+          const Eigen::Matrix2d R = Eigen::Rotation2Dd(x.phi).toRotationMatrix();
+          double s = 0;
+          for (const auto& p : pts) s += grid.score(R * p + Eigen::Vector2d(x.x, x.y));
+          if (s > best) best = s, best_pose = x;
+        }
+    EXPECT_NEAR(r.scan_score, best, 1e-3);
+    EXPECT_NEAR(r.score - r.scan_score, prior.logDensity(0.0), 1e-9);
+    EXPECT_NEAR(r.pose.x, best_pose.x, 1e-9);
+    EXPECT_NEAR(r.pose.y, best_pose.y, 1e-9);
+    EXPECT_NEAR(common::wrapToPi(r.pose.phi - best_pose.phi), 0.0, 1e-9);
+    // The scan was taken at (0.3, 0.2, 2.0), inside every window here: the search finds it,
+    // heading included.
+    EXPECT_NEAR(r.pose.x, 0.3, 0.15);
+    EXPECT_NEAR(r.pose.y, 0.2, 0.15);
+    EXPECT_NEAR(common::wrapToPi(r.pose.phi - 2.0), 0.0, 0.05);
+  }
 }
 
 // The scan taken at `truth` (in the reference scan's frame), matched from a prior at `odometry`.

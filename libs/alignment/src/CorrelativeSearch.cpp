@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 
 namespace urbanslam::alignment {
 
@@ -18,7 +20,8 @@ struct Node {
 class Search {
  public:
   Search(const LikelihoodGrid& grid, const std::vector<Eigen::Vector2d>& points, const MotionPrior& prior, const CorrelativeWindow& w)
-      : grid_(grid), prior_(prior), r_(grid.resolution()), min_score_(w.min_score) {
+      : grid_(grid), prior_(prior), r_(grid.resolution()), min_score_(w.min_score), flat_prior_(w.flat_prior) {
+    if (flat_prior_) flat_log_density_ = prior.logDensity(0.0);
     // A heading step that moves a typical point by one cell (Hess et al. 2016, eq. 7 takes the
     // farthest), "typical" being the median range: half the points then move by at most a cell
     // between neighbouring headings, the rest by a few, which the refinement absorbs. Outdoors
@@ -36,21 +39,38 @@ class Search {
     step_ = std::acos(std::max(-1.0, 1.0 - r_ * r_ / (2.0 * far * far)));
     const int k = static_cast<int>(std::ceil(w.half_angle_rad / step_));
     half_cells_ = std::max(0, static_cast<int>(std::ceil(w.half_width_m / r_)));
+    const auto trimmed = [&](double trim_m) {
+      return half_cells_ - std::clamp(static_cast<int>(std::lround(trim_m / r_)), 0, half_cells_);
+    };
+    lo_x_ = -trimmed(w.trim_m[0]);
+    hi_x_ = trimmed(w.trim_m[1]);
+    lo_y_ = -trimmed(w.trim_m[2]);
+    hi_y_ = trimmed(w.trim_m[3]);
     const Eigen::Vector2d t(prior.mean().x, prior.mean().y);
+    const int64_t width = grid.levelWidth(0), pad = grid.pad();
     for (int a = -k; a <= k; ++a) {
       const double dphi = a * step_, phi = prior.mean().phi + dphi;
       const Eigen::Matrix2d R = Eigen::Rotation2Dd(phi).toRotationMatrix();
-      std::vector<Eigen::Vector2i> cells;
-      cells.reserve(points.size());
-      for (const auto& p : points) cells.push_back(grid.cellOf(R * p + t));
+      Heading h;
+      h.cells.reserve(points.size());
+      h.linear.reserve(points.size());
+      for (const auto& p : points) {
+        const Eigen::Vector2i c = grid.cellOf(R * p + t);
+        h.cells.push_back(c);
+        h.linear.push_back((c.y() + pad) * width + c.x() + pad);
+        h.min_x = std::min(h.min_x, c.x());
+        h.max_x = std::max(h.max_x, c.x());
+        h.min_y = std::min(h.min_y, c.y());
+        h.max_y = std::max(h.max_y, c.y());
+      }
       dphi_.push_back(dphi);
-      cells_.push_back(std::move(cells));
+      headings_.push_back(std::move(h));
     }
   }
 
   CorrelativeResult run() {
     int top = 0;
-    while (top < grid_.levels() && (1 << top) < 2 * half_cells_ + 1) ++top;
+    while (top < grid_.levels() && (1 << top) < std::max(hi_x_ - lo_x_, hi_y_ - lo_y_) + 1) ++top;
     // The prior's mean is scored first: the bound to beat, and the odometry wins ties.
     const int centre = static_cast<int>(dphi_.size() / 2);
     best_ = {centre, 0, 0, score(0, centre, 0, 0)};
@@ -60,14 +80,14 @@ class Search {
     std::vector<Node> roots;
     const int s = 1 << top;
     for (int a = 0; a < static_cast<int>(dphi_.size()); ++a)
-      for (int ox = -half_cells_; ox <= half_cells_; ox += s)
-        for (int oy = -half_cells_; oy <= half_cells_; oy += s) roots.push_back({a, ox, oy, score(top, a, ox, oy)});
+      for (int ox = lo_x_; ox <= hi_x_; ox += s)
+        for (int oy = lo_y_; oy <= hi_y_; oy += s) roots.push_back({a, ox, oy, score(top, a, ox, oy)});
     branch(std::move(roots), top);
     CorrelativeResult out;
     out.pose = {prior_.mean().x + best_.ox * r_, prior_.mean().y + best_.oy * r_,
                 common::wrapToPi(prior_.mean().phi + dphi_[static_cast<size_t>(best_.angle)])};
     out.score = best_.score;
-    out.scan_score = best_.score - prior_.logDensity(out.pose);
+    out.scan_score = best_.score - (flat_prior_ ? flat_log_density_ : prior_.logDensity(out.pose));
     out.nodes = nodes_;
     out.below_min_score = below_min_;
     return out;
@@ -76,21 +96,37 @@ class Search {
  private:
   double score(int level, int a, int ox, int oy) {
     ++nodes_;
+    const Heading& hd = headings_[static_cast<size_t>(a)];
     const float* values = grid_.levelData(level);
     const int w = grid_.levelWidth(level), h = grid_.levelHeight(level), pad = grid_.pad();
-    const float floor = grid_.floorValue();
-    const int shift = LikelihoodGrid::shiftOf(level);
+    const int shift = grid_.shiftOf(level);
     double sum = 0;
-    for (const auto& c : cells_[static_cast<size_t>(a)]) {
-      const int i = c.x() + ox + pad, j = c.y() + oy + pad;
-      if (i < 0 || j < 0) {
-        sum += floor;
-        continue;
+    // Every point of the block's lowest corner inside the level's array (the block's other
+    // poses are in its values): no per-point checks, and at full resolution one addition per
+    // point. Most blocks of a search are such.
+    const bool inside = !hd.cells.empty() && hd.min_x + ox + pad >= 0 && hd.min_y + oy + pad >= 0 && ((hd.max_x + ox + pad) >> shift) < w &&
+                        ((hd.max_y + oy + pad) >> shift) < h;
+    if (inside && shift == 0) {
+      const int64_t offset = static_cast<int64_t>(oy) * w + ox;
+      for (const int64_t i : hd.linear) sum += values[i + offset];
+    } else if (inside) {
+      for (const auto& c : hd.cells)
+        sum += values[static_cast<size_t>((c.y() + oy + pad) >> shift) * static_cast<size_t>(w) +
+                      static_cast<size_t>((c.x() + ox + pad) >> shift)];
+    } else {
+      const float floor = grid_.floorValue();
+      for (const auto& c : hd.cells) {
+        const int i = c.x() + ox + pad, j = c.y() + oy + pad;
+        if (i < 0 || j < 0) {
+          sum += floor;
+          continue;
+        }
+        const int ia = i >> shift, ja = j >> shift;
+        sum += (ia >= w || ja >= h) ? floor : values[static_cast<size_t>(ja) * static_cast<size_t>(w) + static_cast<size_t>(ia)];
       }
-      const int ia = i >> shift, ja = j >> shift;
-      sum += (ia >= w || ja >= h) ? floor : values[static_cast<size_t>(ja) * static_cast<size_t>(w) + static_cast<size_t>(ia)];
     }
-    const int last = std::min(half_cells_, ox + (1 << level) - 1), last_y = std::min(half_cells_, oy + (1 << level) - 1);
+    if (flat_prior_) return sum + flat_log_density_;
+    const int last = std::min(hi_x_, ox + (1 << level) - 1), last_y = std::min(hi_y_, oy + (1 << level) - 1);
     const double m2 = prior_.minMahalanobis2(ox * r_, last * r_, oy * r_, last_y * r_, dphi_[static_cast<size_t>(a)]);
     return sum + prior_.logDensity(m2);
   }
@@ -115,7 +151,7 @@ class Search {
     int count = 0;
     for (int dx : {0, s})
       for (int dy : {0, s})
-        if (n.ox + dx <= half_cells_ && n.oy + dy <= half_cells_)
+        if (n.ox + dx <= hi_x_ && n.oy + dy <= hi_y_)
           children[static_cast<size_t>(count++)] = {n.angle, n.ox + dx, n.oy + dy, score(level - 1, n.angle, n.ox + dx, n.oy + dy)};
     for (int k = 1; k < count; ++k)  // best first (insertion sort of at most four)
       for (int m = k; m > 0 && children[static_cast<size_t>(m)].score > children[static_cast<size_t>(m - 1)].score; --m)
@@ -131,13 +167,24 @@ class Search {
     }
   }
 
+  // The scan's cells at one heading with the prior's mean as the translation, their linear
+  // indices in the full-resolution levels, and their bounding box.
+  struct Heading {
+    std::vector<Eigen::Vector2i> cells;
+    std::vector<int64_t> linear;
+    int min_x = std::numeric_limits<int>::max(), max_x = std::numeric_limits<int>::min();
+    int min_y = std::numeric_limits<int>::max(), max_y = std::numeric_limits<int>::min();
+  };
   const LikelihoodGrid& grid_;
   const MotionPrior& prior_;
   double r_, step_ = 0;
   double min_score_;
+  bool flat_prior_ = false;
+  double flat_log_density_ = 0;
   int half_cells_ = 0, nodes_ = 0;
+  int lo_x_ = 0, hi_x_ = 0, lo_y_ = 0, hi_y_ = 0;  // the translations searched [cells]
   std::vector<double> dphi_;
-  std::vector<std::vector<Eigen::Vector2i>> cells_;
+  std::vector<Heading> headings_;
   Node best_{0, 0, 0, 0};
   bool below_min_ = false;
 };

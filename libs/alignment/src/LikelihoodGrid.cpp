@@ -6,7 +6,7 @@
 namespace urbanslam::alignment {
 
 LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d& centre, const LikelihoodGridOptions& o)
-    : resolution_(o.resolution_m), floor_(static_cast<float>(std::log(o.miss_floor))) {
+    : resolution_(o.resolution_m), full_levels_(std::max(0, o.full_resolution_levels)), floor_(static_cast<float>(std::log(o.miss_floor))) {
   const double reach = 3.0 * o.hit_sigma_m;  // beyond 3σ a hit adds nothing to the floor
   Eigen::Vector2d lo = centre, hi = centre;
   bool any = false;
@@ -53,12 +53,12 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
   // Level h from level h-1 by doubling: the block of 2^h starting at (i, j) is four blocks of
   // 2^(h-1) starting at (i, j), (i+s, j), (i, j+s), (i+s, j+s).
   dims_.push_back({width_, height_});
-  // Levels 1 .. kFullLevels at full resolution: the exact largest value of the block of 2^h
+  // Levels 1 .. full_levels_ at full resolution: the exact largest value of the block of 2^h
   // cells starting at each cell (rows first, then columns, in loops the compiler vectorises;
   // a block reaching past the edge sees the floor there). Most of a search's blocks are scored
   // at these levels, where an exact bound prunes most.
   const size_t w_ = static_cast<size_t>(width_), h_ = static_cast<size_t>(height_);
-  for (int k = 1; k <= std::min(levels, kFullLevels); ++k) {
+  for (int k = 1; k <= std::min(levels, full_levels_); ++k) {
     const size_t step = static_cast<size_t>(1) << (k - 1);
     const Cells& prev = level_.back();
     Cells rows(prev.size()), next(prev.size());  // every cell written below
@@ -103,7 +103,7 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
     src = &block_max;
     bw = nw;
     bh = nh;
-    if (k <= kFullLevels) continue;
+    if (k <= full_levels_) continue;
     Cells dilated(block_max.size());  // every cell written below
     for (int b = 0; b < bh; ++b)
       for (int a = 0; a < bw; ++a)

@@ -206,7 +206,7 @@ PriorMatchResult matchWithPrior(const MatchReference& reference, const PointSet&
   out.matched = matched;
   out.rms_residual_m = matched > 0 ? std::sqrt(sum_d2 / matched) : 0.0;
   out.odometry_outvoted = out.prior_weight < 0.5;
-  if (scan_beams.valid()) {
+  if (scan_beams.valid() && o.count_free_space) {
     std::tie(out.in_view, out.seen_through) = freeSpace(x);
     const double d = o.displacement_m, a = o.displacement_deg * M_PI / 180;
     for (const common::Pose2& delta :

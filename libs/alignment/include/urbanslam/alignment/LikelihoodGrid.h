@@ -27,6 +27,9 @@ struct LikelihoodGridOptions {
   double miss_floor = 0.05;    // κ: the density of an unexplained return relative to a hit's peak
   double max_radius_m = 40.0;  // cells farther than this from the centre (along x or y) are left out
   int levels = 5;              // pyramid levels above the base (blocks of 2^levels cells; wider windows get more root blocks)
+  // Levels 1 .. this stored at full resolution (exact block maxima, a tighter bound), the ones
+  // above at 1/2^h of it (a looser bound for a quarter of the memory and less).
+  int full_resolution_levels = 2;
 };
 
 class LikelihoodGrid {
@@ -42,10 +45,9 @@ class LikelihoodGrid {
     return {static_cast<int>(std::floor((p.x() - origin_.x()) / resolution_)),
             static_cast<int>(std::floor((p.y() - origin_.y()) / resolution_))};
   }
-  // Levels up to kFullLevels are stored at full resolution (exact block maxima); higher ones at
-  // 1/2^h of it (a looser bound).
-  static constexpr int kFullLevels = 2;
-  static int shiftOf(int level) { return level <= kFullLevels ? 0 : level; }
+  // Levels up to options' full_resolution_levels are stored at full resolution (exact block
+  // maxima); higher ones at 1/2^h of it (a looser bound).
+  int shiftOf(int level) const { return level <= full_levels_ ? 0 : level; }
   // Level 0: the cell's value; level h: a bound on the largest value in the block of 2^h x 2^h
   // cells whose lowest corner is (i, j). The floor outside the grid.
   float value(int level, int i, int j) const {
@@ -70,6 +72,7 @@ class LikelihoodGrid {
 
  private:
   double resolution_;
+  int full_levels_ = 2;
   Eigen::Vector2d origin_;  // corner of cell (0, 0)
   int pad_ = 0;             // cells before cell 0 on each axis (blocks that start outside)
   int width_ = 0, height_ = 0;

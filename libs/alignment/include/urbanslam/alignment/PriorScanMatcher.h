@@ -59,6 +59,9 @@ struct PriorMatcherOptions {
   double seen_through_rate_displaced = 0.3;
   double displacement_m = 0.5;
   double displacement_deg = 10;
+  // The result's free-space counts (in_view, seen_through and their displaced sums) are taken;
+  // false leaves them 0 (a caller that needs them from only some matches saves their cost).
+  bool count_free_space = true;
   double free_margin_m = 0.3;  // seen empty up to this + free_margin_fraction * range before a return
   double free_margin_fraction = 0.05;
   double point_sigma_m = 0.05;   // a return's distance to the reference surface (refinement)

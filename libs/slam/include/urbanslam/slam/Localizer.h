@@ -46,8 +46,9 @@ struct LocalizerOptions {
   TrackingMonitorOptions monitor;
   double min_matched_fraction = 0.5;  // a tracking match must explain this share of the scan's points
   // A match's posterior covariance times covariance_scale (the map's [local] one: successive
-  // matches against the same map points have correlated errors), with these floors: the map's
-  // keyframes disagree with each other by about this much, which no single match sees.
+  // matches against the same map points have correlated errors), with these floors (the map's
+  // keyframes disagree with each other by about this much, which no single match sees), plus
+  // the match's search-refinement spread (PriorMatchResult::spread), as local SLAM takes it.
   double covariance_scale = 4.0;
   double min_sigma_xy_m = 0.02;
   double min_sigma_deg = 0.5;
@@ -69,6 +70,11 @@ struct LocalizerOptions {
   int confirm_matches = 10;
   double continuity_probability = 0.999;
   double continuity_sigma_scale = 2.0;
+  // The seen-through rates the matcher weighs free space with are learnt from one tracking match
+  // per this much log time: successive scans see the same walls from nearly the same pose, so
+  // counting every one adds little but cost (the counts at the result and four displaced poses
+  // against every keyframe of the tile were more than half of Intel's tracking time).
+  double free_space_sample_interval_s = 1.0;
   // When the monitor declares the pose lost, the last matches disagreed with the prediction: the
   // pose is uncertain by at least this much, whatever the matcher's covariance said.
   double lost_sigma_xy_m = 0.5;
@@ -90,14 +96,15 @@ struct LocalizedScan {
   bool matched = false;      // the scan's match explained it (tracking)
   bool relocalised = false;  // a place search found the pose at this scan
   double matched_fraction = 0;
-  double mahalanobis2 = 0;  // the match's correction of the prediction, d' P⁻¹ d
+  double mahalanobis2 = 0;  // the match's correction of the prediction, d' P⁻¹ d (P: the prediction's covariance plus the floors)
 };
 
 struct LocalizerStats {
   size_t measurements = 0, scans = 0, scans_used = 0, odometry = 0;
   size_t tracking = 0, lost = 0, matches_failed = 0;
   size_t place_searches = 0, relocalisations = 0, lost_events = 0;
-  size_t fixes_rejected = 0;  // place-search fixes the confirmed dead-reckoned pose ruled out
+  size_t fixes_rejected = 0;        // place-search fixes the confirmed dead-reckoned pose ruled out
+  size_t place_search_windows = 0;  // windows searched by branch and bound, over all place searches
   double first_timestamp = 0, last_timestamp = 0;
   double lost_s = 0;        // log time spent lost
   double first_fix_s = -1;  // log time from the first scan to the first tracked one (-1: never)
@@ -140,6 +147,8 @@ class Localizer {
   TrackingMonitor monitor_;
   alignment::PriorMatcherOptions matcher_;
   alignment::SeenThroughRate seen_through_{0.05}, seen_through_displaced_{0.3};
+  bool have_free_space_sample_ = false;
+  double last_free_space_sample_ = 0;
 
   LocalizationState state_ = LocalizationState::Lost;
   bool have_pose_ = false;

@@ -23,7 +23,7 @@ struct MapAreaOptions {
   double keyframe_reach_m = 20.0;           // a tile's reference holds the keyframes this close to the tile (their scans reach into it)
   double keyframe_spacing_m = 0.5;          // revisits thinned: one keyframe per cell this wide and heading quadrant
   size_t cached_tiles = 6;                  // tracking references kept (a few tens of MB each)
-  size_t cached_coarse_tiles = 64;          // coarse grids kept (about 1 MB each)
+  size_t cached_coarse_tiles = 64;          // coarse grids kept (a few MB each)
   alignment::PriorMatcherOptions matcher;   // the tracking references' grid and search (grid radius set from the tile)
   alignment::LikelihoodGridOptions coarse;  // the place-recognition grids (radius set from the tile)
   alignment::ScanModelOptions scan_model;   // the keyframes' points, as local SLAM made them

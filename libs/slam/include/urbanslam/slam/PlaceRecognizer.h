@@ -24,7 +24,7 @@ namespace urbanslam::slam {
 
 struct PlaceRecognitionOptions {
   double candidate_spacing_m = 2.0;  // one search window per keyframe cell this wide ...
-  double window_overlap_m = 0.75;    // ... reaching this far beyond the cell
+  double window_overlap_m = 0.75;    // ... reaching this far into a neighbouring cell that has no window of its own
   double voxel_m = 0.3;              // the scan thinned to one point per voxel for the search
   double max_range_m = 25.0;         // farther returns left out of the search (the grids reach about this far)
   int min_points = 20;               // fewer thinned points: too little to recognise a place
