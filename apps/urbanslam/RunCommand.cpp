@@ -76,6 +76,10 @@ int runCommand(const Argv& args) {
     options = slam::loadPipelineOptions(ini, &resolved);
     slam::resolveDefaultPaths(options, projectHome());
   }
+  // The progress observer outlives the pipeline: global SLAM's thread may still call it while an
+  // error from reading the log unwinds this function.
+  common::ProgressBar bar("run", 1000, !quiet);
+  ProgressObserver progress(bar);
   std::unique_ptr<slam::Pipeline> pipeline =
       map.empty() ? std::make_unique<slam::Pipeline>(options) : slam::loadMap(map, ini.empty() ? nullptr : &options);
   if (ini.empty()) {
@@ -86,8 +90,6 @@ int runCommand(const Argv& args) {
   // The simulator is a data source like a file reader: a drive of any length streams through.
   std::unique_ptr<io::DataSource> source =
       ap.has("simulate") ? std::make_unique<sim::SimulatedSource>(sim::loadSimOptions(log)) : io::openDataSource(log);
-  common::ProgressBar bar("run", 1000, !quiet);
-  ProgressObserver progress(bar);
   pipeline->addObserver(&progress);
   pipeline->runInput(*source);
   // The map is saved before finish(): finish() drops the closures still awaiting confirmation,

@@ -80,8 +80,8 @@ int main(int argc, char** argv) {
     slam::resolveDefaultPaths(options, URBANSLAM_SOURCE_DIR);
     std::unique_ptr<io::DataSource> source =
         city.empty() ? io::openDataSource(log) : std::make_unique<sim::SimulatedSource>(sim::loadSimOptions(city));
+    StepRecorder rec;  // outlives the pipeline, whose global SLAM thread calls it
     slam::Pipeline pipeline(options);
-    StepRecorder rec;
     pipeline.addObserver(&rec);
     const double cpu0 = cpuSeconds();
     pipeline.run(*source);

@@ -20,8 +20,8 @@ gui::MapSnapshot runExcerpt(slam::LoopClosureOptions::ImageDetector image_detect
   slam::PipelineOptions o;
   o.loop_closure.image_detector = image_detector;
   o.image_loop.vocabulary = test::repoPath("share/vision_loop/sift_k10_L4.usvoc");
+  gui::SnapshotCollector c;  // outlives the pipeline
   slam::Pipeline p(o);
-  gui::SnapshotCollector c;
   p.addObserver(&c);
   auto src = io::openDataSource(test::repoPath("rawlogs/rtabmap-loop-excerpt"));
   p.run(*src);
@@ -81,8 +81,8 @@ TEST(CameraView, WithoutTheDetectorFramesButNoMatch) {
 TEST(CameraView, SnapshotsShareImageBuffers) {
   slam::PipelineOptions o;  // the default pipeline: Tree of Words on, with the shipped vocabulary
   o.image_loop.vocabulary = test::repoPath("share/vision_loop/sift_k10_L4.usvoc");
+  gui::SnapshotCollector c;  // outlives the pipeline
   slam::Pipeline p(o);
-  gui::SnapshotCollector c;
   p.addObserver(&c);
   auto src = io::openDataSource(test::repoPath("rawlogs/rtabmap-loop-excerpt"));
   for (int i = 0; i < 4; ++i) p.step(*src);

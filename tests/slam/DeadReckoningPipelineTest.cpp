@@ -40,8 +40,8 @@ TEST(DeadReckoningPipeline, KeyframesSitAtTheOdometryOfTheirTime) {
   o.local.scan_matching = false;
   o.keyframes.min_translation_m = 0.3;
   o.keyframes.min_rotation_deg = 15;
+  CountingObserver obs;  // outlives the pipeline
   slam::Pipeline p(o);
-  CountingObserver obs;
   p.addObserver(&obs);
   auto src = io::openDataSource(kExcerpt);
   p.run(*src);

@@ -36,9 +36,9 @@ struct Recorder : slam::PipelineObserver {
 };
 
 struct PipelineRun {
+  Recorder recorder;  // outlives the pipeline, whose global SLAM thread calls it
   std::unique_ptr<slam::Pipeline> pipeline;
   std::string state;  // the map file's bytes before finish()
-  Recorder recorder;
 };
 
 void run(const std::string& log, bool threaded, PipelineRun& r) {

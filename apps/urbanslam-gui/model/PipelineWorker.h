@@ -50,8 +50,9 @@ class PipelineWorker {
 
   std::string log_path_, ini_path_, resolved_ini_, format_, default_laser_model_;
   std::unique_ptr<io::DataSource> source_;
-  std::unique_ptr<slam::Pipeline> pipeline_;
+  // Before the pipeline: global SLAM's thread calls the collector until the pipeline is gone.
   SnapshotCollector collector_;
+  std::unique_ptr<slam::Pipeline> pipeline_;
 
   mutable std::mutex mutex_;  // guards the pipeline and the control flags below
   std::condition_variable wake_;

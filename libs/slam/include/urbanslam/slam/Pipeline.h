@@ -39,6 +39,8 @@ class Pipeline {
   explicit Pipeline(PipelineOptions options);
   ~Pipeline();
 
+  // The observer must outlive the pipeline: global SLAM's thread may call it until the pipeline
+  // is destroyed (after an error in the reading thread, too).
   void addObserver(PipelineObserver* observer);
   // An appearance test for loop-closure candidates (the laser classifier); without one every
   // candidate goes to alignment and gating.
