@@ -18,6 +18,16 @@
 namespace urbanslam::alignment {
 namespace {
 
+// The heading step the search takes (CorrelativeSearch.cpp): one that moves the median point by
+// one cell. The exhaustive references enumerate the same headings.
+double searchHeadingStep(const LikelihoodGrid& grid, const std::vector<Eigen::Vector2d>& pts) {
+  std::vector<double> ranges;
+  for (const auto& p : pts) ranges.push_back(p.norm());
+  std::sort(ranges.begin(), ranges.end());
+  const double far = std::max(grid.resolution(), ranges[static_cast<size_t>(0.5 * static_cast<double>(ranges.size() - 1))]);
+  return std::acos(1.0 - grid.resolution() * grid.resolution() / (2 * far * far));
+}
+
 Eigen::Matrix3d correlatedCov() {
   Eigen::Matrix3d c;
   c << 0.04, 0.015, 0.004, 0.015, 0.02, -0.002, 0.004, -0.002, 0.01;
@@ -75,11 +85,7 @@ TEST(CorrelativeSearch, BranchAndBoundFindsTheExhaustiveOptimum) {
   window.half_angle_rad = 0.25;
   const CorrelativeResult r = correlativeSearch(grid, pts, prior, window);
   // The same score over every pose of the same lattice.
-  std::vector<double> ranges;
-  for (const auto& p : pts) ranges.push_back(p.norm());
-  std::sort(ranges.begin(), ranges.end());
-  const double far = std::max(grid.resolution(), ranges[static_cast<size_t>(0.5 * static_cast<double>(ranges.size() - 1))]);
-  const double step = std::acos(1.0 - grid.resolution() * grid.resolution() / (2 * far * far));
+  const double step = searchHeadingStep(grid, pts);
   const int k = static_cast<int>(std::ceil(window.half_angle_rad / step)),
             w = static_cast<int>(std::ceil(window.half_width_m / grid.resolution()));
   double best = -1e300;
@@ -143,11 +149,7 @@ TEST(CorrelativeSearch, AFlatPriorFindsTheBestScanScoreOverEveryHeading) {
     window.flat_prior = true;
     window.trim_m = c.trim;
     const CorrelativeResult r = correlativeSearch(grid, pts, prior, window);
-    std::vector<double> ranges;
-    for (const auto& p : pts) ranges.push_back(p.norm());
-    std::sort(ranges.begin(), ranges.end());
-    const double far = std::max(grid.resolution(), ranges[static_cast<size_t>(0.5 * static_cast<double>(ranges.size() - 1))]);
-    const double step = std::acos(1.0 - grid.resolution() * grid.resolution() / (2 * far * far));
+    const double step = searchHeadingStep(grid, pts);
     const int k = static_cast<int>(std::ceil(window.half_angle_rad / step)),
               w = static_cast<int>(std::ceil(window.half_width_m / grid.resolution()));
     const auto cells = [&](double trim) { return static_cast<int>(std::lround(trim / grid.resolution())); };
