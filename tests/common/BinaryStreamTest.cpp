@@ -111,6 +111,23 @@ TEST(BinaryStream, RefusesReadsPastTheEndAndImpossibleCounts) {
     BinaryReader r(b.data(), b.size(), "x.bin");
     EXPECT_THROW(r.dense(), InputError);
   }
+  {  // no values to bound its width by: refused at once, not walked column by column
+    BinaryWriter d;
+    d.size(0);
+    d.size(1ull << 60);
+    const std::string b = d.bytes();
+    BinaryReader r(b.data(), b.size(), "x.bin");
+    EXPECT_THROW(r.dense(), InputError);
+  }
+  {  // an empty matrix of modest sizes is still a matrix
+    BinaryWriter d;
+    d.dense(Eigen::MatrixXd(0, 3));
+    const std::string b = d.bytes();
+    BinaryReader r(b.data(), b.size(), "x.bin");
+    const Eigen::MatrixXd m = r.dense();
+    EXPECT_EQ(m.rows(), 0);
+    EXPECT_EQ(m.cols(), 3);
+  }
   {
     const std::string two = std::string("\x02", 1);
     BinaryReader r(two.data(), two.size(), "x.bin");

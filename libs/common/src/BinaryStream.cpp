@@ -148,9 +148,13 @@ void BinaryReader::raw(void* out, size_t n) {
 
 Eigen::MatrixXd BinaryReader::dense() {
   const size_t rows = size(), cols = size();
-  if (rows != 0 && cols > remaining() / 8 / rows)
+  // An empty matrix reads no values, so the bytes left bound neither of its sizes: a cap does
+  // (a 0 x 2^60 matrix from a file took minutes to walk its empty columns).
+  constexpr size_t kMaxSide = size_t{1} << 31;
+  if (rows > kMaxSide || cols > kMaxSide || (rows != 0 && cols > remaining() / 8 / rows))
     fail("a " + std::to_string(rows) + " x " + std::to_string(cols) + " matrix in the bytes left");
   Eigen::MatrixXd m(static_cast<Eigen::Index>(rows), static_cast<Eigen::Index>(cols));
+  if (m.size() == 0) return m;
   for (Eigen::Index c = 0; c < m.cols(); ++c)
     for (Eigen::Index r = 0; r < m.rows(); ++r) m(r, c) = f64();
   return m;
