@@ -180,16 +180,17 @@ void Pipeline::onScan(io::LaserScan scan, double progress) {
   // Local SLAM's own time: waiting for global SLAM's submap estimate is counted apart
   // (timing.global_wait_s), or a batch run, which always catches up with global SLAM, would
   // report global SLAM's time as the front end's.
-  const double waited_before_ms = stats_.global_wait_s * 1e3;
+  const double waited_before_s = stats_.global_wait_s;
+  const auto waitedMs = [&] { return (stats_.global_wait_s - waited_before_s) * 1e3; };
   if (local_.isKeyframe()) {
     common::Stopwatch kw;
     addKeyframe(std::move(scan));
-    stats_.keyframe_ms.push_back(kw.milliseconds() - (stats_.global_wait_s * 1e3 - waited_before_ms));
+    stats_.keyframe_ms.push_back(kw.milliseconds() - waitedMs());
   } else if (const auto anchor = local_.placeScan(scan)) {
     ++stats_.scans_anchored;
     map_.addAnchor(*anchor);
   }
-  const double ms = sw.milliseconds() - (stats_.global_wait_s * 1e3 - waited_before_ms);
+  const double ms = sw.milliseconds() - waitedMs();
   stats_.recordStep(ms, local_.keyframes());
   StepEvent ev{stats_.scans_used, local_.keyframes(), stats_.last_timestamp, ms, progress};
   for (auto* o : observers_) o->onStep(ev);
@@ -230,14 +231,14 @@ void Pipeline::addKeyframe(io::LaserScan scan, const std::optional<CameraMeasure
     const Keyframe& added = map_.back();
     for (auto* o : observers_) o->onKeyframe({added.index, added.timestamp, added.pose, cov, &scan});
     global_.closeLoops(added.index, handed_over);
-    if (options_.local.correction_lag_keyframes > 0 && options_.local.scan_matching) {
+    if (takesSubmapCorrections()) {
       SubmapEstimate e{added.index, {}};
       const size_t n = std::min(map_.size(), static_cast<size_t>(options_.local.submap_keyframes));
       for (size_t i = map_.size() - n; i < map_.size(); ++i) e.poses.push_back(map_.keyframes()[i].pose);
       submap_corrections_.publish(std::move(e));
     }
   });
-  if (options_.local.correction_lag_keyframes > 0) {
+  if (takesSubmapCorrections()) {
     keyframe_tickets_.emplace_back(k, ticket);
     while (keyframe_tickets_.size() > static_cast<size_t>(options_.local.correction_lag_keyframes) + 1) keyframe_tickets_.pop_front();
   }
@@ -245,7 +246,7 @@ void Pipeline::addKeyframe(io::LaserScan scan, const std::optional<CameraMeasure
 
 void Pipeline::correctSubmap(size_t k) {
   const size_t lag = static_cast<size_t>(options_.local.correction_lag_keyframes);
-  if (lag == 0 || !options_.local.scan_matching || k < lag) return;
+  if (!takesSubmapCorrections() || k < lag) return;
   const size_t j = k - lag;
   std::optional<SubmapEstimate> e = submap_corrections_.take(j);
   if (!e) {

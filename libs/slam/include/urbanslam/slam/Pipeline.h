@@ -100,6 +100,8 @@ class Pipeline {
   // Local SLAM takes global SLAM's estimate of the submap as it stood after keyframe
   // k - [local] correction_lag_keyframes, waiting for it if global SLAM is not that far yet.
   void correctSubmap(size_t k);
+  // Local SLAM has a submap to correct and a lag to correct it at.
+  bool takesSubmapCorrections() const { return options_.local.correction_lag_keyframes > 0 && options_.local.scan_matching; }
   // Waits for global SLAM's queue to run dry; records the most it ever held.
   void drainGlobalSlam();
   void writeStateNow(common::BinaryWriter& w) const;
