@@ -8,6 +8,7 @@
 #include "urbanslam/alignment/FreeSpace.h"
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/esdf/PoseOps.h"
+#include "urbanslam/slam/KeyframeGrid.h"
 #include "urbanslam/slam/LoopCloser.h"
 #include "urbanslam/slam/Pipeline.h"
 
@@ -124,4 +125,88 @@ TEST(LoopCloser, CorridorSlideConflictsWithFreeSpace) {
   // aliased minimum, which matches more points: this pair cannot be closed correctly from these
   // two scans alone, so it must not be closed at all.)
   EXPECT_LT(alignment::mutualFreeSpaceConflict(p.keyframes[0].scan.expand(), p.keyframes[1].scan.expand(), p.truth), 0.05);
+}
+
+namespace {
+
+// A straight street driven twice: keyframes 0..n-1 one metre apart along x, then the current
+// keyframe n at (x_now, 0), placed by a chain whose every link has `link_sigma_m`. The scans are
+// all the same (the test's scorer, not the scans, says which keyframes look alike).
+struct Street {
+  std::vector<slam::Keyframe> keyframes;
+  slam::KeyframeGrid grid{2.0};
+  std::unique_ptr<esdf::Esdf> filter = std::make_unique<esdf::Esdf>();
+};
+
+Street street(size_t n, double x_now, double link_sigma_m) {
+  io::LaserScan scan;
+  scan.angle_min_rad = -M_PI / 2;
+  scan.angle_increment_rad = M_PI / 180;
+  scan.max_range_m = 80;
+  scan.ranges.assign(181, 10.0f);
+  scan.valid.assign(181, 1);
+  Street s;
+  s.filter->initialise(esdf::Vec3::Zero(), esdf::Mat3::Identity() * 1e-9);
+  const esdf::Mat3 cov = esdf::Vec3(link_sigma_m * link_sigma_m, link_sigma_m * link_sigma_m, 1e-6).asDiagonal();
+  for (size_t i = 0; i <= n; ++i) {
+    const common::Pose2 pose{i < n ? static_cast<double>(i) : x_now, 0, 0};
+    if (i > 0) s.filter->augmentRelative(static_cast<int>(i - 1), esdf::toVec(common::between(s.keyframes.back().pose, pose)), cov.inverse());
+    s.keyframes.push_back({i, static_cast<double>(i), pose, io::CompactScan(scan), false, {}});
+    s.grid.insert(i, pose.x, pose.y);
+  }
+  s.filter->recover();
+  return s;
+}
+
+}  // namespace
+
+// While the estimate is good the keyframes nearest to it are the candidates, whatever a scorer
+// says; once its 3 sigma reaches beyond search_radius_m the classifier's detections among every
+// keyframe within reach come first, best first and one per place, then the nearest ones.
+TEST(LoopCloser, AppearancePicksTheCandidatesWhenThePoseIsTooUncertain) {
+  slam::LoopClosureOptions o;  // search_radius_m 4, min_keyframe_gap 30, laser_threshold 0
+  const size_t n = 200;
+  const double x_now = 100;  // the estimate is at keyframe 100; keyframe 108 looks like it
+  const auto scorer = [](size_t earlier, size_t) {
+    if (earlier == 108) return 2.0;   // the best
+    if (earlier == 109) return 1.9;   // the same place
+    if (earlier == 93) return 0.5;    // another place, a weaker detection
+    if (earlier == 101) return -0.1;  // below the decision threshold
+    return -1.0;
+  };
+
+  {  // 0.01 m per link: 3 sigma ~ 0.3 m (after 200 links ~0.14 m sigma): the estimate picks.
+    Street s = street(n, x_now, 0.01);
+    slam::LoopCloser closer(o);
+    closer.setScorer(scorer);
+    const auto c = closer.candidates(*s.filter, s.keyframes, s.grid, n);
+    ASSERT_FALSE(c.empty());
+    EXPECT_EQ(c.front().keyframe, 100u);
+    EXPECT_FALSE(c.front().detection.has_value());
+    for (const auto& k : c) EXPECT_FALSE(k.detection.has_value()) << k.keyframe;
+  }
+  {  // 0.3 m per link: sigma ~4 m, 3 sigma far beyond 4 m: appearance picks (reach ~17 m).
+    Street s = street(n, x_now, 0.3);
+    slam::LoopCloser closer(o);
+    closer.setScorer(scorer);
+    const auto c = closer.candidates(*s.filter, s.keyframes, s.grid, n);
+    ASSERT_GE(c.size(), 3u);  // 108 (109 is the same place), then 93; 101 is no detection
+    EXPECT_EQ(c[0].keyframe, 108u);
+    ASSERT_TRUE(c[0].detection.has_value());
+    EXPECT_EQ(c[0].detection->detector, "laser");
+    EXPECT_DOUBLE_EQ(c[0].detection->score, 2.0);
+    EXPECT_EQ(c[1].keyframe, 93u);
+    ASSERT_TRUE(c[1].detection.has_value());
+    // Then the keyframes nearest the estimate, as without a classifier.
+    EXPECT_EQ(c[2].keyframe, 100u);
+    EXPECT_FALSE(c[2].detection.has_value());
+    for (size_t k = 2; k < c.size(); ++k) EXPECT_FALSE(c[k].detection.has_value()) << c[k].keyframe;
+
+    // Without a classifier the same uncertain estimate keeps the nearest keyframes.
+    slam::LoopCloser plain(o);
+    const auto p = plain.candidates(*s.filter, s.keyframes, s.grid, n);
+    ASSERT_FALSE(p.empty());
+    EXPECT_EQ(p.front().keyframe, 100u);
+    EXPECT_FALSE(p.front().detection.has_value());
+  }
 }

@@ -18,16 +18,14 @@ constexpr double kDeg = M_PI / 180.0;
 GlobalSlam::GlobalSlam(const PipelineOptions& options, Map& map, PipelineStats& stats, const std::vector<PipelineObserver*>& observers)
     : options_(options), map_(map), stats_(stats), observers_(observers), closer_(options.loop_closure) {
   if (options_.loop_closure.enabled && options_.loop_closure.detector == LoopClosureOptions::Detector::Laser) {
-    // The AdaBoost classifier screens candidates before the (costlier) alignment. Its score is
-    // the margin above the model's decision factor (eq. 3.30), so laser_threshold = 0 is the
-    // model's own operating point.
+    // The AdaBoost classifier picks the candidates where the estimate is too uncertain to. Its
+    // score is the margin above the model's decision factor (eq. 3.30), so laser_threshold = 0
+    // is the model's own operating point.
     const std::string model = options_.loop_closure.laser_model.empty() ? laser_loop::kDefaultModelPath : options_.loop_closure.laser_model;
     laser_detector_ = std::make_unique<laser_loop::LoopDetector>(laser_loop::LoopDetector::fromFile(model));
-    closer_.setScorer(
-        [this](size_t earlier, size_t current) {
-          return laser_detector_->score(laser_detector_->keyframe(current), earlier) - laser_detector_->factor();
-        },
-        "laser");
+    closer_.setScorer([this](size_t earlier, size_t current) {
+      return laser_detector_->score(laser_detector_->keyframe(current), earlier) - laser_detector_->factor();
+    });
   }
 }
 
@@ -172,20 +170,24 @@ void GlobalSlam::closeLoops(size_t current, SteadyTime handed_over) {
     return;
   common::Stopwatch sw;
   expirePending(current);
-  // 6. Candidates: initial set near the estimate, final set by Mahalanobis distance (keyframes
-  // with scans only: alignment needs both).
-  std::vector<size_t> cands;
+  // 6. Candidates: initial set near the estimate, final set by Mahalanobis distance, picked by
+  // appearance when the estimate is too uncertain (keyframes with scans only: alignment needs
+  // both).
+  std::vector<Candidate> cands;
   if (map_.keyframes()[current].hasScan()) cands = closer_.candidates(*map_.filter(), map_.keyframes(), map_.index(), current);
-  cands.erase(std::remove_if(cands.begin(), cands.end(), [&](size_t i) { return !map_.keyframes()[i].hasScan(); }), cands.end());
   if (cands.size() > static_cast<size_t>(options_.loop_closure.max_candidates))
     cands.resize(static_cast<size_t>(options_.loop_closure.max_candidates));
-  for (auto* o : observers_) o->onCandidates({current, &cands});
+  std::vector<size_t> keyframes;
+  for (const Candidate& c : cands) keyframes.push_back(c.keyframe);
+  for (auto* o : observers_) o->onCandidates({current, &keyframes});
   const bool confirm = options_.loop_closure.confirm_window > 0;
   bool accepted = false;
-  for (size_t i : cands) {
-    // 7-9. Detection, alignment and gating (the update itself waits for a confirmation).
+  for (const Candidate& c : cands) {
+    // 7-9. Alignment and gating (the update itself waits for a confirmation).
     ++stats_.closures_tried;
-    if (admit(closer_.tryClose(*map_.filter(), map_.keyframes(), i, current, !confirm), current) == Admission::Accepted) {
+    const Detection* detection = c.detection ? &*c.detection : nullptr;
+    if (admit(closer_.tryClose(*map_.filter(), map_.keyframes(), c.keyframe, current, !confirm, detection), current) ==
+        Admission::Accepted) {
       accepted = true;
       break;  // one closure per keyframe; the next keyframe sees the corrected map
     }

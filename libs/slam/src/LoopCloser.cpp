@@ -24,8 +24,6 @@ const char* reasonName(ClosureReason reason) {
   switch (reason) {
     case ClosureReason::None:
       return "";
-    case ClosureReason::Classifier:
-      return "classifier";
     case ClosureReason::Alignment:
       return "alignment";
     case ClosureReason::Ambiguous:
@@ -51,10 +49,7 @@ const char* reasonName(ClosureReason reason) {
 LoopCloser::LoopCloser(const LoopClosureOptions& options)
     : options_(options), chi2_2dof_(esdf::chi2Quantile(options.mahalanobis_probability, 2)) {}
 
-void LoopCloser::setScorer(CandidateScorer scorer, std::string name) {
-  scorer_ = std::move(scorer);
-  detector_ = std::move(name);
-}
+void LoopCloser::setScorer(CandidateScorer scorer) { scorer_ = std::move(scorer); }
 
 // Covariance of the relative pose ⊖x_i ⊕ x_k from the (conservative) joint covariance. Kept for
 // the current keyframe: the candidate search computes it, the alignment choice reuses it.
@@ -74,8 +69,8 @@ Eigen::Matrix3d LoopCloser::relativeCovariance(esdf::Esdf& filter, size_t i, siz
   return s;
 }
 
-std::vector<size_t> LoopCloser::candidates(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, const KeyframeGrid& grid,
-                                           size_t current) {
+std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, const KeyframeGrid& grid,
+                                              size_t current) {
   const auto& cur = keyframes[current];
   if (current < static_cast<size_t>(options_.min_keyframe_gap)) return {};
   const size_t newest_allowed = current - static_cast<size_t>(options_.min_keyframe_gap);
@@ -88,27 +83,52 @@ std::vector<size_t> LoopCloser::candidates(esdf::Esdf& filter, const std::vector
   grid.query(cur.pose.x, cur.pose.y, radius, near);
   std::vector<std::pair<double, size_t>> initial;
   for (size_t i : near) {
-    if (i > newest_allowed) continue;
+    if (i > newest_allowed || !keyframes[i].hasScan()) continue;
     const double d = std::hypot(keyframes[i].pose.x - cur.pose.x, keyframes[i].pose.y - cur.pose.y);
     if (d <= radius) initial.emplace_back(d, i);
   }
+  // Bound the covariance work per keyframe: 30 keyframes go on to the Mahalanobis test.
+  constexpr size_t kFinalTests = 30;
+  std::vector<Candidate> picked;
   std::sort(initial.begin(), initial.end());
-  if (initial.size() > 30) initial.resize(30);  // bound the covariance work per keyframe
+  if (scorer_ && 3 * sigma > options_.search_radius_m && cur.hasScan()) {
+    // Appearance: every keyframe within reach is scored (a classifier vote costs ~0.2 us), the
+    // detections best first, one per place so that an aliased place cannot take every slot.
+    std::vector<std::pair<double, size_t>> scored;
+    for (const auto& [d, i] : initial)
+      if (const double score = scorer_(i, current); score >= options_.laser_threshold) scored.emplace_back(score, i);
+    std::sort(scored.begin(), scored.end(), [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second < b.second); });
+    for (const auto& [score, i] : scored) {
+      if (picked.size() == kFinalTests) break;
+      const bool same_place = std::any_of(picked.begin(), picked.end(), [&](const Candidate& p) {
+        return std::hypot(keyframes[i].pose.x - keyframes[p.keyframe].pose.x, keyframes[i].pose.y - keyframes[p.keyframe].pose.y) <
+               options_.search_radius_m;
+      });
+      if (!same_place) picked.push_back({i, Detection{"laser", score}});
+    }
+  }
+  // The keyframes nearest the estimate: the candidates, or after the detections the rest.
+  for (const auto& [d, i] : initial) {
+    if (picked.size() == kFinalTests) break;
+    if (std::none_of(picked.begin(), picked.end(), [&](const Candidate& p) { return p.keyframe == i; })) picked.push_back({i, std::nullopt});
+  }
   // Final set: could the two poses be within the sensor's overlap distance, given their joint
   // uncertainty? d^2 = t' (J Σ J' + (R/2)^2 I)^-1 t for the relative position t.
-  std::vector<std::pair<double, size_t>> final_set;
+  std::vector<std::pair<double, Candidate>> final_set;
   const double r2 = 0.25 * options_.search_radius_m * options_.search_radius_m;
-  for (const auto& [d, i] : initial) {
+  for (size_t n = 0; n < picked.size(); ++n) {
+    const size_t i = picked[n].keyframe;
     const esdf::Vec3 xi = filter.mean(static_cast<int>(i)), xk = filter.mean(static_cast<int>(current));
     const Eigen::Matrix3d s = relativeCovariance(filter, i, current);
     const Eigen::Matrix2d st = s.topLeftCorner<2, 2>() + r2 * Eigen::Matrix2d::Identity();
     const Eigen::Vector2d t = esdf::between(xi, xk).head<2>();
     const double d2 = t.dot(st.inverse() * t);
-    if (d2 <= chi2_2dof_) final_set.emplace_back(d2, i);
+    // Detections keep their order (best score first), before the others (nearest first).
+    if (d2 <= chi2_2dof_) final_set.emplace_back(picked[n].detection ? static_cast<double>(n) - 1e9 : d2, picked[n]);
   }
-  std::sort(final_set.begin(), final_set.end());
-  std::vector<size_t> out;
-  for (const auto& [d2, i] : final_set) out.push_back(i);
+  std::stable_sort(final_set.begin(), final_set.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<Candidate> out;
+  for (auto& [key, cand] : final_set) out.push_back(std::move(cand));
   return out;
 }
 
@@ -142,17 +162,8 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
   r.to = current;
   r.from_time = keyframes[earlier].timestamp;
   r.to_time = keyframes[current].timestamp;
-  r.detector = detection ? detection->detector : detector_;
-  // Detection: the appearance test, when a detector is configured (a proposal comes with its own).
-  if (detection) {
-    r.score = detection->score;
-  } else if (scorer_) {
-    r.score = scorer_(earlier, current);
-    if (r.score < options_.laser_threshold) {
-      r.reason = ClosureReason::Classifier;
-      return r;
-    }
-  }
+  r.detector = detection ? detection->detector : "pose";
+  if (detection) r.score = detection->score;
   // Alignment from the current estimate of the relative pose.
   const esdf::Vec3 xi = filter.mean(static_cast<int>(earlier)), xk = filter.mean(static_cast<int>(current));
   r.prior_sigma_m = largestPositionSigma(relativeCovariance(filter, earlier, current));
@@ -185,7 +196,7 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
   r.measurement = a.transform;
   r.rms_m = a.rms_residual_m;
   const double matched = a.matchedFraction();
-  if (!scorer_ && !detection) r.score = matched;
+  if (!detection) r.score = matched;
   if (!good(a)) {
     r.reason = ClosureReason::Alignment;
     return r;

@@ -57,10 +57,6 @@ void PipelineStats::recordStep(double ms, size_t keyframes) {
 
 void Pipeline::addObserver(PipelineObserver* observer) { observers_.push_back(observer); }
 
-void Pipeline::setCandidateScorer(CandidateScorer scorer, std::string name) {
-  global_.setCandidateScorer(std::move(scorer), std::move(name));
-}
-
 template <typename Body>
 void Pipeline::reportingFilterFailures(const io::DataSource& source, const std::string& where, Body&& body) {
   // Values that are each in range can still be too extreme together for the filter's

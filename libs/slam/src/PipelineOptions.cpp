@@ -71,9 +71,9 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("enabled", o.loop_closure.enabled, "search for loop closures");
   s.add<LoopClosureOptions::Detector>("detector", o.loop_closure.detector,
                                       {{"none", LoopClosureOptions::Detector::None}, {"laser", LoopClosureOptions::Detector::Laser}},
-                                      "none: alignment + gating verify every candidate; laser: AdaBoost classifier first");
+                                      "candidates where the pose is too uncertain to pick them (3 sigma beyond search_radius_m); none: the nearest to the estimate; laser: the AdaBoost classifier's detections among every keyframe within reach");
   s.add("laser_model", o.loop_closure.laser_model, {}, "laser classifier model; empty: share/laser_loop/default.model");
-  s.add("laser_threshold", o.loop_closure.laser_threshold, -100.0, 100.0, "", "classifier decision offset (higher: fewer false alarms)");
+  s.add("laser_threshold", o.loop_closure.laser_threshold, -100.0, 100.0, "", "classifier decision offset (higher: fewer false alarms): a keyframe scoring below is not a candidate");
   s.add<LoopClosureOptions::ImageDetector>(
       "image_detector", o.loop_closure.image_detector,
       {{"none", LoopClosureOptions::ImageDetector::None}, {"tree_of_words", LoopClosureOptions::ImageDetector::TreeOfWords}},

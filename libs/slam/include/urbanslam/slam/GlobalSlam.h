@@ -1,8 +1,8 @@
 #pragma once
 // Global SLAM (thesis ch. 5): the one place that changes the filter. A new keyframe enters as a
 // delayed pose (ESDF prediction with augmentation, constant time) with local SLAM's constraint;
-// then the loop-closure candidates (near the estimate, Mahalanobis-gated), the optional laser
-// classifier, alignment, the innovation gate, confirmation by a second agreeing closure, the
+// then the loop-closure candidates (near the estimate, Mahalanobis-gated; picked by the laser
+// classifier where the estimate is too uncertain), alignment, the innovation gate, confirmation by a second agreeing closure, the
 // update, and the recovery after it. Tree of Words proposals take the same path from the
 // alignment on.
 #include <array>
@@ -35,7 +35,6 @@ class GlobalSlam {
   GlobalSlam(const PipelineOptions& options, Map& map, PipelineStats& stats, const std::vector<PipelineObserver*>& observers);
   ~GlobalSlam();
 
-  void setCandidateScorer(CandidateScorer scorer, std::string name) { closer_.setScorer(std::move(scorer), std::move(name)); }
   // The keyframe joins the map with the constraint from the previous one. Returns its marginal
   // covariance (row-major; zero without a filter or for the first keyframe).
   std::array<double, 9> addKeyframe(Keyframe kf, const KeyframeConstraint& constraint);

@@ -1,10 +1,12 @@
 #pragma once
 // Global SLAM (thesis ch. 5): for a new keyframe, the loop-closure candidates — an initial set of
 // earlier keyframes near the current estimate, a final set by Mahalanobis distance with the
-// recovered covariances (§5.2) — then detection, alignment for the relative pose and its
+// recovered covariances (§5.2), picked by appearance (the laser classifier, §3.2) when the
+// estimate is too uncertain to pick them — then alignment for the relative pose and its
 // covariance (§5.3) and the innovation gate (§5.4) before the ESDF update.
 #include <Eigen/Core>
 #include <functional>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -23,7 +25,6 @@ struct Keyframe;
 // Why a loop-closure hypothesis did not become a constraint.
 enum class ClosureReason {
   None,                 // accepted (or not decided yet)
-  Classifier,           // the laser classifier's score was below its threshold
   Alignment,            // the scans could not be aligned well enough
   Ambiguous,            // another alignment explains the scans about as well
   FreeSpace,            // one scan's points lie where the other scan's beams passed through
@@ -52,27 +53,38 @@ struct LoopClosureRecord {
   double prior_sigma_m = 0;        // largest std. deviation of the relative position before the closure
 };
 
-// Optional appearance test of a candidate pair before alignment (the laser classifier).
-// Returns the score; the pair proceeds when score >= threshold.
+// Appearance similarity of a pair of keyframes (the laser classifier's margin above its
+// decision factor: >= 0 is a detection).
 using CandidateScorer = std::function<double(size_t earlier, size_t current)>;
 
-// A pair already proposed by a detector outside the loop closer (Tree of Words): it skips the
-// scorer and goes straight to alignment and gating.
+// Who proposed a pair, and with what score: the laser classifier among the keyframes within
+// reach, or a detector outside the loop closer (Tree of Words). Pairs proposed by the estimate
+// alone ("pose") carry none; their score is the alignment's matched fraction.
 struct Detection {
   std::string detector;
   double score = 0;
+};
+
+// A pair to align: the earlier keyframe, and its detection when appearance proposed it.
+struct Candidate {
+  size_t keyframe = 0;
+  std::optional<Detection> detection;
 };
 
 class LoopCloser {
  public:
   explicit LoopCloser(const LoopClosureOptions& options);
 
-  void setScorer(CandidateScorer scorer, std::string name);
+  // With a scorer, appearance picks the candidates when the estimate is too uncertain to.
+  void setScorer(CandidateScorer scorer);
 
-  // The final candidate set for keyframe `current`, nearest (Mahalanobis) first; `grid` is the
-  // map's spatial index of the keyframes.
-  std::vector<size_t> candidates(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, const KeyframeGrid& grid, size_t current);
-  // Detection, alignment and gating of one candidate. With `commit`, a closure that passes is
+  // The final candidate set for keyframe `current`; `grid` is the map's spatial index of the
+  // keyframes. While the current pose's 3 sigma stays within search_radius_m, the keyframes
+  // nearest the estimate (Mahalanobis) come first. Beyond that, many keyframes lie within reach
+  // and the nearest ones are as likely wrong as any: with a scorer, those the classifier detects
+  // come first, best first and one per place (search_radius_m apart), then the nearest ones.
+  std::vector<Candidate> candidates(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, const KeyframeGrid& grid, size_t current);
+  // Alignment and gating of one candidate. With `commit`, a closure that passes is
   // added to the filter; without, it is only tested (accepted = passed) for later confirmation.
   LoopClosureRecord tryClose(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current, bool commit = true,
                              const Detection* detection = nullptr);
@@ -93,7 +105,6 @@ class LoopCloser {
 
   LoopClosureOptions options_;
   CandidateScorer scorer_;
-  std::string detector_ = "pose";
   double chi2_2dof_;
   size_t cached_for_ = static_cast<size_t>(-1);
   std::unordered_map<size_t, Eigen::Matrix3d> cached_;  // relative covariances for cached_for_

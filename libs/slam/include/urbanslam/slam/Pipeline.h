@@ -42,9 +42,6 @@ class Pipeline {
   // The observer must outlive the pipeline: global SLAM's thread may call it until the pipeline
   // is destroyed (after an error in the reading thread, too).
   void addObserver(PipelineObserver* observer);
-  // An appearance test for loop-closure candidates (the laser classifier); without one every
-  // candidate goes to alignment and gating.
-  void setCandidateScorer(CandidateScorer scorer, std::string name);
   // Processes one measurement. Returns false when the input is exhausted.
   bool step(io::DataSource& source);
   // Runs to the end of the input, then finish().
