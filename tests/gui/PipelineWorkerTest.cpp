@@ -13,6 +13,8 @@ using namespace std::chrono_literals;
 namespace {
 const std::string kLog = test::repoPath("rawlogs/intel-corrected-excerpt.log.gz");
 const std::string kIni = test::repoPath("ini/default.ini");
+// The classifier model the ini leaves to the default, found as the GUI finds it (in its home).
+const std::string kModel = slam::defaultLaserModelPath(test::repoPath(""));
 
 template <typename Pred>
 bool waitFor(Pred p, std::chrono::milliseconds limit = 10s) {
@@ -26,7 +28,7 @@ bool waitFor(Pred p, std::chrono::milliseconds limit = 10s) {
 }  // namespace
 
 TEST(PipelineWorker, StartsPausedAndStepsOneKeyframeAtATime) {
-  gui::PipelineWorker w(kLog, kIni);
+  gui::PipelineWorker w(kLog, kIni, kModel);
   std::this_thread::sleep_for(50ms);
   EXPECT_EQ(w.collector().snapshot().keyframes.size(), 0u);  // nothing runs before play/step
   for (size_t k = 1; k <= 3; ++k) {
@@ -37,14 +39,16 @@ TEST(PipelineWorker, StartsPausedAndStepsOneKeyframeAtATime) {
 }
 
 TEST(PipelineWorker, PlayRunsToTheEndLikeTheBatchPipeline) {
-  gui::PipelineWorker w(kLog, kIni);
+  gui::PipelineWorker w(kLog, kIni, kModel);
   w.play();
   ASSERT_TRUE(waitFor([&] { return w.finished(); }));
   const auto snap = w.collector().snapshot();
   EXPECT_TRUE(snap.finished);
   EXPECT_EQ(w.error(), "");
   // Same keyframes as a batch run of the same input and ini.
-  slam::Pipeline batch(slam::loadPipelineOptions(kIni));
+  slam::PipelineOptions options = slam::loadPipelineOptions(kIni);
+  slam::resolveDefaultPaths(options, test::repoPath(""));
+  slam::Pipeline batch(options);
   auto src = io::openDataSource(kLog);
   batch.run(*src);
   ASSERT_EQ(snap.keyframes.size(), batch.keyframes().size());
@@ -55,7 +59,7 @@ TEST(PipelineWorker, PlayRunsToTheEndLikeTheBatchPipeline) {
 }
 
 TEST(PipelineWorker, PauseStopsProgress) {
-  gui::PipelineWorker w(kLog, kIni);
+  gui::PipelineWorker w(kLog, kIni, kModel);
   w.setSpeed(50);  // 50x real time: the 270 s excerpt takes seconds, long enough to pause
   w.play();
   ASSERT_TRUE(waitFor([&] { return w.collector().snapshot().keyframes.size() >= 2; }));
