@@ -43,7 +43,8 @@ int evalLaserLoopCommand(const Argv& args) {
                "all revisit pairs within --d-pos are positives, randomly drawn pairs beyond --d-neg negatives.\n"
                "Prints detection at 0 %, 0.1 % and 1 % false alarm for the model and for a learning-free\n"
                "nearest-neighbour baseline on the normalised feature vector, and the rotation test (positives\n"
-               "with heading difference > 90° vs < 30°, at the 1 % false-alarm threshold).");
+               "with heading difference > 90° vs < 30°, at the 1 % false-alarm threshold), and the detection of\n"
+               "same-side revisits (heading difference <= 90°: what a 180° scanner can see again) at 1 % and 0 %.");
   ap.addPositional("MODEL", "model file (share/laser_loop/default.model, or from train-laser-loop)");
   ap.addPositional("DATA", "logs with a reference trajectory", true, true);
   ap.addOption("out", "DIR", "write roc.csv, roc.png, features.csv (and cv.csv, cv.png with --cv-t-max) here");
@@ -126,6 +127,18 @@ int evalLaserLoopCommand(const Argv& args) {
     r["detection_heading_lt_30"] = small ? double(small_hit) / double(small) : 0.0;
     return r;
   };
+  // A 180° scanner sees the same side of a place only on revisits within ±90° of heading: their
+  // detection against every negative, the figure a front laser can be held to.
+  std::vector<double> same_side_pos;
+  for (const auto& [s, dphi] : pos_heading)
+    if (dphi >= 0 && dphi <= M_PI / 2) same_side_pos.push_back(s);
+  common::Json same_side = common::Json::object();
+  same_side["positives"] = same_side_pos.size();
+  if (!same_side_pos.empty()) {
+    const laser_loop::Roc sroc(same_side_pos, neg);
+    same_side["detection_at_fa_0.01"] = sroc.at(0.01).detection;
+    same_side["detection_at_fa_0"] = sroc.at(0.0).detection;
+  }
   size_t at_factor_det = 0, at_factor_fa = 0;
   for (double s : pos) at_factor_det += s >= factor;
   for (double s : neg) at_factor_fa += s >= factor;
@@ -152,6 +165,7 @@ int evalLaserLoopCommand(const Argv& args) {
   j["false_alarm_at_factor"] = double(at_factor_fa) / double(neg.size());
   j["rotation_at_fa_0.01"] = rotation(roc.at(0.01).threshold);
   j["rotation_at_fa_0"] = rotation(roc.at(0.0).threshold);
+  j["same_side"] = same_side;
 
   if (ap.has("out")) {
     const std::filesystem::path dir = ap.option("out");
@@ -223,6 +237,10 @@ int evalLaserLoopCommand(const Argv& args) {
   std::cout << "rotation (at 1 % FA): heading difference > 90°: " << pct(r.at("detection_heading_gt_90").asNumber()) << " of "
             << static_cast<long>(r.at("pairs_heading_gt_90").asNumber()) << "; < 30°: " << pct(r.at("detection_heading_lt_30").asNumber())
             << " of " << static_cast<long>(r.at("pairs_heading_lt_30").asNumber()) << "\n";
+  if (same_side.contains("detection_at_fa_0.01"))
+    std::cout << "same side (heading difference <= 90°, " << same_side_pos.size() << " positives): detection at 1 % FA "
+              << pct(same_side.at("detection_at_fa_0.01").asNumber()) << ", at 0 % FA " << pct(same_side.at("detection_at_fa_0").asNumber())
+              << "\n";
   return 0;
 }
 

@@ -210,3 +210,34 @@ TEST(Cli, SimulatedDriveRunsFromFileAndStream) {
   EXPECT_GT(field("within_0_1_m"), 0.5) << e.out;
   EXPECT_NE(e.out.find("\"loops_recall\":"), std::string::npos) << e.out;  // a 400 m drive has no revisit to score
 }
+
+namespace {
+// The number after "key": in `json`, from `from` on (-1 when absent).
+double numberAfter(const std::string& json, const std::string& key, size_t from = 0) {
+  const std::string k = "\"" + key + "\":";
+  const size_t at = json.find(k, from);
+  return at == std::string::npos ? -1 : std::stod(json.substr(at + k.size()));
+}
+}  // namespace
+
+// The same-side figures are those of an evaluation whose positives are only the revisits within
+// 90° of heading, against the same negatives (a fixed count, so both runs draw the same ones).
+// The operating point at a false-alarm rate is picked among all scores, positives included, so
+// the two may differ by the few positives that fall between two negatives' scores there.
+TEST(Cli, EvalLaserLoopReportsSameSideRevisits) {
+  const std::string common = "eval-laser-loop --quiet --json --negatives-per-positive 0 --min-negatives 5000 " +
+                             repoPath("share/laser_loop/default.model") + " " + repoPath("rawlogs/intel.rawlog");
+  const CliResult any = runCli(common + " --max-heading-diff 180");
+  const CliResult same = runCli(common + " --max-heading-diff 90");
+  ASSERT_EQ(any.code, 0) << any.err;
+  ASSERT_EQ(same.code, 0) << same.err;
+  const size_t at = any.out.find("\"same_side\":");
+  ASSERT_NE(at, std::string::npos) << any.out;
+  EXPECT_GT(numberAfter(any.out, "positives"), numberAfter(any.out, "positives", at));  // the excerpt has opposite-heading revisits
+  EXPECT_EQ(numberAfter(any.out, "positives", at), numberAfter(same.out, "positives"));
+  EXPECT_EQ(numberAfter(any.out, "negatives"), numberAfter(same.out, "negatives"));
+  const double positives = numberAfter(same.out, "positives");
+  EXPECT_NEAR(numberAfter(any.out, "detection_at_fa_0.01", at), numberAfter(same.out, "detection_at_fa_0.01"), 3 / positives);
+  EXPECT_NEAR(numberAfter(any.out, "detection_at_fa_0", at), numberAfter(same.out, "detection_at_fa_0"), 3 / positives);
+  EXPECT_GT(numberAfter(any.out, "detection_at_fa_0.01", at), 0.1);  // the model detects same-side revisits
+}
