@@ -4,6 +4,7 @@
 #include <cmath>
 #include <memory>
 
+#include "ConstantScan.h"
 #include "TestPaths.h"
 #include "urbanslam/alignment/FreeSpace.h"
 #include "urbanslam/esdf/Esdf.h"
@@ -139,12 +140,7 @@ struct Street {
 };
 
 Street street(size_t n, double x_now, double link_sigma_m) {
-  io::LaserScan scan;
-  scan.angle_min_rad = -M_PI / 2;
-  scan.angle_increment_rad = M_PI / 180;
-  scan.max_range_m = 80;
-  scan.ranges.assign(181, 10.0f);
-  scan.valid.assign(181, 1);
+  const io::LaserScan scan = test::constantScan(0, 10.0f, 80);
   Street s;
   s.filter->initialise(esdf::Vec3::Zero(), esdf::Mat3::Identity() * 1e-9);
   const esdf::Mat3 cov = esdf::Vec3(link_sigma_m * link_sigma_m, link_sigma_m * link_sigma_m, 1e-6).asDiagonal();

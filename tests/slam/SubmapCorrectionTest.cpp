@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "ConstantScan.h"
 #include "urbanslam/slam/LocalSlam.h"
 #include "urbanslam/slam/SubmapCorrections.h"
 
@@ -22,16 +23,7 @@ Eigen::Matrix3d mat(const common::Pose2& p) {
   return m;
 }
 
-io::LaserScan someScan(double t) {
-  io::LaserScan s;
-  s.timestamp = t;
-  s.angle_min_rad = -M_PI / 2;
-  s.angle_increment_rad = M_PI / 180;
-  s.max_range_m = 30;
-  s.ranges.assign(181, 5.0f);
-  s.valid.assign(181, 1);
-  return s;
-}
+io::LaserScan someScan(double t) { return test::constantScan(t, 5.0f, 30); }
 
 void expectSame(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b, const std::string& what) {
   EXPECT_LT((a - b).cwiseAbs().maxCoeff(), 1e-9) << what << "\n" << a << "\n" << b;
