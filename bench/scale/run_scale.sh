@@ -5,7 +5,8 @@
 #   bench/scale/run_scale.sh [BUILD_DIR] [OUT_DIR]
 #
 # Environment: CITIES="1 10 100" (km2), ROUTE_KM="3 10 30" (drive length per city),
-# LOGS="intel aces fr079 csail" (raw Freiburg logs, needs ../shared/data; "" for none).
+# LOGS="intel aces fr079 csail" (raw Freiburg logs, needs ../shared/data; "" for none),
+# PIPELINE_INI (the cities' pipeline configuration; default ini/default.ini).
 # Per run: OUT_DIR/NAME/ holds the run's outputs, steps.csv and step_time.png (step time against
 # the map's size); the cities are scored against their truth (simulate --no-rawlog writes it).
 # Prints one table: keyframes, the front end's step p50/p99/max and p99 per decade of map size,
@@ -29,7 +30,7 @@ for i in "${!CITIES[@]}"; do
   a=${CITIES[$i]} km=${ROUTES[$i]} name=city-${CITIES[$i]}km2
   sed -e "s/^area_km2 .*/area_km2 = $a/" -e "s/^route_length_km .*/route_length_km = $km/" ini/city-1km2.ini > "$OUT/$name.ini"
   "$U" simulate --quiet --no-rawlog --ini "$OUT/$name.ini" --out "$OUT/$name-truth" > /dev/null
-  "$B" --city "$OUT/$name.ini" --out "$OUT/$name" > "$OUT/$name.json"
+  "$B" --city "$OUT/$name.ini" --ini "${PIPELINE_INI:-ini/default.ini}" --out "$OUT/$name" > "$OUT/$name.json"
   "$U" eval "$OUT/$name" --truth "$OUT/$name-truth" --json > "$OUT/$name.eval.json"
   rows+=("$name")
 done

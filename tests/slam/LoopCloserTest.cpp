@@ -156,53 +156,56 @@ Street street(size_t n, double x_now, double link_sigma_m) {
 
 }  // namespace
 
-// While the estimate is good the keyframes nearest to it are the candidates, whatever a scorer
-// says; once its 3 sigma reaches beyond search_radius_m the classifier's detections among every
-// keyframe within reach come first, best first and one per place, then the nearest ones.
-TEST(LoopCloser, AppearancePicksTheCandidatesWhenThePoseIsTooUncertain) {
-  slam::LoopClosureOptions o;  // search_radius_m 4, min_keyframe_gap 30, laser_threshold 0
+// The keyframes nearest the estimate are always the first candidates. Once the pose relative to
+// the nearest keyframe is uncertain beyond appearance_min_sigma_m, the classifier's detections
+// among every keyframe within reach follow: best first, one per place, none below the threshold.
+TEST(LoopCloser, AppearanceAddsCandidatesWhenThePoseIsTooUncertain) {
+  slam::LoopClosureOptions o;  // search_radius_m 4, min_keyframe_gap 30, max_candidates 3, laser_threshold 0
+  o.appearance_min_sigma_m = 3;
   const size_t n = 200;
   const double x_now = 100;  // the estimate is at keyframe 100; keyframe 108 looks like it
   const auto scorer = [](size_t earlier, size_t) {
     if (earlier == 108) return 2.0;   // the best
     if (earlier == 109) return 1.9;   // the same place
     if (earlier == 93) return 0.5;    // another place, a weaker detection
-    if (earlier == 101) return -0.1;  // below the decision threshold
+    if (earlier == 120) return -0.1;  // below the decision threshold
     return -1.0;
   };
+  const auto nearestFirst = [&](const std::vector<slam::Candidate>& c) {
+    ASSERT_GE(c.size(), 3u);
+    EXPECT_EQ(c[0].keyframe, 100u);
+    for (size_t k = 0; k < 3; ++k) {
+      EXPECT_FALSE(c[k].detection.has_value()) << c[k].keyframe;
+      EXPECT_LE(std::abs(static_cast<double>(c[k].keyframe) - x_now), 2.0) << c[k].keyframe;
+    }
+  };
 
-  {  // 0.01 m per link: 3 sigma ~ 0.3 m (after 200 links ~0.14 m sigma): the estimate picks.
+  {  // 0.01 m per link: the pose is known to ~0.1 m relative to keyframe 100: no detections.
     Street s = street(n, x_now, 0.01);
     slam::LoopCloser closer(o);
     closer.setScorer(scorer);
     const auto c = closer.candidates(*s.filter, s.keyframes, s.grid, n);
-    ASSERT_FALSE(c.empty());
-    EXPECT_EQ(c.front().keyframe, 100u);
-    EXPECT_FALSE(c.front().detection.has_value());
-    for (const auto& k : c) EXPECT_FALSE(k.detection.has_value()) << k.keyframe;
+    nearestFirst(c);
+    EXPECT_EQ(c.size(), 3u);
   }
-  {  // 0.3 m per link: sigma ~4 m, 3 sigma far beyond 4 m: appearance picks (reach ~17 m).
-    Street s = street(n, x_now, 0.3);
+  {  // 0.5 m per link: ~5 m relative to keyframe 100 (reach ~25 m): the detections follow.
+    Street s = street(n, x_now, 0.5);
     slam::LoopCloser closer(o);
     closer.setScorer(scorer);
     const auto c = closer.candidates(*s.filter, s.keyframes, s.grid, n);
-    ASSERT_GE(c.size(), 3u);  // 108 (109 is the same place), then 93; 101 is no detection
-    EXPECT_EQ(c[0].keyframe, 108u);
-    ASSERT_TRUE(c[0].detection.has_value());
-    EXPECT_EQ(c[0].detection->detector, "laser");
-    EXPECT_DOUBLE_EQ(c[0].detection->score, 2.0);
-    EXPECT_EQ(c[1].keyframe, 93u);
-    ASSERT_TRUE(c[1].detection.has_value());
-    // Then the keyframes nearest the estimate, as without a classifier.
-    EXPECT_EQ(c[2].keyframe, 100u);
-    EXPECT_FALSE(c[2].detection.has_value());
-    for (size_t k = 2; k < c.size(); ++k) EXPECT_FALSE(c[k].detection.has_value()) << c[k].keyframe;
+    nearestFirst(c);
+    ASSERT_EQ(c.size(), 5u);  // 108 (109 is the same place), then 93; 120 is no detection
+    EXPECT_EQ(c[3].keyframe, 108u);
+    ASSERT_TRUE(c[3].detection.has_value());
+    EXPECT_EQ(c[3].detection->detector, "laser");
+    EXPECT_DOUBLE_EQ(c[3].detection->score, 2.0);
+    EXPECT_EQ(c[4].keyframe, 93u);
+    ASSERT_TRUE(c[4].detection.has_value());
 
-    // Without a classifier the same uncertain estimate keeps the nearest keyframes.
+    // Without a classifier the same uncertain estimate has only the nearest keyframes.
     slam::LoopCloser plain(o);
     const auto p = plain.candidates(*s.filter, s.keyframes, s.grid, n);
-    ASSERT_FALSE(p.empty());
-    EXPECT_EQ(p.front().keyframe, 100u);
-    EXPECT_FALSE(p.front().detection.has_value());
+    nearestFirst(p);
+    EXPECT_EQ(p.size(), 3u);
   }
 }

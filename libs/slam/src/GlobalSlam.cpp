@@ -20,13 +20,24 @@ GlobalSlam::GlobalSlam(const PipelineOptions& options, Map& map, PipelineStats& 
   if (options_.loop_closure.enabled && options_.loop_closure.detector == LoopClosureOptions::Detector::Laser) {
     // The AdaBoost classifier picks the candidates where the estimate is too uncertain to. Its
     // score is the margin above the model's decision factor (eq. 3.30), so laser_threshold = 0
-    // is the model's own operating point.
-    const std::string model = options_.loop_closure.laser_model.empty() ? laser_loop::kDefaultModelPath : options_.loop_closure.laser_model;
-    laser_detector_ = std::make_unique<laser_loop::LoopDetector>(laser_loop::LoopDetector::fromFile(model));
+    // is the model's own operating point. A configured model is read now, so that a bad file
+    // stops the run before it starts; without one, the shipped model is read at the first use.
+    if (!options_.loop_closure.laser_model.empty())
+      laser_detector_ = std::make_unique<laser_loop::LoopDetector>(laser_loop::LoopDetector::fromFile(options_.loop_closure.laser_model));
     closer_.setScorer([this](size_t earlier, size_t current) {
-      return laser_detector_->score(laser_detector_->keyframe(current), earlier) - laser_detector_->factor();
+      laser_loop::LoopDetector& d = laserDetector();
+      return d.score(d.keyframe(current), earlier) - d.factor();
     });
   }
+}
+
+laser_loop::LoopDetector& GlobalSlam::laserDetector() {
+  if (!laser_detector_)
+    laser_detector_ = std::make_unique<laser_loop::LoopDetector>(laser_loop::LoopDetector::fromFile(laser_loop::kDefaultModelPath));
+  // Features are a function of each keyframe's scan, computed once, when first needed (the
+  // indoor logs never need them; a resumed run computes them from the saved scans).
+  for (size_t k = laser_detector_->size(); k < map_.size(); ++k) laser_detector_->addKeyframe(map_.keyframes()[k].scan.expand());
+  return *laser_detector_;
 }
 
 GlobalSlam::~GlobalSlam() = default;
@@ -53,7 +64,6 @@ std::array<double, 9> GlobalSlam::addKeyframe(Keyframe kf, const KeyframeConstra
   // Window recovery moved the last `recent_window` keyframes too.
   const size_t window = static_cast<size_t>(options_.estimator.recent_window);
   if (filter && k > 0) map_.pullPoses(k > window ? k - window : 0);
-  if (laser_detector_) laser_detector_->addKeyframe(kf.scan.expand());  // features once per keyframe
   map_.addKeyframe(std::move(kf));
   std::array<double, 9> c{};
   if (filter && k > 0) {
@@ -175,8 +185,6 @@ void GlobalSlam::closeLoops(size_t current, SteadyTime handed_over) {
   // both).
   std::vector<Candidate> cands;
   if (map_.keyframes()[current].hasScan()) cands = closer_.candidates(*map_.filter(), map_.keyframes(), map_.index(), current);
-  if (cands.size() > static_cast<size_t>(options_.loop_closure.max_candidates))
-    cands.resize(static_cast<size_t>(options_.loop_closure.max_candidates));
   std::vector<size_t> keyframes;
   for (const Candidate& c : cands) keyframes.push_back(c.keyframe);
   for (auto* o : observers_) o->onCandidates({current, &keyframes});

@@ -89,46 +89,48 @@ std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const std::vec
   }
   // Bound the covariance work per keyframe: 30 keyframes go on to the Mahalanobis test.
   constexpr size_t kFinalTests = 30;
-  std::vector<Candidate> picked;
   std::sort(initial.begin(), initial.end());
-  if (scorer_ && 3 * sigma > options_.search_radius_m && cur.hasScan()) {
-    // Appearance: every keyframe within reach is scored (a classifier vote costs ~0.2 us), the
-    // detections best first, one per place so that an aliased place cannot take every slot.
-    std::vector<std::pair<double, size_t>> scored;
-    for (const auto& [d, i] : initial)
-      if (const double score = scorer_(i, current); score >= options_.laser_threshold) scored.emplace_back(score, i);
-    std::sort(scored.begin(), scored.end(), [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second < b.second); });
-    for (const auto& [score, i] : scored) {
-      if (picked.size() == kFinalTests) break;
-      const bool same_place = std::any_of(picked.begin(), picked.end(), [&](const Candidate& p) {
-        return std::hypot(keyframes[i].pose.x - keyframes[p.keyframe].pose.x, keyframes[i].pose.y - keyframes[p.keyframe].pose.y) <
-               options_.search_radius_m;
-      });
-      if (!same_place) picked.push_back({i, Detection{"laser", score}});
-    }
-  }
-  // The keyframes nearest the estimate: the candidates, or after the detections the rest.
-  for (const auto& [d, i] : initial) {
-    if (picked.size() == kFinalTests) break;
-    if (std::none_of(picked.begin(), picked.end(), [&](const Candidate& p) { return p.keyframe == i; })) picked.push_back({i, std::nullopt});
-  }
   // Final set: could the two poses be within the sensor's overlap distance, given their joint
   // uncertainty? d^2 = t' (J Σ J' + (R/2)^2 I)^-1 t for the relative position t.
-  std::vector<std::pair<double, Candidate>> final_set;
   const double r2 = 0.25 * options_.search_radius_m * options_.search_radius_m;
-  for (size_t n = 0; n < picked.size(); ++n) {
-    const size_t i = picked[n].keyframe;
+  const auto mahalanobis2 = [&](size_t i) {
     const esdf::Vec3 xi = filter.mean(static_cast<int>(i)), xk = filter.mean(static_cast<int>(current));
     const Eigen::Matrix3d s = relativeCovariance(filter, i, current);
     const Eigen::Matrix2d st = s.topLeftCorner<2, 2>() + r2 * Eigen::Matrix2d::Identity();
     const Eigen::Vector2d t = esdf::between(xi, xk).head<2>();
-    const double d2 = t.dot(st.inverse() * t);
-    // Detections keep their order (best score first), before the others (nearest first).
-    if (d2 <= chi2_2dof_) final_set.emplace_back(picked[n].detection ? static_cast<double>(n) - 1e9 : d2, picked[n]);
-  }
-  std::stable_sort(final_set.begin(), final_set.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    return t.dot(st.inverse() * t);
+  };
+  // The keyframes nearest the estimate (the 30 nearest tested: bounded covariance work), nearest
+  // in Mahalanobis distance first.
+  std::vector<std::pair<double, size_t>> near_set;
+  for (size_t n = 0; n < initial.size() && n < 30; ++n)
+    if (const double d2 = mahalanobis2(initial[n].second); d2 <= chi2_2dof_) near_set.emplace_back(d2, initial[n].second);
+  std::sort(near_set.begin(), near_set.end());
+  const size_t per_source = static_cast<size_t>(options_.max_candidates);
   std::vector<Candidate> out;
-  for (auto& [key, cand] : final_set) out.push_back(std::move(cand));
+  for (size_t n = 0; n < near_set.size() && n < per_source; ++n) out.push_back({near_set[n].second, std::nullopt});
+  // Where the map is: the uncertainty of the current pose relative to the nearest earlier
+  // keyframe (its own marginal grows with the distance from the map's origin even where loops
+  // have tied it to the keyframes around). Beyond appearance_min_sigma_m, more than alignment
+  // from the estimate's guess reaches, the nearest keyframes are as likely wrong as any within
+  // reach: the classifier's detections among all of them follow,
+  // best first and one per place, so that an aliased place cannot take every slot.
+  const bool lost = !initial.empty() &&
+                    largestPositionSigma(relativeCovariance(filter, initial.front().second, current)) > options_.appearance_min_sigma_m;
+  if (!scorer_ || !lost || !cur.hasScan()) return out;
+  std::vector<std::pair<double, size_t>> scored;
+  for (const auto& [d, i] : initial)
+    if (const double score = scorer_(i, current); score >= options_.laser_threshold) scored.emplace_back(score, i);
+  std::sort(scored.begin(), scored.end(), [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second < b.second); });
+  const size_t first_detection = out.size();
+  for (const auto& [score, i] : scored) {
+    if (out.size() - first_detection == per_source) break;
+    const auto same = [&](const Candidate& p) {
+      return p.keyframe == i || (p.detection && std::hypot(keyframes[i].pose.x - keyframes[p.keyframe].pose.x,
+                                                           keyframes[i].pose.y - keyframes[p.keyframe].pose.y) < options_.search_radius_m);
+    };
+    if (std::none_of(out.begin(), out.end(), same) && mahalanobis2(i) <= chi2_2dof_) out.push_back({i, Detection{"laser", score}});
+  }
   return out;
 }
 

@@ -71,8 +71,10 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("enabled", o.loop_closure.enabled, "search for loop closures");
   s.add<LoopClosureOptions::Detector>("detector", o.loop_closure.detector,
                                       {{"none", LoopClosureOptions::Detector::None}, {"laser", LoopClosureOptions::Detector::Laser}},
-                                      "candidates where the pose is too uncertain to pick them (3 sigma beyond search_radius_m); none: the nearest to the estimate; laser: the AdaBoost classifier's detections among every keyframe within reach");
+                                      "where the pose is too uncertain to pick the candidates (appearance_min_sigma_m); none: the nearest to the estimate only; laser: the AdaBoost classifier's detections among every keyframe within reach as well");
   s.add("laser_model", o.loop_closure.laser_model, {}, "laser classifier model; empty: share/laser_loop/default.model");
+  s.add("appearance_min_sigma_m", o.loop_closure.appearance_min_sigma_m, 0.0, 1000.0, "m",
+        "detector = laser: the classifier adds candidates once the pose relative to the nearest keyframe is this uncertain (1 sigma; from the estimate's guess, alignment reaches a few metres)");
   s.add("laser_threshold", o.loop_closure.laser_threshold, -100.0, 100.0, "", "classifier decision offset (higher: fewer false alarms): a keyframe scoring below is not a candidate");
   s.add<LoopClosureOptions::ImageDetector>(
       "image_detector", o.loop_closure.image_detector,

@@ -497,9 +497,8 @@ void GlobalSlam::readState(BinaryReader& r) {
   for (size_t i = 0, count = r.count(kRecordBytes); i < count; ++i) closures_.push_back(readRecord(r, n));
   dirty_since_recovery_ = r.boolean();
   last_full_size_ = r.size();
-  // The classifier's keyframe features: a function of each keyframe's scan.
-  if (laser_detector_)
-    for (const Keyframe& k : map_.keyframes()) laser_detector_->addKeyframe(k.scan.expand());
+  // The classifier's keyframe features are not saved: a function of each keyframe's scan,
+  // computed when first needed (laserDetector()).
 }
 
 // --- Camera images ---

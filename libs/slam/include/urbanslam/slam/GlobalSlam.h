@@ -69,13 +69,15 @@ class GlobalSlam {
   void closureAdded(size_t current, SteadyTime handed_over);
   // Full recovery; the latency of the oldest closure it brings into the whole map is recorded.
   void recoverAll();
+  // The laser classifier with the features of every keyframe so far.
+  laser_loop::LoopDetector& laserDetector();
 
   const PipelineOptions& options_;
   Map& map_;
   PipelineStats& stats_;
   const std::vector<PipelineObserver*>& observers_;
   LoopCloser closer_;
-  std::unique_ptr<laser_loop::LoopDetector> laser_detector_;  // [loop_closure] detector = laser
+  std::unique_ptr<laser_loop::LoopDetector> laser_detector_;  // [loop_closure] detector = laser, once read
   std::deque<LoopClosureRecord> pending_;                     // passed alignment + gate, awaiting confirmation
   std::vector<LoopClosureRecord> closures_;
   bool dirty_since_recovery_ = false;

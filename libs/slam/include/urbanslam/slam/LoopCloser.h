@@ -75,14 +75,15 @@ class LoopCloser {
  public:
   explicit LoopCloser(const LoopClosureOptions& options);
 
-  // With a scorer, appearance picks the candidates when the estimate is too uncertain to.
+  // With a scorer, appearance adds candidates when the estimate is too uncertain to pick them.
   void setScorer(CandidateScorer scorer);
 
   // The final candidate set for keyframe `current`; `grid` is the map's spatial index of the
-  // keyframes. While the current pose's 3 sigma stays within search_radius_m, the keyframes
-  // nearest the estimate (Mahalanobis) come first. Beyond that, many keyframes lie within reach
-  // and the nearest ones are as likely wrong as any: with a scorer, those the classifier detects
-  // come first, best first and one per place (search_radius_m apart), then the nearest ones.
+  // keyframes. First the max_candidates keyframes nearest the estimate (Mahalanobis). When the
+  // pose relative to the nearest keyframe is uncertain beyond appearance_min_sigma_m, many
+  // keyframes lie within reach and the nearest ones are as likely wrong as any: with a scorer,
+  // up to max_candidates of the classifier's detections follow, best first and one per place
+  // (search_radius_m apart).
   std::vector<Candidate> candidates(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, const KeyframeGrid& grid, size_t current);
   // Alignment and gating of one candidate. With `commit`, a closure that passes is
   // added to the filter; without, it is only tested (accepted = passed) for later confirmation.

@@ -74,6 +74,7 @@ struct LoopClosureOptions {
   // none: alignment + gating verify every candidate; laser: the AdaBoost classifier screens them first.
   enum class Detector { None, Laser } detector = Detector::None;
   std::string laser_model;       // classifier model file; empty = share/laser_loop/default.model
+  double appearance_min_sigma_m = 3.0;  // detector = laser: the classifier adds candidates beyond this pose uncertainty
   double laser_threshold = 0.0;  // strong-classifier margin offset (higher: fewer false alarms)
   // Image proposals (Tree of Words, [image_loop]) go through the same alignment, gating and
   // confirmation as the laser candidates; without scans they are only recorded.
