@@ -87,8 +87,6 @@ std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const std::vec
     const double d = std::hypot(keyframes[i].pose.x - cur.pose.x, keyframes[i].pose.y - cur.pose.y);
     if (d <= radius) initial.emplace_back(d, i);
   }
-  // Bound the covariance work per keyframe: 30 keyframes go on to the Mahalanobis test.
-  constexpr size_t kFinalTests = 30;
   std::sort(initial.begin(), initial.end());
   // Final set: could the two poses be within the sensor's overlap distance, given their joint
   // uncertainty? d^2 = t' (J Σ J' + (R/2)^2 I)^-1 t for the relative position t.
@@ -100,10 +98,11 @@ std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const std::vec
     const Eigen::Vector2d t = esdf::between(xi, xk).head<2>();
     return t.dot(st.inverse() * t);
   };
-  // The keyframes nearest the estimate (the 30 nearest tested: bounded covariance work), nearest
-  // in Mahalanobis distance first.
+  // The keyframes nearest the estimate, nearest in Mahalanobis distance first (the 30 nearest
+  // tested: bounded covariance work per keyframe).
+  constexpr size_t kMahalanobisTests = 30;
   std::vector<std::pair<double, size_t>> near_set;
-  for (size_t n = 0; n < initial.size() && n < 30; ++n)
+  for (size_t n = 0; n < initial.size() && n < kMahalanobisTests; ++n)
     if (const double d2 = mahalanobis2(initial[n].second); d2 <= chi2_2dof_) near_set.emplace_back(d2, initial[n].second);
   std::sort(near_set.begin(), near_set.end());
   const size_t per_source = static_cast<size_t>(options_.max_candidates);
@@ -113,8 +112,8 @@ std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const std::vec
   // keyframe (its own marginal grows with the distance from the map's origin even where loops
   // have tied it to the keyframes around). Beyond appearance_min_sigma_m, more than alignment
   // from the estimate's guess reaches, the nearest keyframes are as likely wrong as any within
-  // reach: the classifier's detections among all of them follow,
-  // best first and one per place, so that an aliased place cannot take every slot.
+  // reach: the classifier's detections among all of them follow, best first and one per place,
+  // so that an aliased place cannot take every slot.
   const bool lost = !initial.empty() &&
                     largestPositionSigma(relativeCovariance(filter, initial.front().second, current)) > options_.appearance_min_sigma_m;
   if (!scorer_ || !lost || !cur.hasScan()) return out;
