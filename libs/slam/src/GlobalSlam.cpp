@@ -18,7 +18,7 @@ constexpr double kDeg = M_PI / 180.0;
 GlobalSlam::GlobalSlam(const PipelineOptions& options, Map& map, PipelineStats& stats, const std::vector<PipelineObserver*>& observers)
     : options_(options), map_(map), stats_(stats), observers_(observers), closer_(options.loop_closure) {
   if (options_.loop_closure.enabled && options_.loop_closure.detector == LoopClosureOptions::Detector::Laser) {
-    // The AdaBoost classifier picks the candidates where the estimate is too uncertain to. Its
+    // The AdaBoost classifier adds candidates where the estimate is too uncertain to pick them. Its
     // score is the margin above the model's decision factor (eq. 3.30), so laser_threshold = 0
     // is the model's own operating point. A configured model is read now, so that a bad file
     // stops the run before it starts; without one, the shipped model is read at the first use.
@@ -180,9 +180,9 @@ void GlobalSlam::closeLoops(size_t current, SteadyTime handed_over) {
     return;
   common::Stopwatch sw;
   expirePending(current);
-  // 6. Candidates: initial set near the estimate, final set by Mahalanobis distance, picked by
-  // appearance when the estimate is too uncertain (keyframes with scans only: alignment needs
-  // both).
+  // 6. Candidates: initial set near the estimate, final set by Mahalanobis distance, and where
+  // the estimate is too uncertain the classifier's detections (keyframes with scans only:
+  // alignment needs both).
   std::vector<Candidate> cands;
   if (map_.keyframes()[current].hasScan()) cands = closer_.candidates(*map_.filter(), map_.keyframes(), map_.index(), current);
   std::vector<size_t> keyframes;

@@ -114,9 +114,9 @@ std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const std::vec
   // from the estimate's guess reaches, the nearest keyframes are as likely wrong as any within
   // reach: the classifier's detections among all of them follow, best first and one per place,
   // so that an aliased place cannot take every slot.
-  const bool lost = !initial.empty() &&
-                    largestPositionSigma(relativeCovariance(filter, initial.front().second, current)) > options_.appearance_min_sigma_m;
-  if (!scorer_ || !lost || !cur.hasScan()) return out;
+  if (!scorer_ || initial.empty() || !cur.hasScan()) return out;
+  // (The nearest keyframe's relative covariance is the one its Mahalanobis test computed.)
+  if (largestPositionSigma(relativeCovariance(filter, initial.front().second, current)) <= options_.appearance_min_sigma_m) return out;
   std::vector<std::pair<double, size_t>> scored;
   for (const auto& [d, i] : initial)
     if (const double score = scorer_(i, current); score >= options_.laser_threshold) scored.emplace_back(score, i);

@@ -71,7 +71,8 @@ struct LocalOptions {
 // Global SLAM: loop-closure search, verification and the ESDF update.
 struct LoopClosureOptions {
   bool enabled = true;
-  // none: alignment + gating verify every candidate; laser: the AdaBoost classifier screens them first.
+  // Candidates besides the nearest to the estimate where the pose is too uncertain to pick them
+  // (appearance_min_sigma_m): none, or laser (the AdaBoost classifier's detections).
   enum class Detector { None, Laser } detector = Detector::None;
   std::string laser_model;       // classifier model file; empty = share/laser_loop/default.model
   double appearance_min_sigma_m = 3.0;  // detector = laser: the classifier adds candidates beyond this pose uncertainty
