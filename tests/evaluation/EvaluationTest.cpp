@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <random>
@@ -42,6 +43,49 @@ TEST(Evaluation, RelationMetricMatchesHandComputedErrors) {
   EXPECT_NEAR(m.abs_trans_m.mean, 0.1, 1e-9);
   EXPECT_NEAR(m.sqr_trans_m2.mean, 0.01, 1e-9);
   EXPECT_NEAR(m.sqr_rot_deg2.mean, 4.0, 1e-9);
+}
+
+// Nodes bridged along a dense trajectory, against poses computed here by hand: nodes that are
+// the dense poses (every 20th of a circle) give the circle back where linear interpolation cuts
+// its chords; nodes moved rigidly give the moved circle; one node shifted by a world offset
+// carries that offset into its neighbourhood, linearly in time down to zero at the next node.
+TEST(Evaluation, NodesAreBridgedAlongTheDenseTrajectory) {
+  const auto dense = circle();
+  std::vector<io::StampedPose> nodes;
+  for (size_t i = 0; i < dense.size(); i += 20) nodes.push_back(dense[i]);
+  auto bridged = evaluation::bridgeNodes(nodes, dense);
+  ASSERT_EQ(bridged.size(), 181u);  // 0 .. 18.0 s at every dense time
+  double worst_bridged = 0, worst_linear = 0;
+  for (size_t i = 0; i < bridged.size(); ++i) {
+    EXPECT_DOUBLE_EQ(bridged[i].timestamp, dense[i].timestamp);
+    worst_bridged = std::max(worst_bridged, std::hypot(bridged[i].pose.x - dense[i].pose.x, bridged[i].pose.y - dense[i].pose.y));
+    common::Pose2 lin;
+    ASSERT_TRUE(evaluation::interpolatePose(nodes, dense[i].timestamp, 10.0, lin));
+    worst_linear = std::max(worst_linear, std::hypot(lin.x - dense[i].pose.x, lin.y - dense[i].pose.y));
+  }
+  EXPECT_LT(worst_bridged, 1e-9);
+  EXPECT_GT(worst_linear, 0.05);  // the chord of 20 steps on a 5 m circle sags by centimetres
+
+  const common::Pose2 frame{3.0, -2.0, 0.7};
+  auto moved = nodes;
+  for (auto& n : moved) n.pose = common::compose(frame, n.pose);
+  std::reverse(moved.begin(), moved.end());  // any time order
+  bridged = evaluation::bridgeNodes(moved, dense);
+  for (size_t i = 0; i < bridged.size(); ++i) {
+    const common::Pose2 want = common::compose(frame, dense[i].pose);
+    EXPECT_NEAR(bridged[i].pose.x, want.x, 1e-9);
+    EXPECT_NEAR(bridged[i].pose.y, want.y, 1e-9);
+    EXPECT_NEAR(common::wrapToPi(bridged[i].pose.phi - want.phi), 0.0, 1e-9);
+  }
+
+  auto shifted = nodes;
+  shifted[3].pose.x += 0.4;  // the node at 6.0 s; its neighbours at 4.0 s and 8.0 s stay
+  bridged = evaluation::bridgeNodes(shifted, dense);
+  for (size_t i = 40; i <= 80; ++i) {
+    const double t = dense[i].timestamp, expect_dx = 0.4 * (1.0 - std::abs(t - 6.0) / 2.0);
+    EXPECT_NEAR(bridged[i].pose.x - dense[i].pose.x, expect_dx, 1e-9) << "t " << t;
+    EXPECT_NEAR(bridged[i].pose.y, dense[i].pose.y, 1e-9) << "t " << t;
+  }
 }
 
 TEST(Evaluation, TimeOffsetIsRecoveredFromTheReference) {

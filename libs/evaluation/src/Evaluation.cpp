@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -79,6 +80,43 @@ bool interpolatePose(const std::vector<io::StampedPose>& traj, double t, double 
   if (b.timestamp - a.timestamp > max_gap_s) return false;
   out = common::interpolate(a.pose, b.pose, (t - a.timestamp) / (b.timestamp - a.timestamp));
   return true;
+}
+
+std::vector<io::StampedPose> bridgeNodes(const std::vector<io::StampedPose>& nodes, const std::vector<io::StampedPose>& dense) {
+  const auto n = shifted(nodes, 0), d = shifted(dense, 0);  // time-sorted copies
+  if (n.size() < 2) return n;
+  std::vector<double> times;
+  for (const auto& p : n) times.push_back(p.timestamp);
+  for (const auto& p : d)
+    if (p.timestamp > n.front().timestamp && p.timestamp < n.back().timestamp) times.push_back(p.timestamp);
+  std::sort(times.begin(), times.end());
+  times.erase(std::unique(times.begin(), times.end()), times.end());
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<io::StampedPose> out;
+  out.reserve(times.size());
+  size_t i = 0;  // n[i].timestamp <= t < n[i + 1].timestamp, or the last interval
+  for (const double t : times) {
+    while (i + 2 < n.size() && n[i + 1].timestamp <= t) ++i;
+    const auto &a = n[i], &b = n[i + 1];
+    if (t <= a.timestamp || b.timestamp <= a.timestamp) {
+      out.push_back({t, a.pose});
+      continue;
+    }
+    if (t >= b.timestamp) {
+      out.push_back({t, b.pose});
+      continue;
+    }
+    const double f = (t - a.timestamp) / (b.timestamp - a.timestamp);
+    Pose2 da, db, dt;
+    if (!interpolatePose(d, a.timestamp, inf, da) || !interpolatePose(d, b.timestamp, inf, db) || !interpolatePose(d, t, inf, dt)) {
+      out.push_back({t, common::interpolate(a.pose, b.pose, f)});
+      continue;
+    }
+    const Pose2 forward = common::compose(a.pose, common::between(da, dt));
+    const Pose2 backward = common::compose(b.pose, common::between(db, dt));
+    out.push_back({t, common::interpolate(forward, backward, f)});
+  }
+  return out;
 }
 
 namespace {

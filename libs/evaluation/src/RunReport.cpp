@@ -101,8 +101,10 @@ RunReport evaluateRun(const RunReportOptions& o) {
   const auto estimate = io::readTum(traj_path.string());
   if (estimate.empty()) throw common::InputError(traj_path.string() + ": no poses (the run mapped nothing)");
   // The relations score the run's nodes, the scans it placed (as Cartographer scores its own),
-  // interpolated at each relation time; a folder without them (a peer's) is scored on its one
-  // trajectory.
+  // at each relation time: bridged along the trajectory at odometry times between nodes, which
+  // where every relation time is a scan time (the raw benchmark logs) is Cartographer's figure
+  // to the digit, and on sparse scans keeps the turns the odometry saw. A folder without nodes
+  // (a peer's) is scored on its one trajectory.
   const bool have_nodes = fs::exists(nodes_path);
   const auto nodes = have_nodes ? io::readTum(nodes_path.string()) : estimate;
 
@@ -146,8 +148,13 @@ RunReport evaluateRun(const RunReportOptions& o) {
       if (m.used == 0) throw common::InputError(o.relations + ": no relation falls inside the run's time span (wrong dataset or offset?)");
       return r;
     };
-    j["relations"] = block(nodes, have_nodes ? nodes_path : traj_path);
-    if (have_nodes) j["relations_odometry"] = block(estimate, traj_path);
+    j["relations"] = block(have_nodes ? bridgeNodes(nodes, estimate) : estimate, have_nodes ? nodes_path : traj_path);
+    j["relations"]["interpolation"] = have_nodes ? "odometry" : "linear";
+    if (have_nodes) {
+      j["relations_linear"] = block(nodes, nodes_path);  // the nodes' chords, as Cartographer interpolates
+      j["relations_linear"]["interpolation"] = "linear";
+      j["relations_odometry"] = block(estimate, traj_path);
+    }
     common::Json& r = j[have_nodes ? "relations_odometry" : "relations"];
     // Where the odometry-time trajectory's error comes from: relations at scans, inside one
     // interval between scans (only the odometry there), and the rest; the three shares add up to

@@ -36,6 +36,15 @@ struct RelationMetrics {
 // or across a gap longer than max_gap_s.
 bool interpolatePose(const std::vector<io::StampedPose>& traj, double t, double max_gap_s, common::Pose2& out);
 
+// A run's nodes (the scans it placed) at every time of `dense` (its trajectory at odometry times)
+// inside the nodes' span, and at their own times. Between two nodes the pose follows dense's
+// shape: dense's motion carried forward from the earlier node and backward from the later one,
+// blended by time. So it equals each node at its time, and between nodes seconds apart it keeps
+// the turn the odometry saw instead of cutting the chord (linear interpolation, what nodes
+// without a dense companion get). Either input in any time order; times outside dense's span
+// are interpolated linearly.
+std::vector<io::StampedPose> bridgeNodes(const std::vector<io::StampedPose>& nodes, const std::vector<io::StampedPose>& dense);
+
 RelationMetrics relationMetrics(const std::vector<io::StampedPose>& traj, const std::vector<Relation>& rel, double time_offset_s,
                                 double max_gap_s = 1.0);
 
