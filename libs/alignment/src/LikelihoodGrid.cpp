@@ -58,25 +58,27 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
   // a block reaching past the edge sees the floor there). Most of a search's blocks are scored
   // at these levels, where an exact bound prunes most.
   const size_t w_ = static_cast<size_t>(width_), h_ = static_cast<size_t>(height_);
+  // Both passes write into one array: the row pass reads the level below, the column pass runs
+  // in place from the first row up (row b reads rows b and b + step, and row b + step is
+  // overwritten only later), so a level costs one array of memory traffic, not two.
   for (int k = 1; k <= std::min(levels, full_levels_); ++k) {
     const size_t step = static_cast<size_t>(1) << (k - 1);
     const Cells& prev = level_.back();
-    Cells rows(prev.size()), next(prev.size());  // every cell written below
+    Cells next(prev.size());  // every cell written below
     for (size_t b = 0; b < h_; ++b) {
       const float* src = prev.data() + b * w_;
-      float* dst = rows.data() + b * w_;
+      float* dst = next.data() + b * w_;
       const size_t n = w_ > step ? w_ - step : 0;
       for (size_t a = 0; a < n; ++a) dst[a] = std::max(src[a], src[a + step]);
       for (size_t a = n; a < w_; ++a) dst[a] = std::max(src[a], floor_);
     }
     for (size_t b = 0; b < h_; ++b) {
-      const float* r0 = rows.data() + b * w_;
       float* dst = next.data() + b * w_;
       if (b + step < h_) {
-        const float* r1 = rows.data() + (b + step) * w_;
-        for (size_t a = 0; a < w_; ++a) dst[a] = std::max(r0[a], r1[a]);
+        const float* r1 = next.data() + (b + step) * w_;
+        for (size_t a = 0; a < w_; ++a) dst[a] = std::max(dst[a], r1[a]);
       } else {
-        for (size_t a = 0; a < w_; ++a) dst[a] = std::max(r0[a], floor_);
+        for (size_t a = 0; a < w_; ++a) dst[a] = std::max(dst[a], floor_);
       }
     }
     level_.push_back(std::move(next));
