@@ -48,6 +48,13 @@ class Search {
     hi_y_ = trimmed(w.trim_m[3]);
     const Eigen::Vector2d t(prior.mean().x, prior.mean().y);
     const int64_t width = grid.levelWidth(0), pad = grid.pad();
+    // Every translation searched puts a point of cell c at c + (ox, oy), lo_ <= o <= hi_: inside
+    // the base array for all of them, outside every level's array for all of them (before its
+    // start, or past the top level's last block), or at the edge (checked per lookup). Outdoors
+    // the scan reaches past the submap's grid and most points are of the first two kinds.
+    const int top_block = 1 << grid.levels();
+    const int64_t reach_w = (grid.levelWidth(0) + top_block - 1) / top_block * top_block;
+    const int64_t reach_h = (grid.levelHeight(0) + top_block - 1) / top_block * top_block;
     for (int a = -k; a <= k; ++a) {
       const double dphi = a * step_, phi = prior.mean().phi + dphi;
       const Eigen::Matrix2d R = Eigen::Rotation2Dd(phi).toRotationMatrix();
@@ -56,12 +63,16 @@ class Search {
       h.linear.reserve(points.size());
       for (const auto& p : points) {
         const Eigen::Vector2i c = grid.cellOf(R * p + t);
-        h.cells.push_back(c);
-        h.linear.push_back((c.y() + pad) * width + c.x() + pad);
-        h.min_x = std::min(h.min_x, c.x());
-        h.max_x = std::max(h.max_x, c.x());
-        h.min_y = std::min(h.min_y, c.y());
-        h.max_y = std::max(h.max_y, c.y());
+        const int64_t x0 = c.x() + lo_x_ + pad, x1 = static_cast<int64_t>(c.x()) + hi_x_ + pad;
+        const int64_t y0 = c.y() + lo_y_ + pad, y1 = static_cast<int64_t>(c.y()) + hi_y_ + pad;
+        if (x1 < 0 || y1 < 0 || x0 >= reach_w || y0 >= reach_h) {
+          ++h.outside;
+        } else if (x0 >= 0 && y0 >= 0 && x1 < width && y1 < grid.levelHeight(0)) {
+          h.cells.push_back(c);
+          h.linear.push_back((c.y() + pad) * width + c.x() + pad);
+        } else {
+          h.edge.push_back(c);
+        }
       }
       dphi_.push_back(dphi);
       headings_.push_back(std::move(h));
@@ -100,30 +111,48 @@ class Search {
     const float* values = grid_.levelData(level);
     const int w = grid_.levelWidth(level), h = grid_.levelHeight(level), pad = grid_.pad();
     const int shift = grid_.shiftOf(level);
-    double sum = 0;
-    // Every point of the block's lowest corner inside the level's array (the block's other
-    // poses are in its values): no per-point checks, and at full resolution one addition per
-    // point. Most blocks of a search are such.
-    const bool inside = !hd.cells.empty() && hd.min_x + ox + pad >= 0 && hd.min_y + oy + pad >= 0 && ((hd.max_x + ox + pad) >> shift) < w &&
-                        ((hd.max_y + oy + pad) >> shift) < h;
-    if (inside && shift == 0) {
-      const int64_t offset = static_cast<int64_t>(oy) * w + ox;
-      for (const int64_t i : hd.linear) sum += values[i + offset];
-    } else if (inside) {
-      for (const auto& c : hd.cells)
-        sum += values[static_cast<size_t>((c.y() + oy + pad) >> shift) * static_cast<size_t>(w) +
-                      static_cast<size_t>((c.x() + ox + pad) >> shift)];
-    } else {
-      const float floor = grid_.floorValue();
-      for (const auto& c : hd.cells) {
-        const int i = c.x() + ox + pad, j = c.y() + oy + pad;
-        if (i < 0 || j < 0) {
-          sum += floor;
-          continue;
-        }
-        const int ia = i >> shift, ja = j >> shift;
-        sum += (ia >= w || ja >= h) ? floor : values[static_cast<size_t>(ja) * static_cast<size_t>(w) + static_cast<size_t>(ia)];
+    const float floor = grid_.floorValue();
+    double sum = static_cast<double>(hd.outside) * floor;
+    // The points inside at every translation: no per-point checks, and at full resolution one
+    // addition per point.
+    if (shift == 0) {
+      // Four running sums: one chain of dependent additions would wait on each before the next.
+      const float* base = values + static_cast<int64_t>(oy) * w + ox;
+      const int64_t* idx = hd.linear.data();
+      const size_t n = hd.linear.size(), n4 = n & ~static_cast<size_t>(3);
+      double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+      for (size_t k = 0; k < n4; k += 4) {
+        s0 += base[idx[k]];
+        s1 += base[idx[k + 1]];
+        s2 += base[idx[k + 2]];
+        s3 += base[idx[k + 3]];
       }
+      for (size_t k = n4; k < n; ++k) s0 += base[idx[k]];
+      sum += (s0 + s1) + (s2 + s3);
+    } else {
+      const auto at = [&](const Eigen::Vector2i& c) {
+        return values[static_cast<size_t>((c.y() + oy + pad) >> shift) * static_cast<size_t>(w) + static_cast<size_t>((c.x() + ox + pad) >> shift)];
+      };
+      const Eigen::Vector2i* cells = hd.cells.data();
+      const size_t n = hd.cells.size(), n4 = n & ~static_cast<size_t>(3);
+      double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+      for (size_t k = 0; k < n4; k += 4) {
+        s0 += at(cells[k]);
+        s1 += at(cells[k + 1]);
+        s2 += at(cells[k + 2]);
+        s3 += at(cells[k + 3]);
+      }
+      for (size_t k = n4; k < n; ++k) s0 += at(cells[k]);
+      sum += (s0 + s1) + (s2 + s3);
+    }
+    for (const auto& c : hd.edge) {
+      const int i = c.x() + ox + pad, j = c.y() + oy + pad;
+      if (i < 0 || j < 0) {
+        sum += floor;
+        continue;
+      }
+      const int ia = i >> shift, ja = j >> shift;
+      sum += (ia >= w || ja >= h) ? floor : values[static_cast<size_t>(ja) * static_cast<size_t>(w) + static_cast<size_t>(ia)];
     }
     if (flat_prior_) return sum + flat_log_density_;
     const int last = std::min(hi_x_, ox + (1 << level) - 1), last_y = std::min(hi_y_, oy + (1 << level) - 1);
@@ -167,13 +196,13 @@ class Search {
     }
   }
 
-  // The scan's cells at one heading with the prior's mean as the translation, their linear
-  // indices in the full-resolution levels, and their bounding box.
+  // The scan's cells at one heading with the prior's mean as the translation: those inside the
+  // grid at every translation searched (and their linear indices in the full-resolution levels),
+  // those at its edge, and how many fall outside at every translation (the floor each).
   struct Heading {
-    std::vector<Eigen::Vector2i> cells;
+    std::vector<Eigen::Vector2i> cells, edge;
     std::vector<int64_t> linear;
-    int min_x = std::numeric_limits<int>::max(), max_x = std::numeric_limits<int>::min();
-    int min_y = std::numeric_limits<int>::max(), max_y = std::numeric_limits<int>::min();
+    size_t outside = 0;
   };
   const LikelihoodGrid& grid_;
   const MotionPrior& prior_;

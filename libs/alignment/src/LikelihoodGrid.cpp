@@ -39,15 +39,32 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
   for (const auto& sp : reference) {
     if (std::abs(sp.p.x() - centre.x()) > o.max_radius_m || std::abs(sp.p.y() - centre.y()) > o.max_radius_m) continue;
     const Eigen::Vector2i c = cellOf(sp.p);
-    for (int j = c.y() - r; j <= c.y() + r; ++j)
-      for (int i = c.x() - r; i <= c.x() + r; ++i) {
-        const int a = i + pad_, b = j + pad_;
-        if (a < 0 || b < 0 || a >= width_ || b >= height_) continue;
-        const Eigen::Vector2d cell_centre = origin_ + resolution_ * Eigen::Vector2d(i + 0.5, j + 0.5);
-        const float v = table[static_cast<size_t>(std::min<double>(kTable, (cell_centre - sp.p).squaredNorm() * to_index + 0.5))];
-        float& dst = base[static_cast<size_t>(b) * static_cast<size_t>(width_) + static_cast<size_t>(a)];
-        dst = std::max(dst, v);
+    // The stamp's cells inside the array, and each column's and row's squared offset once.
+    const int i0 = std::max(c.x() - r, -pad_), i1 = std::min(c.x() + r, width_ - 1 - pad_);
+    const int j0 = std::max(c.y() - r, -pad_), j1 = std::min(c.y() + r, height_ - 1 - pad_);
+    if (i0 > i1 || j0 > j1) continue;
+    double dx2[64];  // 2r + 1 <= 64 columns (checked below)
+    const bool small = i1 - i0 < 64;
+    if (small)
+      for (int i = i0; i <= i1; ++i) {
+        const double dx = (origin_.x() + resolution_ * (i + 0.5)) - sp.p.x();
+        dx2[i - i0] = dx * dx;
       }
+    for (int j = j0; j <= j1; ++j) {
+      const double dy = (origin_.y() + resolution_ * (j + 0.5)) - sp.p.y(), dy2 = dy * dy;
+      float* row = base.data() + static_cast<size_t>(j + pad_) * static_cast<size_t>(width_) + static_cast<size_t>(pad_);
+      for (int i = i0; i <= i1; ++i) {
+        double d2x;
+        if (small) {
+          d2x = dx2[i - i0];
+        } else {
+          const double dx = (origin_.x() + resolution_ * (i + 0.5)) - sp.p.x();
+          d2x = dx * dx;
+        }
+        const float v = table[static_cast<size_t>(std::min<double>(kTable, (d2x + dy2) * to_index + 0.5))];
+        row[i] = std::max(row[i], v);
+      }
+    }
   }
   level_.push_back(std::move(base));
   // Level h from level h-1 by doubling: the block of 2^h starting at (i, j) is four blocks of
@@ -88,10 +105,25 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
   // the largest value of each aligned block of 2^h cells (from the four blocks of the level
   // below), and the stored value is the largest over two blocks on each axis, which covers every
   // block of 2^h cells starting inside block I: a looser bound for a quarter of the memory.
+  // The aligned blocks' maxima up to the last full-resolution level are that level's values at
+  // every 2^k-th cell (the block starting there; every value is at least the floor, so the floor
+  // past the edge changes no maximum): read off it instead of another pass over the base.
+  const int full = std::min(levels, full_levels_);
   Cells block_max;
-  const Cells* src = &level_.front();  // the block maxima of the level below (the base at first)
   int bw = width_, bh = height_;
-  for (int k = 1; k <= levels; ++k) {
+  if (full > 0) {
+    const int nw = (width_ + (1 << full) - 1) >> full, nh = (height_ + (1 << full) - 1) >> full;
+    const Cells& lv = level_[static_cast<size_t>(full)];
+    block_max.resize(static_cast<size_t>(nw) * static_cast<size_t>(nh));
+    for (int b = 0; b < nh; ++b)
+      for (int a = 0; a < nw; ++a)
+        block_max[static_cast<size_t>(b) * static_cast<size_t>(nw) + static_cast<size_t>(a)] =
+            lv[(static_cast<size_t>(b) << full) * w_ + (static_cast<size_t>(a) << full)];
+    bw = nw;
+    bh = nh;
+  }
+  const Cells* src = full > 0 ? &block_max : &level_.front();  // the block maxima of the level below
+  for (int k = full + 1; k <= levels; ++k) {
     const int nw = (bw + 1) / 2, nh = (bh + 1) / 2;
     Cells next(static_cast<size_t>(nw) * static_cast<size_t>(nh));  // every cell written below
     const auto at = [&](int a, int b) {
