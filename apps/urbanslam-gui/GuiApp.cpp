@@ -8,6 +8,7 @@
 #include <string>
 
 #include "MainFrame.h"
+#include "urbanslam/common/Heap.h"
 
 namespace {
 
@@ -97,6 +98,7 @@ class GuiApp : public wxApp {
 wxIMPLEMENT_APP_NO_MAIN(GuiApp);
 
 int main(int argc, char** argv) {
+  urbanslam::common::keepFreedBuffers();
   // --help before wx starts: wx's GTK initialisation fails without a display (exit 255), and the
   // help must not need one.
   for (int i = 1; i < argc; ++i) {

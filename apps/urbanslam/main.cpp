@@ -7,6 +7,7 @@
 
 #include "Commands.h"
 #include "urbanslam/common/Error.h"
+#include "urbanslam/common/Heap.h"
 
 namespace {
 
@@ -27,6 +28,7 @@ void printUsage() {
 
 int main(int argc, char** argv) {
   using namespace urbanslam;
+  common::keepFreedBuffers();
   if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") || !std::strcmp(argv[1], "help")) {
     printUsage();
     return argc < 2 ? common::kExitBadInput : 0;

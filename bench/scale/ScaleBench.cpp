@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "urbanslam/common/Error.h"
+#include "urbanslam/common/Heap.h"
 #include "urbanslam/common/Json.h"
 #include "urbanslam/common/Timing.h"
 #include "urbanslam/laser_loop/LinePlot.h"
@@ -58,6 +59,7 @@ double cpuSeconds() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  urbanslam::common::keepFreedBuffers();  // as the urbanslam command does
   std::string city, log, ini = std::string(URBANSLAM_SOURCE_DIR) + "/ini/default.ini", out;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
