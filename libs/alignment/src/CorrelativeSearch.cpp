@@ -74,6 +74,7 @@ class Search {
           h.edge.push_back(c);
         }
       }
+      h.prior = prior.headingTerms(dphi);
       dphi_.push_back(dphi);
       headings_.push_back(std::move(h));
     }
@@ -156,7 +157,7 @@ class Search {
     }
     if (flat_prior_) return sum + flat_log_density_;
     const int last = std::min(hi_x_, ox + (1 << level) - 1), last_y = std::min(hi_y_, oy + (1 << level) - 1);
-    const double m2 = prior_.minMahalanobis2(ox * r_, last * r_, oy * r_, last_y * r_, dphi_[static_cast<size_t>(a)]);
+    const double m2 = prior_.minMahalanobis2(hd.prior, ox * r_, last * r_, oy * r_, last_y * r_);
     return sum + prior_.logDensity(m2);
   }
 
@@ -203,6 +204,7 @@ class Search {
     std::vector<Eigen::Vector2i> cells, edge;
     std::vector<int64_t> linear;
     size_t outside = 0;
+    MotionPrior::HeadingTerms prior;  // the prior's bound's terms at this heading
   };
   const LikelihoodGrid& grid_;
   const MotionPrior& prior_;

@@ -33,16 +33,28 @@ double MotionPrior::gaussianWeight(double m2) const {
   return 1.0 / (1.0 + std::exp(log_uniform_ - g));
 }
 
+MotionPrior::HeadingTerms MotionPrior::headingTerms(double dphi) const {
+  HeadingTerms h;
+  h.b = information_.topRightCorner<2, 1>() * dphi;
+  h.c = information_(2, 2) * dphi * dphi;
+  h.u = -position_ldlt_.solve(h.b);
+  return h;
+}
+
 double MotionPrior::minMahalanobis2(double dx0, double dx1, double dy0, double dy1, double dphi) const {
+  return minMahalanobis2(headingTerms(dphi), dx0, dx1, dy0, dy1);
+}
+
+double MotionPrior::minMahalanobis2(const HeadingTerms& h, double dx0, double dx1, double dy0, double dy1) const {
   // q(u) = u' A u + 2 b' u + c over u = (dx, dy) with the heading fixed.
   const Eigen::Matrix2d A = information_.topLeftCorner<2, 2>();
-  const Eigen::Vector2d b = information_.topRightCorner<2, 1>() * dphi;
-  const double c = information_(2, 2) * dphi * dphi;
+  const Eigen::Vector2d& b = h.b;
+  const double c = h.c;
   const auto q = [&](double x, double y) {
     return A(0, 0) * x * x + 2 * A(0, 1) * x * y + A(1, 1) * y * y + 2 * (b(0) * x + b(1) * y) + c;
   };
   // The unconstrained minimum, when it lies inside the rectangle.
-  const Eigen::Vector2d u = -position_ldlt_.solve(b);
+  const Eigen::Vector2d& u = h.u;
   if (u(0) >= dx0 && u(0) <= dx1 && u(1) >= dy0 && u(1) <= dy1) return std::max(0.0, q(u(0), u(1)));
   // Otherwise on an edge: a 1D convex quadratic on each, minimised by clamping.
   double best = std::numeric_limits<double>::infinity();

@@ -35,6 +35,15 @@ class MotionPrior {
   // lies in [dx0, dx1] x [dy0, dy1] with heading difference dphi (exact: a convex quadratic
   // minimised over a rectangle). Bounds the density of a whole block of candidate poses.
   double minMahalanobis2(double dx0, double dx1, double dy0, double dy1, double dphi) const;
+  // The same in two steps, for a search that bounds many blocks at each of a few headings: what
+  // depends on the heading alone (the quadratic's linear and constant terms, its unconstrained
+  // minimum), then the rectangle.
+  struct HeadingTerms {
+    Eigen::Vector2d b, u;
+    double c = 0;
+  };
+  HeadingTerms headingTerms(double dphi) const;
+  double minMahalanobis2(const HeadingTerms& h, double dx0, double dx1, double dy0, double dy1) const;
 
  private:
   common::Pose2 mean_;
