@@ -63,6 +63,8 @@
 #   wall_s / rtf     wall-clock time of the SLAM process (not the conversion) and the real-time
 #                    factor (log duration / wall). The machine is shared and the peers run niced,
 #                    so these are indicative;
+#   cpu_s / rtf_1cpu CPU time (user + system, every thread) of the SLAM process and the log
+#                    duration over it: the real-time factor on one core;
 #   status           ok, failed (exit code and the first error line of OUT_DIR/<dataset>/<system>.out),
 #                    timeout, or no-eval (the run finished but eval could not score its output).
 # The same table, tab-separated with empty cells for "-", is written to OUT_DIR/results.tsv.
@@ -238,11 +240,11 @@ PY
 
 # One row of the table (stdout) and of results.tsv.
 TSV=$OUT/results.tsv
-COLS=(dataset system rel_n rel_m rel_sd sq_m2 sq_sd rot_deg ate_m loops false wall_s rtf status)
-row() {  # dataset system status wall duration eval.json|- block stats.json|-
+COLS=(dataset system rel_n rel_m rel_sd sq_m2 sq_sd rot_deg ate_m loops false wall_s rtf cpu_s rtf_1cpu status)
+row() {  # dataset system status wall cpu duration eval.json|- block stats.json|-
   python3 - "$TSV" "$@" <<'PY'
 import json, os, sys
-tsv, name, system, status, wall, dur, ev, block, stats = sys.argv[1:10]
+tsv, name, system, status, wall, cpu, dur, ev, block, stats = sys.argv[1:11]
 j = json.load(open(ev)) if ev != '-' and os.path.exists(ev) else {}
 r = j.get(block, {})
 main = system in ('urbanslam', 'icp-slam', 'rbpf-slam')
@@ -253,13 +255,15 @@ if system == 'urbanslam':
     if loops is None and stats != '-' and os.path.exists(stats):
         loops = json.load(open(stats)).get('counts', {}).get('loop_closures_accepted')
 num = lambda v: float(v) if v not in ('', '-', None) else None
-wall, dur = num(wall), num(dur)
+wall, cpu, dur = num(wall), num(cpu), num(dur)
 rtf = dur / wall if wall and dur and main and status == 'ok' else None
+rtf1 = dur / cpu if cpu and dur and main and status == 'ok' else None
 vals = [r.get('used'), r.get('abs_trans_mean_m'), r.get('abs_trans_std_m'), r.get('sqr_trans_mean_m2'),
-        r.get('sqr_trans_std_m2'), r.get('abs_rot_mean_deg'), ate, loops, false, wall if main else None, rtf]
-fmts = ['%d', '%.4f', '%.4f', '%.5f', '%.5f', '%.3f', '%.3f', '%d', '%d', '%.1f', '%.1f']
+        r.get('sqr_trans_std_m2'), r.get('abs_rot_mean_deg'), ate, loops, false, wall if main else None, rtf,
+        cpu if main else None, rtf1]
+fmts = ['%d', '%.4f', '%.4f', '%.5f', '%.5f', '%.3f', '%.3f', '%d', '%d', '%.1f', '%.1f', '%.1f', '%.1f']
 cells = [(f % v) if v is not None else '-' for f, v in zip(fmts, vals)]
-widths = [6, 8, 7, 9, 8, 8, 8, 6, 6, 8, 7]
+widths = [6, 8, 7, 9, 8, 8, 8, 6, 6, 8, 7, 7, 8]
 print(f"{name:14s} {system:15s} " + ' '.join(c.rjust(w) for c, w in zip(cells, widths)) + f"  {status}")
 with open(tsv, 'a') as o:
     o.write('\t'.join([name, system] + [c if c != '-' else '' for c in cells] + [status]) + '\n')
@@ -267,14 +271,16 @@ PY
 }
 
 now() { date +%s.%N; }
-# Runs "$@" under the time limit; sets RC (0 ok, 124 timeout) and WALL.
+# Runs "$@" under the time limit; sets RC (0 ok, 124 timeout), WALL and CPU (user + system time
+# of the process and its children: what one core would need).
 timed() {
   local t0 t1
   t0=$(now)
   RC=0
-  timeout --kill-after=30 "$TIME_LIMIT" "$@" || RC=$?
+  timeout --kill-after=30 "$TIME_LIMIT" /usr/bin/time -f "%U %S" -o "$OUT/.cpu" "$@" || RC=$?
   t1=$(now)
   WALL=$(python3 -c "print($t1 - $t0)")
+  CPU=$(awk 'NF == 2 && $1 ~ /^[0-9.]+$/ { c = $1 + $2 } END { if (c != "") print c; else print "-" }' "$OUT/.cpu" 2>/dev/null || echo -)
 }
 status_of() {  # exit_code console_output (after timed: WALL)
   case $1 in
@@ -294,7 +300,7 @@ peer() {
 }
 
 (IFS=$'\t'; echo "${COLS[*]}") > "$TSV"
-printf "%-14s %-15s %6s %8s %7s %9s %8s %8s %8s %6s %6s %8s %7s  %s\n" dataset system rel_n rel_m ±sd sq_m2 ±sd rot_deg ate_m loops false wall_s rtf status
+printf "%-14s %-15s %6s %8s %7s %9s %8s %8s %8s %6s %6s %8s %7s %7s %8s  %s\n" dataset system rel_n rel_m ±sd sq_m2 ±sd rot_deg ate_m loops false wall_s rtf cpu_s rtf_1cpu status
 # A peer on the dataset's peer rawlog with its ini (FOLDER/NAME.ini), its trajectory made into
 # FOLDER/trajectory_odometry.tum by TUM_FN FOLDER TUM_ARG, scored, and its row printed. Uses the
 # loop's $o, $name, $dur and $can_eval.
@@ -307,7 +313,7 @@ run_peer() {  # name folder tum_fn tum_arg
     if evaluate "$p" "$o/$sys.eval.json"; then ev=$o/$sys.eval.json
     elif [[ $can_eval == 1 ]]; then st=no-eval; fi
   fi
-  row "$name" "$sys" "$st" "$WALL" "$dur" "$ev" relations -
+  row "$name" "$sys" "$st" "$WALL" "$CPU" "$dur" "$ev" relations -
 }
 
 for d in "${datasets[@]}"; do
@@ -340,9 +346,9 @@ for d in "${datasets[@]}"; do
       if evaluate "$o/urbanslam" "$o/urbanslam.eval.json"; then ev=$o/urbanslam.eval.json
       elif [[ $can_eval == 1 ]]; then st=no-eval; fi
     fi
-    row "$name" urbanslam "$st" "$WALL" "$dur" "$ev" relations "$o/urbanslam/stats.json"
+    row "$name" urbanslam "$st" "$WALL" "$CPU" "$dur" "$ev" relations "$o/urbanslam/stats.json"
     if [[ $ev != - ]] && python3 -c "import json,sys; sys.exit('relations_odometry' not in json.load(open('$ev')))"; then
-      row "$name" urbanslam@odom "$st" "$WALL" "$dur" "$ev" relations_odometry -
+      row "$name" urbanslam@odom "$st" "$WALL" "$CPU" "$dur" "$ev" relations_odometry -
     fi
   fi
   want icp-slam "$SYSTEMS" || want rbpf-slam "$SYSTEMS" || continue
@@ -355,7 +361,7 @@ for d in "${datasets[@]}"; do
   if ! $U convert "$src" "$o/peer.rawlog" --layout frames --quiet > "$o/convert.out" 2>&1 ||
      ! rawlog-edit --list-timestamps -i "$o/peer.rawlog" --text-file-output "$o/peer.timestamps.txt" -q > /dev/null 2>&1; then
     for s in icp-slam rbpf-slam; do
-      want $s "$SYSTEMS" && row "$name" $s "failed (no peer rawlog: $(tail -1 "$o/convert.out" | cut -c1-60))" - - - relations -
+      want $s "$SYSTEMS" && row "$name" $s "failed (no peer rawlog: $(tail -1 "$o/convert.out" | cut -c1-60))" - - - - relations -
     done
     continue
   fi

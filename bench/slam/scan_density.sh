@@ -8,12 +8,13 @@
 #               backward from the later one, blended by time) at every odometry time, scored
 #               by `urbanslam eval`: the effect of density alone;
 #   rerun       `urbanslam run` on the log with the other scans relabelled RLASER, which the ini
-#               does not use (the odometry is untouched): what the system makes of it, scored two
-#               ways: rerun_m on its nodes interpolated linearly at the relation times (eval's
-#               main figure, as Cartographer scores itself; with nodes seconds apart its floor is
-#               high: the full run's own poses at one scan in 15 score 0.1465 m so), rerun_odo_m on its
-#               trajectory at odometry times (the nodes bridged by the odometry, as same_poses
-#               bridges them); ATE against run_datasets.sh's reference (the corrected log's poses
+#               does not use (the odometry is untouched): what the system makes of it, scored
+#               three ways: rerun_m, eval's main figure, on its nodes bridged along its
+#               trajectory at odometry times (as same_poses bridges them); rerun_lin_m on its
+#               nodes interpolated linearly at the relation times (Cartographer's interpolation:
+#               with nodes seconds apart it cuts the turns, and the full run's own poses at one
+#               scan in 15 score about 0.146 m so); rerun_odo_m on its trajectory at odometry
+#               times itself; ATE against run_datasets.sh's reference (the corrected log's poses
 #               at the raw log's times).
 #
 #   bench/slam/scan_density.sh [BUILD_DIR] [OUT_DIR]
@@ -94,7 +95,7 @@ PY
 
 mkdir -p "$OUT/fr079/density"
 echo "FR079 raw log, keeping 1 scan in k (Intel's corrected log: 1 in 15 of the raw log's)"
-echo " k  scans  relations  same_poses_m  rerun_m  rerun_odo_m  rerun_ate_m  rerun_loops"
+echo " k  scans  relations  same_poses_m  rerun_m  rerun_lin_m  rerun_odo_m  rerun_ate_m  rerun_loops"
 for k in "${KS[@]}"; do
   sp=$OUT/fr079/density/same$k
   n=$(same_poses "$run/trajectory_scans.tum" "$dr/trajectory_odometry.tum" "$k" "$sp")
@@ -113,9 +114,10 @@ for k in "${KS[@]}"; do
 import json, sys
 k, n, same_ev, ev = sys.argv[1:5]
 s = json.load(open(same_ev))['relations']; used, same = s['used'], s['abs_trans_mean_m']
-j = json.load(open(ev)); r = j['relations']; ro = j.get('relations_odometry', r)
+j = json.load(open(ev)); r = j['relations']; ro = j.get('relations_odometry', r); rl = j.get('relations_linear', r)
 ate = j.get('ate_rmse_m'); loops = j.get('loops_accepted')
-print(f"{int(k):2d} {int(n):6d} {int(used):10d} {float(same):13.4f} {r['abs_trans_mean_m']:8.4f} {ro['abs_trans_mean_m']:12.4f} "
+print(f"{int(k):2d} {int(n):6d} {int(used):10d} {float(same):13.4f} {r['abs_trans_mean_m']:8.4f} {rl['abs_trans_mean_m']:12.4f} "
+      f"{ro['abs_trans_mean_m']:12.4f} "
       f"{(f'{ate:12.3f}' if ate is not None else '           -')} {(f'{loops:12d}' if loops is not None else '           -')}")
 PY
 done
