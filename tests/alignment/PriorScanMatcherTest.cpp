@@ -222,6 +222,34 @@ TEST(PriorScanMatcher, ClearScanMatchBeatsWrongOdometry) {
   }
 }
 
+TEST(PriorScanMatcher, ReversingSinceAnAnchorIsFoundWithinTheAnchorsReach) {
+  // A scan between keyframes: the odometry says +0.5 m since the keyframe, an earlier scan was
+  // matched at +0.4 m, and since then the vehicle reversed 0.1 m instead of going on 0.1 m. The
+  // reach from the anchor (0.1 m to it plus 0.1 m of travel) finds it as the whole increment's
+  // twice 0.5 m does, in a window a third as wide.
+  const Eigen::Matrix3d cov = Eigen::Vector3d(0.025 * 0.025, 0.025 * 0.025, 1e-4).asDiagonal();
+  const common::Pose2 truth{0.3, 0.0, 0.0}, odometry{0.5, 0.0, 0.0};
+  PriorMatcherOptions o;
+  o.search_window_m = 0.3;
+  const MatchReference ref(scanPoints(test::roomWorld(), {0, 0, 0}), Eigen::Vector2d::Zero(), o);
+  const PointSet scan = scanPoints(test::roomWorld(), truth, 11);
+  const PriorMatchResult whole = matchWithPrior(ref, scan, odometry, cov, o);
+  o.direction_reach_m = 0.1 + 0.1;
+  const PriorMatchResult chained = matchWithPrior(ref, scan, odometry, cov, o);
+  for (const PriorMatchResult* r : {&whole, &chained}) {
+    ASSERT_TRUE(r->valid) << r->failure_reason;
+    EXPECT_NEAR(r->pose.x, truth.x, 0.02);
+    EXPECT_NEAR(r->pose.y, truth.y, 0.02);
+    EXPECT_NEAR(r->pose.phi, truth.phi, 0.005);
+  }
+  EXPECT_LT(chained.search_nodes, whole.search_nodes);
+  // A reach that stops short of the truth cannot find it.
+  o.direction_reach_m = 0.0;
+  o.search_window_m = 0.1;
+  const PriorMatchResult too_short = matchWithPrior(ref, scan, odometry, cov, o);
+  EXPECT_GT(std::abs(too_short.search_pose.x - truth.x), 0.05);
+}
+
 TEST(PriorScanMatcher, CorridorKeepsTheOdometryAlongItsAxis) {
   // Nothing in a straight corridor says how far the vehicle went: the odometry decides along x
   // (with its own uncertainty), the walls decide y and the heading.

@@ -72,9 +72,10 @@ PriorMatchResult matchWithPrior(const MatchReference& reference, const PointSet&
   CorrelativeWindow window;
   // The uniform share stands for odometry that is wrong in direction, not only in size (reversing
   // reported as driving forwards): the vehicle is anywhere within the travelled distance of where
-  // it started, up to twice that from the odometry's pose.
-  const double travel = std::hypot(prior_mean.x, prior_mean.y);
-  window.half_width_m = std::min(o.max_search_window_m, std::max({o.search_window_m, 3 * sxy, 2 * travel}));
+  // it started, up to twice that from the odometry's pose (or as far as the caller knows it to be,
+  // o.direction_reach_m).
+  const double reach = o.direction_reach_m >= 0 ? o.direction_reach_m : 2 * std::hypot(prior_mean.x, prior_mean.y);
+  window.half_width_m = std::min(o.max_search_window_m, std::max({o.search_window_m, 3 * sxy, reach}));
   window.half_angle_rad = std::min(o.max_search_window_deg, std::max(o.search_window_deg, 3 * sphi * 180 / M_PI)) * M_PI / 180;
   const double volume = 4 * window.half_width_m * window.half_width_m * 2 * window.half_angle_rad;
   const MotionPrior prior(prior_mean, prior_cov, o.odometry_outlier_probability, volume);

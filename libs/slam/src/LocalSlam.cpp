@@ -63,14 +63,24 @@ KeyframeConstraint LocalSlam::keyframeConstraint(const io::LaserScan& scan) cons
   return c;
 }
 
-std::optional<ScanAnchor> LocalSlam::placeScan(const io::LaserScan& scan) {
+std::optional<ScanAnchor> LocalSlam::placeScan(const io::LaserScan& scan, const ScanAnchor* previous) {
   if (!options_.scan_matching || !options_.match_every_scan || scan.ranges.empty() || !last_keyframe_has_scan_) return std::nullopt;
   if (have_anchor_ && std::abs(scan.timestamp - last_anchor_time_) < options_.match_min_interval_s) return std::nullopt;
   // Its pose in the last keyframe's frame, for the trajectory at sensor times only (the filter
   // keeps one pose per keyframe).
   Eigen::Matrix3d cov = motion_.covariance();
   cov.diagonal() += Eigen::Vector3d(1e-8, 1e-8, 1e-10);
-  const alignment::PriorMatchResult r = matchSubmap(scan, motion_.increment(), cov);
+  // The vehicle was at the newest anchor: from the odometry's pose, odometry wrong in direction
+  // can have put it as far as that anchor plus the odometry's travel since (as the whole
+  // increment's twice its travel does for the first scan after a keyframe, whose anchor is the
+  // keyframe itself).
+  double reach = -1;
+  if (previous && previous->keyframe + 1 == keyframes_) {
+    const common::Pose2& z = motion_.increment();
+    const common::Pose2 since = common::between(previous->odom, motion_.odometryPose());
+    reach = std::hypot(z.x - previous->offset.x, z.y - previous->offset.y) + std::hypot(since.x, since.y);
+  }
+  const alignment::PriorMatchResult r = matchSubmap(scan, motion_.increment(), cov, reach);
   if (!r.valid) return std::nullopt;
   last_anchor_time_ = scan.timestamp;
   have_anchor_ = true;
@@ -113,8 +123,9 @@ void LocalSlam::correctSubmap(const SubmapEstimate& e) {
   for (const auto& [i, p] : moved) local_poses_[i] = p;
 }
 
-alignment::PriorMatchResult LocalSlam::matchSubmap(const io::LaserScan& scan, const common::Pose2& z, const Eigen::Matrix3d& cov) const {
-  return submap_.match(scan, z, cov, submapPoses());
+alignment::PriorMatchResult LocalSlam::matchSubmap(const io::LaserScan& scan, const common::Pose2& z, const Eigen::Matrix3d& cov,
+                                                   double direction_reach_m) const {
+  return submap_.match(scan, z, cov, submapPoses(), direction_reach_m);
 }
 
 }  // namespace urbanslam::slam

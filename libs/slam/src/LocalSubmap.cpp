@@ -61,7 +61,7 @@ const alignment::MatchReference* LocalSubmap::reference(const std::vector<common
 }
 
 alignment::PriorMatchResult LocalSubmap::match(const io::LaserScan& scan, const common::Pose2& prior, const Eigen::Matrix3d& prior_cov,
-                                               const std::vector<common::Pose2>& poses) const {
+                                               const std::vector<common::Pose2>& poses, double direction_reach_m) const {
   alignment::PriorMatchResult none;
   none.pose = prior;
   none.cov = prior_cov;
@@ -77,6 +77,7 @@ alignment::PriorMatchResult LocalSubmap::match(const io::LaserScan& scan, const 
   alignment::PriorMatcherOptions options = matcher_;
   options.seen_through_rate = seen_through_.rate();
   options.seen_through_rate_displaced = seen_through_displaced_.rate();
+  options.direction_reach_m = direction_reach_m;
   const alignment::PriorMatchResult r = alignment::matchWithPrior(*ref, points(scan), prior, prior_cov, options);
   if (r.valid && !r.odometry_outvoted) {
     seen_through_.add(r.in_view, r.seen_through);

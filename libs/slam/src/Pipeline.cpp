@@ -182,7 +182,7 @@ void Pipeline::onScan(io::LaserScan scan, double progress) {
     common::Stopwatch kw;
     addKeyframe(std::move(scan));
     stats_.keyframe_ms.push_back(kw.milliseconds() - waitedMs());
-  } else if (const auto anchor = local_.placeScan(scan)) {
+  } else if (const auto anchor = local_.placeScan(scan, map_.lastAnchor())) {
     ++stats_.scans_anchored;
     map_.addAnchor(*anchor);
   }

@@ -53,6 +53,10 @@ struct PriorMatcherOptions {
   double max_search_window_m = 3.0;  // the prior's 3σ widens the window up to this
   double max_search_window_deg = 90.0;
   double odometry_outlier_probability = 1e-4;  // the prior's uniform share (MotionPrior.h)
+  // How far from the prior's mean odometry that is wrong in direction (reversing reported as
+  // driving forwards) can have put the vehicle: the window reaches at least this far. < 0: twice
+  // the prior mean's distance from the reference's origin (the motion started there).
+  double direction_reach_m = -1;
   // The share of points in view that the other side saw through at the true pose, and at poses
   // displaced from it by displacement_m and displacement_deg (step 2'); 0: step 2' off.
   double seen_through_rate = 0.05;

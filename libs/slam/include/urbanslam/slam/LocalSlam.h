@@ -41,8 +41,10 @@ class LocalSlam {
   // The constraint for a new keyframe at `scan` from the last one.
   KeyframeConstraint keyframeConstraint(const io::LaserScan& scan) const;
   // A scan between keyframes placed by its submap match, relative to the last keyframe; none
-  // when not matched (disabled, too soon after the last anchor, or no valid match).
-  std::optional<ScanAnchor> placeScan(const io::LaserScan& scan);
+  // when not matched (disabled, too soon after the last anchor, or no valid match). `previous`:
+  // the map's newest anchor (the last keyframe or a scan matched since): the vehicle was there,
+  // so odometry wrong in direction can only have misled it since (the search's reach).
+  std::optional<ScanAnchor> placeScan(const io::LaserScan& scan, const ScanAnchor* previous);
   // Keyframes so far (the index the next one gets).
   size_t keyframes() const { return keyframes_; }
   // `scan` became the newest keyframe, `z` the constraint from the previous one that global SLAM
@@ -62,7 +64,8 @@ class LocalSlam {
   void readState(common::BinaryReader& r);
 
  private:
-  alignment::PriorMatchResult matchSubmap(const io::LaserScan& scan, const common::Pose2& z, const Eigen::Matrix3d& cov) const;
+  alignment::PriorMatchResult matchSubmap(const io::LaserScan& scan, const common::Pose2& z, const Eigen::Matrix3d& cov,
+                                          double direction_reach_m = -1) const;
 
   KeyframeOptions keyframe_options_;
   LocalOptions options_;

@@ -32,8 +32,9 @@ class LocalSubmap {
   // The scan's pose in the newest keyframe's frame, from the prior (the odometry since that
   // keyframe, with its covariance). poses: the current estimates of the submap's keyframes,
   // oldest first (size() of them). Not valid when the submap or the scan has too few points.
+  // direction_reach_m: PriorMatcherOptions' (< 0: from the prior's travel).
   alignment::PriorMatchResult match(const io::LaserScan& scan, const common::Pose2& prior, const Eigen::Matrix3d& prior_cov,
-                                    const std::vector<common::Pose2>& poses) const;
+                                    const std::vector<common::Pose2>& poses, double direction_reach_m = -1) const;
 
   // The keyframes' points, the count of keyframes added and the learnt seen-through rates. The
   // beams are rebuilt from the points and the prepared reference from both at the next match,

@@ -89,6 +89,7 @@ class Map {
   std::vector<io::PosedScan> posedKeyframes() const;
   size_t anchors() const { return anchors_.size(); }
   double lastAnchorTime() const { return anchors_.empty() ? 0.0 : anchors_.back().timestamp; }
+  const ScanAnchor* lastAnchor() const { return anchors_.empty() ? nullptr : &anchors_.back(); }
 
   // Keyframes, edges, the spatial index, anchors and odometry samples (the filter is written on
   // its own: Esdf::writeState). PipelineState.cpp.
