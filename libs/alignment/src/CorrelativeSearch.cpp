@@ -5,11 +5,26 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <limits>
 
 namespace urbanslam::alignment {
 
 namespace {
+
+// value(0) + ... + value(n - 1) in four running sums: one chain of dependent additions would
+// wait on each before the next (the grid lookups of a search are its hottest loop).
+template <typename Value>
+double sum4(size_t n, const Value& value) {
+  const size_t n4 = n & ~static_cast<size_t>(3);
+  double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+  for (size_t k = 0; k < n4; k += 4) {
+    s0 += value(k);
+    s1 += value(k + 1);
+    s2 += value(k + 2);
+    s3 += value(k + 3);
+  }
+  for (size_t k = n4; k < n; ++k) s0 += value(k);
+  return (s0 + s1) + (s2 + s3);
+}
 
 struct Node {
   int angle;     // index into the headings
@@ -117,34 +132,15 @@ class Search {
     // The points inside at every translation: no per-point checks, and at full resolution one
     // addition per point.
     if (shift == 0) {
-      // Four running sums: one chain of dependent additions would wait on each before the next.
       const float* base = values + static_cast<int64_t>(oy) * w + ox;
       const int64_t* idx = hd.linear.data();
-      const size_t n = hd.linear.size(), n4 = n & ~static_cast<size_t>(3);
-      double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
-      for (size_t k = 0; k < n4; k += 4) {
-        s0 += base[idx[k]];
-        s1 += base[idx[k + 1]];
-        s2 += base[idx[k + 2]];
-        s3 += base[idx[k + 3]];
-      }
-      for (size_t k = n4; k < n; ++k) s0 += base[idx[k]];
-      sum += (s0 + s1) + (s2 + s3);
+      sum += sum4(hd.linear.size(), [&](size_t k) { return base[idx[k]]; });
     } else {
-      const auto at = [&](const Eigen::Vector2i& c) {
-        return values[static_cast<size_t>((c.y() + oy + pad) >> shift) * static_cast<size_t>(w) + static_cast<size_t>((c.x() + ox + pad) >> shift)];
-      };
       const Eigen::Vector2i* cells = hd.cells.data();
-      const size_t n = hd.cells.size(), n4 = n & ~static_cast<size_t>(3);
-      double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
-      for (size_t k = 0; k < n4; k += 4) {
-        s0 += at(cells[k]);
-        s1 += at(cells[k + 1]);
-        s2 += at(cells[k + 2]);
-        s3 += at(cells[k + 3]);
-      }
-      for (size_t k = n4; k < n; ++k) s0 += at(cells[k]);
-      sum += (s0 + s1) + (s2 + s3);
+      sum += sum4(hd.cells.size(), [&](size_t k) {
+        const Eigen::Vector2i& c = cells[k];
+        return values[static_cast<size_t>((c.y() + oy + pad) >> shift) * static_cast<size_t>(w) + static_cast<size_t>((c.x() + ox + pad) >> shift)];
+      });
     }
     for (const auto& c : hd.edge) {
       const int i = c.x() + ox + pad, j = c.y() + oy + pad;

@@ -36,6 +36,7 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
   for (int k = 0; k <= kTable; ++k)
     table[static_cast<size_t>(k)] = static_cast<float>(std::log(std::exp(-(max_d2 * k / kTable) * inv2s2) + o.miss_floor));
   const double to_index = kTable / max_d2;
+  std::vector<double> dx2(static_cast<size_t>(2 * r + 1));  // a stamp's columns' squared offsets
   for (const auto& sp : reference) {
     if (std::abs(sp.p.x() - centre.x()) > o.max_radius_m || std::abs(sp.p.y() - centre.y()) > o.max_radius_m) continue;
     const Eigen::Vector2i c = cellOf(sp.p);
@@ -43,25 +44,15 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
     const int i0 = std::max(c.x() - r, -pad_), i1 = std::min(c.x() + r, width_ - 1 - pad_);
     const int j0 = std::max(c.y() - r, -pad_), j1 = std::min(c.y() + r, height_ - 1 - pad_);
     if (i0 > i1 || j0 > j1) continue;
-    double dx2[64];  // 2r + 1 <= 64 columns (checked below)
-    const bool small = i1 - i0 < 64;
-    if (small)
-      for (int i = i0; i <= i1; ++i) {
-        const double dx = (origin_.x() + resolution_ * (i + 0.5)) - sp.p.x();
-        dx2[i - i0] = dx * dx;
-      }
+    for (int i = i0; i <= i1; ++i) {
+      const double dx = (origin_.x() + resolution_ * (i + 0.5)) - sp.p.x();
+      dx2[static_cast<size_t>(i - i0)] = dx * dx;
+    }
     for (int j = j0; j <= j1; ++j) {
       const double dy = (origin_.y() + resolution_ * (j + 0.5)) - sp.p.y(), dy2 = dy * dy;
       float* row = base.data() + static_cast<size_t>(j + pad_) * static_cast<size_t>(width_) + static_cast<size_t>(pad_);
       for (int i = i0; i <= i1; ++i) {
-        double d2x;
-        if (small) {
-          d2x = dx2[i - i0];
-        } else {
-          const double dx = (origin_.x() + resolution_ * (i + 0.5)) - sp.p.x();
-          d2x = dx * dx;
-        }
-        const float v = table[static_cast<size_t>(std::min<double>(kTable, (d2x + dy2) * to_index + 0.5))];
+        const float v = table[static_cast<size_t>(std::min<double>(kTable, (dx2[static_cast<size_t>(i - i0)] + dy2) * to_index + 0.5))];
         row[i] = std::max(row[i], v);
       }
     }
