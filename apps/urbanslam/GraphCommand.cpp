@@ -43,6 +43,8 @@ int graphCommand(const Argv& args) {
   ap.addOption("min-gap", "F", "full recoveries at least F * poses apart (amortises their cost)", "0.25");
   ap.addOption("heading-innovation", "RAD", "full recovery (whatever --min-gap says) before a closure whose heading innovation exceeds RAD",
                "1.0");
+  ap.addFlag("no-headings-first",
+             "that recovery takes Gauss-Newton steps from the stale estimate only (no headings-first solve; branches re-chosen)");
   ap.addOption("window", "W", "poses re-solved by the partial recovery after other loop closures", "50");
   ap.addEpilog(
       "Example:\n  urbanslam graph manhattan.g2o --out manhattan_opt.g2o --json\n"
@@ -67,6 +69,10 @@ int graphCommand(const Argv& args) {
   o.full_recovery_innovation_chi2 = ap.optionDouble("innovation-chi2");
   o.full_recovery_min_gap_fraction = ap.optionDouble("min-gap");
   o.recent_window_poses = static_cast<int>(ap.optionInt("window"));
+  if (ap.flag("no-headings-first")) {
+    o.reinitialise_from_headings = false;
+    o.filter.commit_heading_branch = false;
+  }
   o.full_recovery_heading_innovation_rad = ap.optionDouble("heading-innovation");
   if (!(o.full_recovery_heading_innovation_rad > 0)) throw common::InputError("--heading-innovation: must be > 0");
   if (o.full_recovery_every_closures < 1) throw common::InputError("--full-every: must be >= 1");

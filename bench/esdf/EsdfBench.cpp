@@ -14,11 +14,13 @@
 //     reckoning, no refactorisation).
 // Usage: esdf_bench [--no-full-above N] [--ordering amd|metis|auto|natural] [--backend N]...
 //                   [--final-passes P] [--min-gap F] [--incremental-passes P] [--heading-recovery RAD]
+//                   [--heading-steps N] [--no-headings-first]
 //                   SIZE...
 //        esdf_bench --write-graph N PREFIX   (the back end's drive as PREFIX.g2o + PREFIX.truth.g2o)
 //   (default sizes 1000 10000 100000 1000000; each --backend N also runs the pose-graph back end,
 //   with its recovery policy, on the same drive of N poses)
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -196,6 +198,8 @@ int g_final_passes = -1;
 double g_min_gap = -1;
 int g_incremental_passes = -1;
 double g_heading_recovery = -1;
+int g_heading_steps = -1;
+bool g_no_headings_first = false;
 
 void runBackend(const std::vector<long>& sizes) {
   std::printf(
@@ -204,12 +208,18 @@ void runBackend(const std::vector<long>& sizes) {
   std::printf("%9s %8s | %9s %9s %9s | %8s %8s | %9s %9s | %12s %s\n", "poses", "edges", "step_p50", "step_p99", "step_max", "full",
               "partial", "time_s", "recov_s", "chi2", "");
   for (long n : sizes) {
-    const esdf::PoseGraph graph = cityGraph(n);
+    std::vector<esdf::PoseGraphVertex> truth;
+    const esdf::PoseGraph graph = cityGraph(n, &truth);
     esdf::PoseGraphBackendOptions o;
     if (g_final_passes >= 0) o.filter.relinearise_max_passes = g_final_passes;
     if (g_min_gap >= 0) o.full_recovery_min_gap_fraction = g_min_gap;
     if (g_incremental_passes >= 0) o.incremental_relinearise_passes = g_incremental_passes;
     if (g_heading_recovery >= 0) o.full_recovery_heading_innovation_rad = g_heading_recovery;
+    if (g_heading_steps >= 0) o.heading_recovery_steps = g_heading_steps;
+    if (g_no_headings_first) {
+      o.reinitialise_from_headings = false;
+      o.filter.commit_heading_branch = false;
+    }
     const auto r = esdf::runPoseGraphBackend(graph, o);
     std::printf("%9ld %8d | %9.4f %9.4f %9.1f | %8d %8d | %9.3f %9.3f | %12.3f %s\n", n, r.edges, common::percentile(r.step_ms, 50),
                 common::percentile(r.step_ms, 99), common::percentile(r.step_ms, 100), r.full_recoveries, r.partial_recoveries, r.time_s,
@@ -218,6 +228,23 @@ void runBackend(const std::vector<long>& sizes) {
         "          closures with heading innovation > pi/2 when added: %d (max %.3f rad); "
         "full recoveries forced by the heading innovation: %d\n",
         r.large_heading_innovations, r.max_heading_innovation_rad, r.heading_triggered_recoveries);
+    {
+      // Against the truth (unwrapped, as the drive composes it): closures added on the wrong
+      // heading branch.
+      int wrong = 0;
+      long first_wrong = -1;
+      for (const auto& cb : r.closure_branches) {
+        const auto& e = graph.edges[static_cast<size_t>(cb.edge)];
+        const double d = truth[static_cast<size_t>(e.to)].pose.z() - truth[static_cast<size_t>(e.from)].pose.z();
+        if (std::fabs(cb.heading_diff_rad - d) > M_PI) {
+          ++wrong;
+          if (first_wrong < 0) first_wrong = e.to;
+        }
+      }
+      std::printf("          closures added on the wrong heading branch (against the truth): %d of %zu", wrong, r.closure_branches.size());
+      if (wrong > 0) std::printf(", the first at pose %ld", first_wrong);
+      std::printf("\n");
+    }
     std::fflush(stdout);
   }
 }
@@ -243,6 +270,10 @@ int main(int argc, char** argv) {
       g_incremental_passes = std::atoi(argv[++a]);
     else if (!std::strcmp(argv[a], "--heading-recovery") && a + 1 < argc)
       g_heading_recovery = std::atof(argv[++a]);
+    else if (!std::strcmp(argv[a], "--heading-steps") && a + 1 < argc)
+      g_heading_steps = std::atoi(argv[++a]);
+    else if (!std::strcmp(argv[a], "--no-headings-first"))
+      g_no_headings_first = true;
     else if (!std::strcmp(argv[a], "--ordering") && a + 1 < argc) {
       const std::string o = argv[++a];
       g_ordering = o == "metis"     ? esdf::FillReducingOrdering::Metis

@@ -2,7 +2,7 @@
 // and prints one line per file (chi2, time, recoveries). For tuning and quick comparisons; the
 // user-facing tool is `urbanslam graph`.
 //   esdf_pose_graph [--every N] [--innov CHI2] [--window W] [--passes P] [--no-relin] [--gap F]
-//                   [--heading RAD] FILE...
+//                   [--heading RAD] [--heading-steps N] [--no-headings-first] FILE...
 //   esdf_pose_graph --eval EDGES_FILE POSES_FILE   chi2 of EDGES_FILE's edges at POSES_FILE's vertices
 //   esdf_pose_graph --init IN OUT                  IN with dead-reckoned vertices (for batch tools
 //                                                  that need VERTEX lines), written as g2o
@@ -79,7 +79,12 @@ int main(int argc, char** argv) {
       o.full_recovery_min_gap_fraction = std::atof(next());
     else if (!std::strcmp(argv[a], "--heading"))
       o.full_recovery_heading_innovation_rad = std::atof(next());
-    else {
+    else if (!std::strcmp(argv[a], "--heading-steps"))
+      o.heading_recovery_steps = std::atoi(next());
+    else if (!std::strcmp(argv[a], "--no-headings-first")) {
+      o.reinitialise_from_headings = false;
+      o.filter.commit_heading_branch = false;
+    } else {
       try {
         common::Stopwatch sw;
         const esdf::PoseGraph g = esdf::readPoseGraph(argv[a]);

@@ -152,7 +152,7 @@ TEST(CorruptInput, PoseGraphValuesAndFilterFailuresNameFileAndEdge) {
          (i % 10 == 0 ? "1.5707963267948966" : "0") + " 100 0 0 100 0 1000\n";
   for (int i = 40; i < 80; ++i) g += "EDGE_SE2 " + std::to_string(i - 40) + " " + std::to_string(i) + " 0 0 0 100 0 0 100 0 1000\n";
   expectBadInput("graph " + writeFile(d / "square.g2o", g),
-                 "square.g2o:83: edge 3 -> 43: the filter's information matrix is not positive definite");
+                 "square.g2o:84: edge 4 -> 44: the filter's information matrix is not positive definite");
 }
 
 TEST(CorruptInput, ADirectoryIsNotAnIni) {

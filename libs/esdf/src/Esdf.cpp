@@ -24,6 +24,12 @@ Vec3 Esdf::stabilisingNoise(const MotionModel& m) const {
   return {options_.stabilising_noise_xy_m2, options_.stabilising_noise_xy_m2, options_.stabilising_noise_phi_rad2};
 }
 
+Vec3 Esdf::relativeError(const Factor& f, const Vec3& xa, const Vec3& xb, Mat3* ja, Mat3* jb) const {
+  Vec3 e = relativePoseError(xa, xb, f.z, ja, jb);
+  if (options_.commit_heading_branch) e.z() = xb.z() - xa.z() - f.z.z();
+  return e;
+}
+
 Esdf::Linearisation Esdf::linearise(const Factor& f, const Vec3& xa, const Vec3& xb) const {
   Linearisation l;
   switch (f.kind) {
@@ -46,7 +52,7 @@ Esdf::Linearisation Esdf::linearise(const Factor& f, const Vec3& xa, const Vec3&
       break;
     }
     case Factor::Kind::Relative:
-      l.e0 = relativePoseError(xa, xb, f.z, &l.a_a, &l.a_b);
+      l.e0 = relativeError(f, xa, xb, &l.a_a, &l.a_b);
       l.w = f.weight;
       break;
   }
@@ -197,6 +203,11 @@ void Esdf::predict(std::shared_ptr<const MotionModel> model, const VecU& u, cons
 ObservationResult Esdf::observeRelative(int i, int j, const Vec3& z, const Mat3& omega, bool gate) {
   if (i < 0 || j < 0 || i >= size() || j >= size() || i == j) throw std::out_of_range("observeRelative: bad pose indices");
   Factor f{Factor::Kind::Relative, i, j, z, omega, 0, nullptr, state_.mean(i), state_.mean(j)};
+  if (options_.commit_heading_branch) {
+    // The branch nearest the estimate: the heading difference the wrapped error points to.
+    const double d = state_.mean(j).z() - state_.mean(i).z();
+    f.z.z() = d - common::wrapToPi(d - z.z());
+  }
   const Linearisation l = linearise(f, f.lin_a, f.lin_b);
   ObservationResult r;
   r.chi2 = l.e0.dot(omega * l.e0);
@@ -316,7 +327,7 @@ Vec3 Esdf::factorError(const Factor& f, Mat3* w) const {
     }
     case Factor::Kind::Relative:
       *w = f.weight;
-      return relativePoseError(xa, state_.mean(f.b), f.z);
+      return relativeError(f, xa, state_.mean(f.b), nullptr, nullptr);
   }
   return Vec3::Zero();
 }

@@ -128,7 +128,16 @@ PoseGraphBackendResult runBackend(const PoseGraph& g, const PoseGraphBackendOpti
           if (dh > opt.full_recovery_heading_innovation_rad && pending > 0) {
             // The estimate is too stale to linearise this closure on the right branch: bring
             // it up to date first (whatever the spacing of full recoveries says).
-            const RecoveryStats st = incrementalRecovery(filter, opt, 1);  // a second step: the closure is linearised next
+            RecoveryStats st;
+            common::Stopwatch sw_forced;
+            if (opt.reinitialise_from_headings && opt.filter.relinearise) {
+              st.factors_relinearised = filter.reinitialiseFromHeadings();
+              if (opt.heading_recovery_steps > 0)
+                st.factors_relinearised += incrementalRecovery(filter, opt, opt.heading_recovery_steps - 1).factors_relinearised;
+            } else {
+              st = incrementalRecovery(filter, opt, 1);  // a second step: the closure is linearised next
+            }
+            st.seconds = sw_forced.seconds();
             res.recovery_s += st.seconds;
             res.factors_relinearised += st.factors_relinearised;
             ++res.full_recoveries;
@@ -137,6 +146,8 @@ PoseGraphBackendResult runBackend(const PoseGraph& g, const PoseGraphBackendOpti
             dh = std::fabs(relativePoseError(filter.mean(a), filter.mean(b), e.measurement).z());
           }
           res.max_heading_innovation_rad = std::max(res.max_heading_innovation_rad, dh);
+          const double diff = filter.mean(b).z() - filter.mean(a).z();
+          res.closure_branches.push_back({order[q], diff - common::wrapToPi(diff - e.measurement.z())});
           if (dh > M_PI / 2) ++res.large_heading_innovations;
         }
         ObservationResult r;

@@ -122,8 +122,9 @@ std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const std::vec
     if (const double score = scorer_(i, current); score >= options_.laser_threshold) scored.emplace_back(score, i);
   std::sort(scored.begin(), scored.end(), [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second < b.second); });
   const size_t first_detection = out.size();
-  for (const auto& [score, i] : scored) {
+  for (const auto& [score, detected] : scored) {
     if (out.size() - first_detection == per_source) break;
+    const size_t i = detected;  // a plain variable: lambdas cannot capture structured bindings before C++20 (clang)
     const auto same = [&](const Candidate& p) {
       return p.keyframe == i || (p.detection && std::hypot(keyframes[i].pose.x - keyframes[p.keyframe].pose.x,
                                                            keyframes[i].pose.y - keyframes[p.keyframe].pose.y) < options_.search_radius_m);

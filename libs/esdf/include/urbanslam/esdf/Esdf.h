@@ -60,6 +60,13 @@ struct EsdfOptions {
   double relinearise_cost_tolerance = 0;
 
   FillReducingOrdering ordering = FillReducingOrdering::Amd;
+
+  // A relative-pose factor keeps the heading branch it was linearised on when added (the one
+  // nearest the estimate then): its heading error is never re-wrapped. Re-wrapping at each
+  // relinearisation lets a stale estimate flip an earlier closure onto the other branch, and
+  // it makes the heading part of the problem piecewise rather than linear, which
+  // reinitialiseFromHeadings() relies on.
+  bool commit_heading_branch = false;
 };
 
 struct ObservationResult {
@@ -117,6 +124,15 @@ class Esdf {
   long long relinearise();
   // Partial recovery of poses [first, size()) with the older poses held at their current mean.
   void recoverRecent(int first);
+  // A new linearisation point from the headings first (as LAGO does, Carlone et al. 2014): the
+  // headings that minimise the heading errors alone (a linear problem once every factor has a
+  // branch: commit_heading_branch), then the positions that minimise the whole cost with those
+  // headings held (linear too), then every factor relinearised there. No Gauss-Newton step of
+  // the whole problem can undo a 2*pi twist that a stale estimate puts into a long loop; the
+  // headings-first solution has none, and it costs two sparse solves smaller than Lambda's.
+  // Returns the number of factors relinearised. Prior and relative-pose factors only
+  // (std::logic_error with motion-model factors).
+  long long reinitialiseFromHeadings();
 
   // Marginal covariance of pose i and joint covariance of (x_i, x_j) (6x6, i's block first).
   Mat3 marginalCovariance(int i, CovarianceMode mode = CovarianceMode::Exact);
@@ -165,6 +181,8 @@ class Esdf {
     Vec3 e0;
   };
   Linearisation linearise(const Factor& f, const Vec3& xa, const Vec3& xb) const;
+  // relativePoseError for a relative factor, on its committed branch when commit_heading_branch.
+  Vec3 relativeError(const Factor& f, const Vec3& xa, const Vec3& xb, Mat3* ja, Mat3* jb) const;
   // Error of a factor at the current mean and its weight.
   Vec3 factorError(const Factor& f, Mat3* w) const;
   // A factor's contribution to Lambda (blocks aa, bb, ab) and eta at its linearisation point.
