@@ -69,6 +69,7 @@ TEST(Cli, RunOnTheShippedRawlogWritesEveryOutput) {
   for (const char* f : {"trajectory_keyframes.tum", "trajectory_odometry.tum", "trajectory_scans.tum", "reference.tum", "map.ply",
                         "map.pcd", "map.simplemap", "grid.png", "grid.yaml", "config.ini", "stats.json"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
+  EXPECT_FALSE(fs::exists(out / "grid_tiles"));  // grid.png holds the map at full resolution
   // No temporary files left behind, in the folder or beside it.
   for (const auto& e : fs::directory_iterator(out))
     EXPECT_EQ(e.path().filename().string().find(".partial-"), std::string::npos) << e.path();
@@ -106,6 +107,35 @@ TEST(Cli, RunOnTheShippedRawlogWritesEveryOutput) {
     EXPECT_NEAR(o->pose.y, s.pose.y, 1e-5) << s.timestamp;
   }
   EXPECT_GT(on_odometry, scans.size() / 2);
+}
+
+// A map larger than grid.png may be (grid_max_cells) gets grid.png coarser, and the full
+// resolution in tiles that the index lists (the tiles' cells: GridTiles.* in io_tests).
+TEST(Cli, ALargeMapsGridIsAlsoWrittenInTiles) {
+  const fs::path d = scratchDir("cli_tiles");
+  std::ofstream(d / "t.ini") << "[map]\ngrid_resolution_m = 0.1\ngrid_max_cells = 10000\ngrid_tile_cells = 100\n";
+  const CliResult r = runCli("run --quiet --out " + (d / "run").string() + " --ini " + (d / "t.ini").string() + " " +
+                             repoPath("rawlogs/intel-corrected-excerpt.log.gz"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string stats = slurp(d / "run" / "stats.json");
+  EXPECT_NE(stats.find("\"tiles_resolution_m\": 0.1"), std::string::npos) << stats;
+  std::ifstream index(d / "run" / "grid_tiles" / "tiles.csv");
+  std::string line;
+  std::getline(index, line);
+  int tiles = 0;
+  while (std::getline(index, line)) {
+    std::istringstream fields(line);
+    std::string i, j, png;
+    std::getline(fields, i, ',');
+    std::getline(fields, j, ',');
+    std::getline(fields, png, ',');
+    EXPECT_EQ(png, "tile_" + i + "_" + j + ".png");
+    EXPECT_TRUE(fs::exists(d / "run" / "grid_tiles" / png)) << png;
+    EXPECT_TRUE(fs::exists(d / "run" / "grid_tiles" / ("tile_" + i + "_" + j + ".yaml"))) << png;
+    ++tiles;
+  }
+  EXPECT_GT(tiles, 4);
+  EXPECT_NE(stats.find("\"tiles\": " + std::to_string(tiles)), std::string::npos) << stats;
 }
 
 TEST(Cli, ConvertWritesARawlogThatRunsTheSame) {

@@ -138,6 +138,8 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
 
   s.section("map", "Map products");
   s.add("grid_resolution_m", o.map.grid_resolution_m, 0.01, 2.0, "m", "occupancy grid cell size");
+  s.add("grid_max_cells", o.map.grid_max_cells, 1e4, 1e9, "cells", "grid.png's size bound: a larger map is written coarser there");
+  s.add("grid_tile_cells", o.map.grid_tile_cells, 100, 10000, "cells", "side of a tile of grid_tiles/");
   s.add("point_decimation", o.map.point_decimation, 1, 1000, "", "keep every n-th point in the point clouds");
 
   s.section("output", "Which files a run writes besides the trajectory, stats.json and config.ini");
@@ -147,6 +149,8 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("write_xyz", o.output.write_xyz, "map.xyz (x y z per line)");
   s.add("write_simplemap", o.output.write_simplemap, "map.simplemap (MRPT CSimpleMap)");
   s.add("write_grid", o.output.write_grid, "grid.png + grid.yaml (occupancy grid, map_server convention)");
+  s.add("write_grid_tiles", o.output.write_grid_tiles,
+        "grid_tiles/ (the grid at full resolution in tiles, when grid.png had to be coarser than grid_resolution_m)");
 }
 
 common::Json optionsToJson(const PipelineOptions& options) {

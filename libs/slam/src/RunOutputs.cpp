@@ -9,6 +9,7 @@
 #include "urbanslam/common/Error.h"
 #include "urbanslam/common/Timing.h"
 #include "urbanslam/esdf/PoseGraphIO.h"
+#include "urbanslam/io/GridTiles.h"
 #include "urbanslam/io/MapOutputs.h"
 #include "urbanslam/slam/MapFile.h"
 
@@ -117,6 +118,7 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   if (o.output.write_grid && map_points > 0) {  // camera-only runs have no map points
     io::OccupancyGridOptions g;
     g.resolution_m = o.map.grid_resolution_m;
+    g.max_cells = o.map.grid_max_cells;
     double resolution = g.resolution_m;
     const auto [w, h] = io::writeOccupancyGrid(path("grid"), posed, g, &resolution);
     grid["width"] = w;
@@ -124,6 +126,17 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
     grid["resolution_m"] = resolution;
     files.push("grid.png");
     files.push("grid.yaml");
+    if (o.output.write_grid_tiles && resolution > g.resolution_m) {
+      // grid.png is an overview: the map at the resolution asked for, a tile at a time.
+      io::GridTileOptions t;
+      t.resolution_m = g.resolution_m;
+      t.tile_cells = o.map.grid_tile_cells;
+      const auto tiles = io::writeOccupancyGridTiles(path("grid_tiles"), posed, t);
+      grid["tiles"] = tiles.size();
+      grid["tile_cells"] = t.tile_cells;
+      grid["tiles_resolution_m"] = t.resolution_m;
+      files.push("grid_tiles/");
+    }
   }
 
   const PipelineStats& s = p.stats();

@@ -132,6 +132,8 @@ struct EstimatorOptions {
 
 struct MapOptions {
   double grid_resolution_m = 0.05;  // occupancy grid cell size
+  double grid_max_cells = 1e8;      // grid.png's size bound: a larger map is written coarser there
+  int grid_tile_cells = 2000;       // side of a grid tile (grid_tiles/), in cells
   int point_decimation = 1;         // keep every n-th map point in the point clouds
 };
 
@@ -142,6 +144,9 @@ struct OutputOptions {
   bool write_xyz = false;
   bool write_simplemap = true;
   bool write_grid = true;
+  // A map too large for grid.png at grid_resolution_m (more than grid_max_cells: grid.png is
+  // then coarser) is also written at full resolution as tiles: grid_tiles/.
+  bool write_grid_tiles = true;
 };
 
 struct PipelineOptions {
