@@ -1,4 +1,4 @@
-// urbanslam-gui [FILE] [--ini FILE] [--autorun] [--speed X] [--screenshot FILE] [--exit-when-done]
+// urbanslam-gui [FILE] [--ini FILE] [--map MAP] [--autorun] [--speed X] [--screenshot FILE] [--exit-when-done]
 #include <wx/app.h>
 #include <wx/image.h>
 
@@ -13,10 +13,11 @@
 namespace {
 
 constexpr const char* kUsage =
-    "usage: urbanslam-gui [FILE] [--ini FILE] [--autorun] [--speed X] [--screenshot FILE] [--exit-when-done]\n\n"
+    "usage: urbanslam-gui [FILE] [--ini FILE] [--map MAP] [--autorun] [--speed X] [--screenshot FILE] [--exit-when-done]\n\n"
     "Opens a log (MRPT rawlog, CARMEN log, Victoria Park folder/zip, folder of images; default: the shipped\n"
     "rawlogs/intel.rawlog) and shows the map and its loop closures as they are built.\n\n"
     "  --ini FILE          configuration (default: ini/default.ini)\n"
+    "  --map MAP           localize FILE in a saved map (map.usmap, or the run folder holding it) instead of mapping it\n"
     "  --autorun           start processing at once\n"
     "  --speed X           log seconds per wall second (1: real time); 0 (default): as fast as possible\n"
     "  --screenshot FILE   with --exit-when-done: save the final view as PNG\n"
@@ -48,6 +49,8 @@ class GuiApp : public wxApp {
         std::exit(0);
       } else if (a == "--ini")
         o.ini = value();
+      else if (a == "--map")
+        o.map = value();
       else if (a == "--screenshot")
         o.screenshot = value();
       else if (a == "--autorun")
@@ -103,7 +106,7 @@ int main(int argc, char** argv) {
   // help must not need one.
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--ini" || a == "--screenshot" || a == "--speed" || a == "--snapshot-at") {
+    if (a == "--ini" || a == "--map" || a == "--screenshot" || a == "--speed" || a == "--snapshot-at") {
       ++i;  // a value, even one spelled "--help"
     } else if (a == "--help" || a == "-h") {
       std::cout << kUsage;

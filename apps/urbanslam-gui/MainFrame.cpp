@@ -26,6 +26,7 @@ namespace {
 
 enum Ids {
   kOpen = wxID_HIGHEST + 1,
+  kLocalize,
   kLoadIni,
   kPlay,
   kPause,
@@ -114,7 +115,10 @@ MainFrame::MainFrame(const GuiOptions& options)
   history_.Load(config);
   Bind(wxEVT_TIMER, &MainFrame::onTimer, this);
   timer_.Start(50);  // redraw at most 20 Hz
-  if (!options_.log.empty()) openLog(options_.log);
+  if (!options_.map.empty())
+    localizeLog(options_.map, options_.log);
+  else if (!options_.log.empty())
+    openLog(options_.log);
   updateTitle();
 }
 
@@ -123,6 +127,7 @@ MainFrame::~MainFrame() {
   wxConfig config("urbanslam-gui");
   history_.Save(config);
   worker_.reset();  // joins the pipeline thread
+  localizer_.reset();
 }
 
 void MainFrame::buildMenus() {
@@ -133,6 +138,7 @@ void MainFrame::buildMenus() {
   history_.UseMenu(recent);
   history_.AddFilesToMenu(recent);
   file->Append(kLoadIni, "Load &ini...\tCtrl+I", "Switch the configuration (restarts the run)");
+  file->Append(kLocalize, "&Localize a log in a map...\tCtrl+L", "Track a log's vehicle in a saved map (map.usmap) instead of mapping it");
   file->AppendSeparator();
   auto* exp = new wxMenu;
   exp->Append(kExportAll, "Everything (run folder)...", "All outputs of `urbanslam run` into a folder");
@@ -203,23 +209,36 @@ void MainFrame::buildMenus() {
       },
       kLoadIni);
   Bind(
+      wxEVT_MENU,
+      [this](wxCommandEvent&) {
+        wxFileDialog map(this, "Open map", "", "map.usmap", "urbanslam maps (*.usmap)|*.usmap|All files|*", wxFD_OPEN | wxFD_FILE_MUST_EXIST);
+        if (map.ShowModal() != wxID_OK) return;
+        wxFileDialog log(this, "Log to localize", "", "", "Logs (*.rawlog;*.log;*.gz;*.clf;*.zip)|*.rawlog;*.log;*.gz;*.clf;*.zip|All files|*",
+                         wxFD_OPEN | wxFD_FILE_MUST_EXIST);
+        if (log.ShowModal() == wxID_OK) localizeLog(map.GetPath().ToStdString(), log.GetPath().ToStdString());
+      },
+      kLocalize);
+  Bind(
       wxEVT_MENU, [this](wxCommandEvent&) { Close(); }, wxID_EXIT);
   Bind(
       wxEVT_MENU,
       [this](wxCommandEvent&) {
         if (worker_) worker_->play();
+        if (localizer_) localizer_->play();
       },
       kPlay);
   Bind(
       wxEVT_MENU,
       [this](wxCommandEvent&) {
         if (worker_) worker_->pause();
+        if (localizer_) localizer_->pause();
       },
       kPause);
   Bind(
       wxEVT_MENU,
       [this](wxCommandEvent&) {
         if (worker_) worker_->stepKeyframe();
+        if (localizer_) localizer_->stepScan();
       },
       kStep);
   Bind(
@@ -228,18 +247,21 @@ void MainFrame::buildMenus() {
       wxEVT_MENU,
       [this](wxCommandEvent&) {
         if (worker_) worker_->setSpeed(0);
+        if (localizer_) localizer_->setSpeed(0);
       },
       kSpeedMax);
   Bind(
       wxEVT_MENU,
       [this](wxCommandEvent&) {
         if (worker_) worker_->setSpeed(1);
+        if (localizer_) localizer_->setSpeed(1);
       },
       kSpeedReal);
   Bind(
       wxEVT_MENU,
       [this](wxCommandEvent&) {
         if (worker_) worker_->setSpeed(10);
+        if (localizer_) localizer_->setSpeed(10);
       },
       kSpeed10);
   Bind(
@@ -411,12 +433,14 @@ bool MainFrame::openLog(const std::string& path) {
     auto worker = std::make_unique<PipelineWorker>(path, options_.ini, slam::defaultLaserModelPath(options_.home),
                                                    slam::defaultVocabularyPath(options_.home));
     worker_.reset();  // the previous run's thread ends first
+    localizer_.reset();
     worker_ = std::move(worker);
   } catch (const std::exception& e) {
     showError(e.what());
     return false;
   }
   options_.log = path;
+  options_.map.clear();
   history_.AddFileToHistory(path);
   drawn_version_ = static_cast<size_t>(-1);
   auto_finished_ = false;
@@ -424,6 +448,29 @@ bool MainFrame::openLog(const std::string& path) {
   camera_page_shown_ = false;
   worker_->setSpeed(options_.speed);
   if (options_.autorun) worker_->play();
+  updateTitle();
+  return true;
+}
+
+bool MainFrame::localizeLog(const std::string& map_path, const std::string& log_path) {
+  try {
+    auto localizer = std::make_unique<LocalizationWorker>(map_path, log_path);
+    worker_.reset();
+    localizer_.reset();  // the previous run's thread ends first
+    localizer_ = std::move(localizer);
+  } catch (const std::exception& e) {
+    showError(e.what());
+    return false;
+  }
+  options_.log = log_path;
+  options_.map = map_path;
+  history_.AddFileToHistory(log_path);
+  drawn_version_ = static_cast<size_t>(-1);
+  auto_finished_ = false;
+  snapshot_taken_ = false;
+  layers_.selected_keyframe.reset();
+  localizer_->setSpeed(options_.speed);
+  if (options_.autorun) localizer_->play();
   updateTitle();
   return true;
 }
@@ -440,17 +487,24 @@ bool MainFrame::loadIni(const std::string& path) {
 }
 
 void MainFrame::restart() {
-  if (!options_.log.empty()) openLog(options_.log);
+  if (!options_.map.empty())
+    localizeLog(options_.map, options_.log);
+  else if (!options_.log.empty())
+    openLog(options_.log);
 }
 
 void MainFrame::updateTitle() {
-  SetTitle("urbanslam — " + (options_.log.empty() ? std::string("no log") : options_.log));
+  SetTitle("urbanslam — " + (options_.log.empty() ? std::string("no log") : options_.log) +
+           (options_.map.empty() ? std::string() : " localized in " + options_.map));
   SetStatusText("ini: " + options_.ini, 1);
 }
 
 void MainFrame::exportWith(const wxString& title, const wxString& wildcard, const wxString& default_name,
                            const std::function<void(const slam::Pipeline&, const std::string&)>& write) {
-  if (!worker_) return;
+  if (!worker_) {
+    SetStatusText("exports are of a mapping run (urbanslam localize --out writes a localization's outputs)", 0);
+    return;
+  }
   wxFileDialog dlg(this, title, "", default_name, wildcard, wxFD_SAVE | wxFD_OVERWRITE_PROMPT);
   if (dlg.ShowModal() != wxID_OK) return;
   const std::string path = dlg.GetPath().ToStdString();
@@ -463,27 +517,34 @@ void MainFrame::exportWith(const wxString& title, const wxString& wildcard, cons
 }
 
 void MainFrame::refreshView(bool force) {
-  if (!worker_) return;
-  const size_t v = worker_->collector().version();
+  if (!worker_ && !localizer_) return;
+  const size_t v = worker_ ? worker_->collector().version() : localizer_->version();
   if (!force && v == drawn_version_) return;
   drawn_version_ = v;
-  last_snapshot_ = worker_->collector().snapshot();
+  last_snapshot_ = worker_ ? worker_->collector().snapshot() : localizer_->snapshot();
   canvas_->setDrawList(buildDrawList(last_snapshot_, layers_));
-  stats_->update(last_snapshot_, worker_->logPath(), worker_->iniPath());
+  stats_->update(last_snapshot_, options_.log, worker_ ? worker_->iniPath() : "map " + localizer_->mapPath());
   closures_->update(last_snapshot_);
   camera_->update(cameraView(last_snapshot_, layers_.selected_keyframe));
   if (!camera_page_shown_ && !last_snapshot_.keyframes.empty() && last_snapshot_.keyframes.back().image) {
     camera_page_shown_ = true;  // a log with images: show them (once; the user may switch away)
     notebook_->SetSelection(2);
   }
-  SetStatusText(wxString::Format("%zu keyframes, %.0f %%%s", last_snapshot_.stats.keyframes, 100 * last_snapshot_.stats.progress,
-                                 last_snapshot_.finished ? " - finished" : ""),
-                0);
+  if (last_snapshot_.localizing)
+    SetStatusText(wxString::Format("localizing in %zu keyframes: %zu scans, %zu lost, %zu relocalisations, %.0f %%%s",
+                                   last_snapshot_.keyframes.size(), last_snapshot_.stats.scans, last_snapshot_.lost_scans,
+                                   last_snapshot_.relocalisations, 100 * last_snapshot_.stats.progress,
+                                   last_snapshot_.finished ? " - finished" : ""),
+                  0);
+  else
+    SetStatusText(wxString::Format("%zu keyframes, %.0f %%%s", last_snapshot_.stats.keyframes, 100 * last_snapshot_.stats.progress,
+                                   last_snapshot_.finished ? " - finished" : ""),
+                  0);
 }
 
 void MainFrame::onTimer(wxTimerEvent&) {
   refreshView(false);
-  if (!worker_) return;
+  if (!worker_ && !localizer_) return;
   // --snapshot-at N:FILE: a picture of the view mid-run (the run goes on).
   if (!snapshot_taken_ && options_.snapshot_at_keyframes > 0 && last_snapshot_.keyframes.size() >= options_.snapshot_at_keyframes) {
     snapshot_taken_ = true;
@@ -492,22 +553,40 @@ void MainFrame::onTimer(wxTimerEvent&) {
       if (!ok) std::cerr << "urbanslam-gui: error: " << options_.snapshot_path << ": cannot write\n";
     });
   }
-  const std::string err = worker_->error();
+  const std::string err = error();
   if (!err.empty() && !auto_finished_) {
     auto_finished_ = true;
     showError(err);
     return;
   }
-  if (options_.exit_when_done && worker_->finished() && last_snapshot_.finished && !auto_finished_) {
+  if (options_.exit_when_done && finished() && last_snapshot_.finished && !auto_finished_) {
     auto_finished_ = true;
     finishAutomaticRun();
   }
+}
+
+// --exit-when-done with --map: what the localization drew, as one JSON line; then exit.
+void MainFrame::reportLocalization(bool screenshot_ok) {
+  const DrawList d = buildDrawList(last_snapshot_, layers_);
+  std::printf(
+      "{\"keyframes_drawn\":%zu,\"map_points_drawn\":%zu,\"localized_scans\":%zu,\"localized_poses\":%zu,\"lost_scans\":%zu,"
+      "\"relocalisations\":%zu,\"tracked_segments\":%zu,\"lost_segments\":%zu,\"screenshot\":\"%s\",\"screenshot_ok\":%s}\n",
+      d.keyframes_drawn, d.map_points.size(), last_snapshot_.stats.scans, last_snapshot_.localized.size(), last_snapshot_.lost_scans,
+      last_snapshot_.relocalisations, d.localized_tracked.size(), d.localized_lost.size(), options_.screenshot.c_str(),
+      screenshot_ok ? "true" : "false");
+  std::fflush(stdout);
+  if (!screenshot_ok) g_exit_code = 1;
+  Close(true);
 }
 
 // --exit-when-done: fit the view, take the screenshot if asked, report what was drawn, exit.
 void MainFrame::finishAutomaticRun() {
   canvas_->fitToMap();
   const auto report = [this](bool screenshot_ok) {
+    if (localizer_) {
+      reportLocalization(screenshot_ok);
+      return;
+    }
     size_t pipeline_keyframes = 0;
     worker_->withPipeline([&](const slam::Pipeline& p) { pipeline_keyframes = p.keyframes().size(); });
     const DrawList d = buildDrawList(last_snapshot_, layers_);

@@ -39,10 +39,12 @@ MapCanvas::MapCanvas(wxWindow* parent) : CWxGLCanvasBase(parent, wxID_ANY, wxDef
   accepted_ = makeLines(palette::kClosureAccepted, 2);
   rejected_ = makeLines(palette::kClosureRejected, 1);
   candidates_ = makeLines(palette::kCandidate, 1);
+  tracked_ = makeLines(palette::kLocalizedTracked, 3);
+  lost_ = makeLines(palette::kLocalizedLost, 3);
   robot_ = makeLines(palette::kCurrentScan, 2);
   ellipse_ = makeLines(palette::kCurrentScan, 1);
   for (const auto& o : std::initializer_list<mrpt::opengl::CRenderizable::Ptr>{points_, trajectory_, rejected_, accepted_, candidates_,
-                                                                               scan_, selected_, ellipse_, robot_})
+                                                                               tracked_, lost_, scan_, selected_, ellipse_, robot_})
     scene->insert(o);
   setTopView(true);
   Bind(wxEVT_LEFT_DOWN, &MapCanvas::onLeftDown, this);
@@ -63,6 +65,8 @@ void MapCanvas::setDrawList(const DrawList& d) {
   fill(*trajectory_, d.trajectory, 0.02f);
   fill(*accepted_, d.closures_accepted, 0.04f);
   fill(*rejected_, d.closures_rejected, 0.03f);
+  fill(*tracked_, d.localized_tracked, 0.05f);
+  fill(*lost_, d.localized_lost, 0.05f);
   candidates_->clear();
   for (const auto& c : d.candidates) {  // a small cross on each candidate keyframe
     candidates_->appendLine(c.x - 0.4, c.y, 0.05, c.x + 0.4, c.y, 0.05);

@@ -35,7 +35,7 @@ class MapCanvas : public mrpt::gui::CWxGLCanvasBase {
   void onLeftUp(wxMouseEvent& e);
 
   mrpt::opengl::CPointCloudColoured::Ptr points_, scan_, selected_;
-  mrpt::opengl::CSetOfLines::Ptr trajectory_, accepted_, rejected_, candidates_, robot_, ellipse_;
+  mrpt::opengl::CSetOfLines::Ptr trajectory_, accepted_, rejected_, candidates_, tracked_, lost_, robot_, ellipse_;
   Bounds bounds_;
   bool top_view_ = true;
   bool fitted_once_ = false;

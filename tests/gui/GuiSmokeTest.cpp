@@ -91,3 +91,37 @@ TEST(GuiSmoke, HelpWithoutADisplay) {
     EXPECT_EQ(test::slurp(out).rfind("usage: urbanslam-gui", 0), 0u) << test::slurp(out);
   }
 }
+
+// Localization mode: the Intel excerpt mapped by the CLI, then localized in that map by the
+// window. It draws the map's keyframes and localizes every scan the CLI's `localize` does, with
+// the same number lost, and the screenshot shows the vehicle's path in the tracked colour.
+TEST(GuiSmoke, LocalizesALogInASavedMap) {
+  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run not installed (make deps)";
+  const fs::path d = test::scratchDir("gui_smoke_localize");
+  const std::string log = test::repoPath("rawlogs/intel-corrected-excerpt.log.gz");
+  const test::CliResult run = test::runCli("run --quiet --json --out " + (d / "map").string() + " " + log);
+  ASSERT_EQ(run.code, 0) << run.err;
+  const test::CliResult loc = test::runCli("localize --quiet --json --map " + (d / "map").string() + " --out " + (d / "loc").string() + " " + log);
+  ASSERT_EQ(loc.code, 0) << loc.err;
+  const std::string shot = (d / "view.png").string(), out = (d / "gui.json").string();
+  const std::string cmd = "xvfb-run -a -s '-screen 0 1280x800x24' " + std::string(URBANSLAM_GUI) + " --map " + (d / "map").string() + " " +
+                          log + " --autorun --exit-when-done --screenshot " + shot + " > " + out + " 2>" + (d / "err.txt").string();
+  const int status = std::system(cmd.c_str());
+  const std::string json = test::slurp(out);
+  ASSERT_EQ(WEXITSTATUS(status), 0) << json << test::slurp((d / "err.txt").string());
+  EXPECT_EQ(jsonCount(json, "keyframes_drawn"), jsonCount(run.out, "keyframes")) << json;
+  EXPECT_EQ(jsonCount(json, "localized_scans"), jsonCount(loc.out, "scans_used")) << json << loc.out;
+  EXPECT_EQ(jsonCount(json, "lost_scans"), jsonCount(loc.out, "lost")) << json << loc.out;
+  EXPECT_GT(jsonCount(json, "tracked_segments"), 50u) << json;
+
+  mrpt::img::CImage img;
+  ASSERT_TRUE(img.loadFromFile(shot)) << shot;
+  // The tracked colour is a green no map point has (the age ramp keeps red and blue higher).
+  size_t path = 0;
+  for (unsigned y = 0; y < img.getHeight(); ++y)
+    for (unsigned x = 0; x < img.getWidth(); ++x) {
+      const uint8_t* px = img.ptr<uint8_t>(x, y);  // BGR
+      if (px[1] > 160 && px[2] < 90 && px[0] < 90) ++path;
+    }
+  EXPECT_GT(path, 300u) << "pixels in the tracked path's colour";
+}

@@ -56,11 +56,25 @@ DrawList buildDrawList(const MapSnapshot& s, const Layers& layers) {
       d.bounds.add(x, y);
     }
   }
-  if (layers.trajectory)
+  if (layers.trajectory && !s.localizing)  // localizing: the path drawn is the vehicle's, below
     for (size_t i = 1; i < n; ++i)
       d.trajectory.push_back({static_cast<float>(s.keyframes[i - 1].pose.x), static_cast<float>(s.keyframes[i - 1].pose.y),
                               static_cast<float>(s.keyframes[i].pose.x), static_cast<float>(s.keyframes[i].pose.y)});
-  if (n > 0) {
+  if (s.localizing) {
+    // The map stays as saved; the vehicle is the last localized pose, its path coloured by
+    // whether each stretch was tracked or lost.
+    if (layers.trajectory)
+      for (size_t i = 1; i < s.localized.size(); ++i) {
+        const auto& a = s.localized[i - 1].pose;
+        const auto& b = s.localized[i].pose;
+        (s.localized[i].tracking ? d.localized_tracked : d.localized_lost)
+            .push_back({static_cast<float>(a.x), static_cast<float>(a.y), static_cast<float>(b.x), static_cast<float>(b.y)});
+      }
+    if (!s.localized.empty()) {
+      d.current_pose = s.localized.back().pose;
+      if (layers.uncertainty) d.uncertainty = uncertaintyEllipse(*d.current_pose, s.current_covariance);
+    }
+  } else if (n > 0) {
     const auto& cur = s.keyframes.back();
     d.current_pose = cur.pose;
     if (layers.current_scan && cur.points) {

@@ -59,6 +59,8 @@ constexpr Rgb kClosureRejected{235, 70, 200};
 constexpr Rgb kCandidate{90, 200, 255};
 constexpr Rgb kHeight{200, 200, 210};
 constexpr Rgb kSelected{255, 255, 255};
+constexpr Rgb kLocalizedTracked{40, 230, 40};  // outside the age ramp (its red and blue never drop below 64 and 51)
+constexpr Rgb kLocalizedLost{255, 90, 40};
 }  // namespace palette
 
 // Colour of keyframe `i` of `n` for age colouring: old = blue, new = warm (a perceptual ramp).
@@ -72,6 +74,8 @@ struct DrawList {
   std::optional<common::Pose2> current_pose;
   std::optional<Ellipse> uncertainty;
   std::vector<Segment> closures_accepted, closures_rejected;
+  // Localizing in a saved map: the vehicle's path, each segment by the state at its end.
+  std::vector<Segment> localized_tracked, localized_lost;
   std::vector<common::Pose2> candidates;
   Bounds bounds;  // of everything drawn, for fit-to-map
   size_t keyframes_drawn = 0;

@@ -41,6 +41,13 @@ struct RunStats {
   std::vector<double> step_ms;  // recent per-scan processing times (bounded)
 };
 
+// Localization in a saved map: the vehicle's pose at a localized scan.
+struct LocalizedView {
+  double timestamp = 0;
+  common::Pose2 pose;
+  bool tracking = false;  // else lost: the pose is dead reckoning from the last one tracked
+};
+
 struct MapSnapshot {
   size_t version = 0;  // increases with every change; the GUI redraws only on a new version
   std::vector<KeyframeView> keyframes;
@@ -51,6 +58,11 @@ struct MapSnapshot {
   std::vector<ImageMatchView> image_matches;          // in the order proposed
   RunStats stats;
   bool finished = false;
+  // Localizing in a saved map (LocalizationWorker): `keyframes` is the map as saved, these are
+  // the localized scans that had a pose, and current_covariance is the last one's.
+  bool localizing = false;
+  std::vector<LocalizedView> localized;
+  size_t lost_scans = 0, relocalisations = 0;
 };
 
 }  // namespace urbanslam::gui

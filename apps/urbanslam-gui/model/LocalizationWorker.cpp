@@ -1,0 +1,168 @@
+#include "LocalizationWorker.h"
+
+#include <chrono>
+
+#include "SnapshotCollector.h"
+
+#include "urbanslam/common/Error.h"
+#include "urbanslam/common/Timing.h"
+#include "urbanslam/slam/MapFile.h"
+
+namespace urbanslam::gui {
+
+LocalizationWorker::LocalizationWorker(const std::string& map_path, const std::string& log_path)
+    : map_path_(slam::mapFilePath(map_path)), log_path_(log_path) {
+  map_ = slam::loadMap(map_path_);
+  map_->finish();  // the final estimates of the map's keyframes, as `localize` uses them
+  if (map_->keyframes().empty()) throw common::InputError(map_path_ + ": the map has no keyframes");
+  source_ = io::openDataSource(log_path);
+  localizer_ = std::make_unique<slam::Localizer>(map_->map(), map_->options(), slam::localizerOptions(map_->options()));
+  state_.localizing = true;
+  for (const auto& k : map_->keyframes()) {
+    auto pts = std::make_shared<const std::vector<io::Point2>>(k.hasScan() ? io::scanToPoints(k.scan.expand(), true) : std::vector<io::Point2>{});
+    state_.keyframes.push_back({k.index, k.timestamp, k.pose, std::move(pts), nullptr});
+  }
+  state_.stats.keyframes = state_.keyframes.size();
+  ++state_.version;
+  thread_ = std::thread([this] { loop(); });
+}
+
+LocalizationWorker::~LocalizationWorker() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+void LocalizationWorker::play() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    running_ = true;
+  }
+  wake_.notify_all();
+}
+
+void LocalizationWorker::pause() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  running_ = false;
+  step_request_ = false;
+}
+
+void LocalizationWorker::stepScan() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    step_request_ = true;
+    running_ = true;
+  }
+  wake_.notify_all();
+}
+
+void LocalizationWorker::setSpeed(double factor) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  speed_ = factor;
+}
+
+std::string LocalizationWorker::error() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return error_;
+}
+
+MapSnapshot LocalizationWorker::snapshot() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return state_;
+}
+
+size_t LocalizationWorker::version() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return state_.version;
+}
+
+void LocalizationWorker::loop() {
+  using clock = std::chrono::steady_clock;
+  clock::time_point wall0 = clock::now();
+  double log0 = -1;
+  bool was_running = false;
+  for (;;) {
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      wake_.wait(lock, [&] { return stop_ || (running_ && !finished_); });
+      if (stop_) return;
+    }
+    if (!was_running) {  // resumed: pace from here
+      wall0 = clock::now();
+      log0 = -1;
+    }
+    // The localizer runs outside the lock: the GUI's snapshots never wait for a place search.
+    io::Measurement m;
+    std::optional<slam::LocalizedScan> r;
+    bool more = false;
+    std::string failure;
+    common::Stopwatch sw;
+    try {
+      more = source_->next(m);
+      if (more) r = localizer_->add(m);
+    } catch (const std::exception& e) {
+      failure = e.what();
+      more = false;
+    }
+    const double step_ms = sw.milliseconds();
+    double speed = 0, t = 0;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!more) {
+        if (!failure.empty() && error_.empty()) error_ = failure;
+        if (failure.empty() && state_.stats.scans == 0 && error_.empty())
+          error_ = log_path_ + ": no laser scans the map's [input] options accept: nothing to localize";
+        finished_ = true;
+        running_ = false;
+        was_running = false;
+        state_.finished = true;
+        ++state_.version;
+        continue;
+      }
+      if (!r) continue;  // odometry: nothing to show
+      record(*r, step_ms);
+      if (step_request_) {
+        step_request_ = false;
+        running_ = false;
+      }
+      was_running = running_;
+      speed = speed_;
+      t = r->timestamp;
+    }
+    // Real-time pacing in short naps, so that pause and stop stay responsive.
+    if (speed > 0) {
+      if (log0 < 0) log0 = t;
+      for (;;) {
+        const double ahead = (t - log0) / speed - std::chrono::duration<double>(clock::now() - wall0).count();
+        if (ahead <= 0 || stop_ || !running_) break;
+        std::this_thread::sleep_for(std::chrono::duration<double>(std::min(ahead, 0.05)));
+      }
+    }
+  }
+}
+
+void LocalizationWorker::record(const slam::LocalizedScan& r, double step_ms) {
+  auto& s = state_.stats;
+  if (first_timestamp_ < 0) first_timestamp_ = r.timestamp;
+  ++s.scans;
+  s.log_time_s = r.timestamp - first_timestamp_;
+  s.processing_s += step_ms / 1000.0;
+  s.progress = source_->progress();
+  if (s.step_ms.size() >= SnapshotCollector::kStepHistory)
+    s.step_ms.erase(s.step_ms.begin(), s.step_ms.begin() + SnapshotCollector::kStepHistory / 2);
+  s.step_ms.push_back(step_ms);
+  const bool tracking = r.state == slam::LocalizationState::Tracking;
+  if (!tracking) ++state_.lost_scans;
+  if (r.relocalised) ++state_.relocalisations;
+  if (r.has_pose) {
+    state_.localized.push_back({r.timestamp, r.pose, tracking});
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) state_.current_covariance[static_cast<size_t>(3 * i + j)] = r.cov(i, j);
+  }
+  ++state_.version;
+}
+
+}  // namespace urbanslam::gui

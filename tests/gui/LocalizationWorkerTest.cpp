@@ -1,0 +1,101 @@
+// The GUI's localization mode without wx: a map of the Intel excerpt saved as map.usmap, the
+// same log localized in it by the worker, against the library's batch localization (what
+// `urbanslam localize` runs) on the same map and log.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "TestPaths.h"
+#include "model/DrawList.h"
+#include "model/LocalizationWorker.h"
+#include "urbanslam/common/Error.h"
+#include "urbanslam/io/DataSource.h"
+#include "urbanslam/slam/Localizer.h"
+#include "urbanslam/slam/MapFile.h"
+
+using namespace urbanslam;
+using namespace std::chrono_literals;
+
+namespace {
+const std::string kLog = test::repoPath("rawlogs/intel-corrected-excerpt.log.gz");
+
+template <typename Pred>
+bool waitFor(Pred p, std::chrono::milliseconds limit = 60s) {
+  const auto end = std::chrono::steady_clock::now() + limit;
+  while (!p()) {
+    if (std::chrono::steady_clock::now() > end) return false;
+    std::this_thread::sleep_for(2ms);
+  }
+  return true;
+}
+
+// The excerpt mapped with the default options and saved; its path.
+std::string excerptMap() {
+  const auto d = test::scratchDir("gui_localization_map");
+  const std::string path = (d / "map.usmap").string();
+  slam::Pipeline p(slam::PipelineOptions{});
+  auto src = io::openDataSource(kLog);
+  while (p.step(*src)) {
+  }
+  p.waitForGlobalSlam(*src);
+  slam::saveMap(p, path);
+  return path;
+}
+}  // namespace
+
+TEST(LocalizationWorker, LocalizesLikeTheBatchLocalizerAndDrawsTheMapAndThePath) {
+  const std::string map = excerptMap();
+  // The reference: the library's own run over the same map and log.
+  std::unique_ptr<slam::Pipeline> loaded = slam::loadMap(map);
+  loaded->finish();
+  slam::Localizer batch(loaded->map(), loaded->options(), slam::localizerOptions(loaded->options()));
+  auto src = io::openDataSource(kLog);
+  const auto expected = slam::localize(batch, *src);
+  ASSERT_GT(expected.size(), 50u);
+  size_t expected_poses = 0, expected_lost = 0;
+  for (const auto& r : expected) {
+    expected_poses += r.has_pose;
+    expected_lost += r.state == slam::LocalizationState::Lost;
+  }
+
+  gui::LocalizationWorker w(map, kLog);
+  const gui::MapSnapshot before = w.snapshot();
+  EXPECT_TRUE(before.localizing);
+  EXPECT_EQ(before.keyframes.size(), loaded->keyframes().size());  // the map, drawn before anything runs
+  EXPECT_TRUE(before.localized.empty());
+  w.stepScan();
+  ASSERT_TRUE(waitFor([&] { return w.snapshot().stats.scans == 1; }));
+  w.play();
+  ASSERT_TRUE(waitFor([&] { return w.finished(); }));
+  EXPECT_EQ(w.error(), "");
+  const gui::MapSnapshot s = w.snapshot();
+  EXPECT_TRUE(s.finished);
+  EXPECT_EQ(s.stats.scans, expected.size());
+  EXPECT_EQ(s.localized.size(), expected_poses);
+  EXPECT_EQ(s.lost_scans, expected_lost);
+  ASSERT_FALSE(s.localized.empty());
+  const auto& last = expected.back();
+  EXPECT_NEAR(s.localized.back().pose.x, last.pose.x, 1e-9);
+  EXPECT_NEAR(s.localized.back().pose.y, last.pose.y, 1e-9);
+
+  // The map's keyframes stay as saved; the path is drawn by state, the vehicle at its end.
+  const gui::DrawList d = gui::buildDrawList(s, {});
+  EXPECT_EQ(d.keyframes_drawn, loaded->keyframes().size());
+  EXPECT_GT(d.map_points.size(), 1000u);
+  EXPECT_EQ(d.localized_tracked.size() + d.localized_lost.size(), s.localized.size() - 1);
+  EXPECT_GT(d.localized_tracked.size(), d.localized_lost.size());  // the log localized in its own map
+  ASSERT_TRUE(d.current_pose.has_value());
+  EXPECT_EQ(d.current_pose->x, s.localized.back().pose.x);
+  EXPECT_TRUE(d.uncertainty.has_value());
+}
+
+TEST(LocalizationWorker, BadInputGivesTheCliMessage) {
+  const auto d = test::scratchDir("gui_localization_bad");
+  const std::string not_a_map = (d / "map.usmap").string();
+  std::ofstream(not_a_map) << "not a map";
+  EXPECT_THROW(gui::LocalizationWorker(not_a_map, kLog), common::InputError);
+  EXPECT_THROW(gui::LocalizationWorker(excerptMap(), (d / "missing.rawlog").string()), common::InputError);
+}
