@@ -22,11 +22,15 @@ std::vector<GridTile> writeOccupancyGridTiles(const std::string& dir, const std:
   const double side = t * r;
   std::filesystem::create_directories(dir);
 
-  // Which scans each tile takes: those whose sensor is within reach of it. The reach covers
-  // the sensor's offset on the vehicle, so the grid of a tile (the tile grown by twice the
-  // reach) holds every ray of those scans without MRPT growing it.
+  // Which scans each tile takes: those whose rays can reach it. A ray ends where MRPT's
+  // insertion ends it: a return at its range (at most the insertion range), a beam without one
+  // at half the last return's range (half the insertion range before the first), so the box of
+  // the sensor and every ray's end, grown by a metre for the cells' rounding, holds every cell
+  // the scan changes. Bounded by the insertion range, so a tile's grid (the tile grown by twice that
+  // range) holds every ray of the scans it takes without MRPT growing it.
   std::map<std::pair<long, long>, std::vector<size_t>> takes;
   const double reach = kGridInsertionRangeM;
+  double widest_pad = 0;
   {
     LaserScan buffer;
     for (size_t k = 0; k < scans.size(); ++k) {
@@ -35,15 +39,35 @@ std::vector<GridTile> writeOccupancyGridTiles(const std::string& dir, const std:
       const common::Pose2 sensor = common::compose(scans[k].pose, s.sensor_pose);
       if (!std::isfinite(sensor.x) || !std::isfinite(sensor.y) || std::fabs(sensor.x) > 1e7 || std::fabs(sensor.y) > 1e7)
         throw common::InputError(dir + ": a keyframe pose is beyond 10^7 m");
-      for (long i = static_cast<long>(std::floor((sensor.x - reach) / side)); i <= static_cast<long>(std::floor((sensor.x + reach) / side)); ++i)
-        for (long j = static_cast<long>(std::floor((sensor.y - reach) / side)); j <= static_cast<long>(std::floor((sensor.y + reach) / side));
-             ++j)
+      // A beam without a return ends at most at half the longest return (or half the
+      // insertion range), whatever the beams' order; a non-finite return reaches the range.
+      double longest = reach;
+      for (size_t i = 0; i < s.ranges.size(); ++i)
+        if (s.valid[i]) longest = std::isfinite(s.ranges[i]) ? std::max<double>(longest, s.ranges[i]) : 2 * reach;
+      const double no_return = std::min(reach, 0.5 * longest);
+      double x0 = sensor.x, x1 = sensor.x, y0 = sensor.y, y1 = sensor.y;
+      for (size_t i = 0; i < s.ranges.size(); ++i) {
+        const double r = !s.valid[i] ? no_return : std::isfinite(s.ranges[i]) ? std::min<double>(reach, s.ranges[i]) : reach;
+        const double a = sensor.phi + s.bearing(i);
+        const double ex = sensor.x + r * std::cos(a), ey = sensor.y + r * std::sin(a);
+        x0 = std::min(x0, ex);
+        x1 = std::max(x1, ex);
+        y0 = std::min(y0, ey);
+        y1 = std::max(y1, ey);
+      }
+      // A metre for the cells' rounding, and a beam's width at the insertion range (MRPT spreads
+      // the beams over the aperture its own way).
+      const double pad = 1.0 + reach * std::fabs(s.angle_increment_rad);
+      widest_pad = std::max(widest_pad, pad);
+      for (long i = static_cast<long>(std::floor((x0 - pad) / side)); i <= static_cast<long>(std::floor((x1 + pad) / side)); ++i)
+        for (long j = static_cast<long>(std::floor((y0 - pad) / side)); j <= static_cast<long>(std::floor((y1 + pad) / side)); ++j)
           takes[{i, j}].push_back(k);
     }
   }
-  // The tile's grid, in whole cells on the same lattice as the tile (2 m beyond MRPT's own
-  // resizing margin of 15 cells).
-  const double margin = std::ceil((2 * reach + 2.0) / r) * r;
+  // The tile's grid, in whole cells on the same lattice as the tile: the sensor of a scan it takes
+  // is within the reach and the pad of it, so every ray ends within twice the reach and the pad
+  // (and 2 m more, beyond MRPT's own resizing margin of 15 cells).
+  const double margin = std::ceil((2 * reach + widest_pad + 2.0) / r) * r;
 
   std::vector<GridTile> written;
   LaserScan buffer;

@@ -7,7 +7,7 @@
 // Tiles sit on a lattice anchored at the world origin: tile (i, j) covers
 // [i, i + 1) x [j, j + 1) times tile_cells * resolution_m, so tiles of two runs in the same frame
 // line up. Every cell holds what one grid over the whole map would hold there (the same MRPT
-// insertion: a tile's grid takes every scan taken within reach of it). Tiles that no ray
+// insertion: a tile's grid takes every scan whose rays reach it). Tiles that no ray
 // reaches are not written.
 #include <string>
 #include <vector>
