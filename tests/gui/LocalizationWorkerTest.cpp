@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "TestPaths.h"
+#include "WaitFor.h"
 #include "model/DrawList.h"
 #include "model/LocalizationWorker.h"
 #include "urbanslam/common/Error.h"
@@ -18,19 +19,11 @@
 
 using namespace urbanslam;
 using namespace std::chrono_literals;
+using test::waitFor;
 
 namespace {
 const std::string kLog = test::repoPath("rawlogs/intel-corrected-excerpt.log.gz");
 
-template <typename Pred>
-bool waitFor(Pred p, std::chrono::milliseconds limit = 60s) {
-  const auto end = std::chrono::steady_clock::now() + limit;
-  while (!p()) {
-    if (std::chrono::steady_clock::now() > end) return false;
-    std::this_thread::sleep_for(2ms);
-  }
-  return true;
-}
 
 // The excerpt mapped with the default options and saved; its path.
 std::string excerptMap() {
@@ -67,9 +60,9 @@ TEST(LocalizationWorker, LocalizesLikeTheBatchLocalizerAndDrawsTheMapAndThePath)
   EXPECT_EQ(before.keyframes.size(), loaded->keyframes().size());  // the map, drawn before anything runs
   EXPECT_TRUE(before.localized.empty());
   w.stepScan();
-  ASSERT_TRUE(waitFor([&] { return w.snapshot().stats.scans == 1; }));
+  ASSERT_TRUE(waitFor([&] { return w.snapshot().stats.scans == 1; }, 60s));
   w.play();
-  ASSERT_TRUE(waitFor([&] { return w.finished(); }));
+  ASSERT_TRUE(waitFor([&] { return w.finished(); }, 120s));  // sanitizer builds are slow
   EXPECT_EQ(w.error(), "");
   const gui::MapSnapshot s = w.snapshot();
   EXPECT_TRUE(s.finished);

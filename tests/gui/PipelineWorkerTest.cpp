@@ -4,11 +4,13 @@
 #include <thread>
 
 #include "TestPaths.h"
+#include "WaitFor.h"
 #include "model/PipelineWorker.h"
 #include "urbanslam/common/Error.h"
 
 using namespace urbanslam;
 using namespace std::chrono_literals;
+using test::waitFor;
 
 namespace {
 const std::string kLog = test::repoPath("rawlogs/intel-corrected-excerpt.log.gz");
@@ -16,15 +18,6 @@ const std::string kIni = test::repoPath("ini/default.ini");
 // The classifier model the ini leaves to the default, found as the GUI finds it (in its home).
 const std::string kModel = slam::defaultLaserModelPath(test::repoPath(""));
 
-template <typename Pred>
-bool waitFor(Pred p, std::chrono::milliseconds limit = 10s) {
-  const auto end = std::chrono::steady_clock::now() + limit;
-  while (!p()) {
-    if (std::chrono::steady_clock::now() > end) return false;
-    std::this_thread::sleep_for(2ms);
-  }
-  return true;
-}
 }  // namespace
 
 TEST(PipelineWorker, StartsPausedAndStepsOneKeyframeAtATime) {

@@ -1,7 +1,5 @@
 #include "LocalizationWorker.h"
 
-#include <chrono>
-
 #include "SnapshotCollector.h"
 
 #include "urbanslam/common/Error.h"
@@ -24,45 +22,9 @@ LocalizationWorker::LocalizationWorker(const std::string& map_path, const std::s
   }
   state_.stats.keyframes = state_.keyframes.size();
   ++state_.version;
-  thread_ = std::thread([this] { loop(); });
 }
 
-LocalizationWorker::~LocalizationWorker() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    stop_ = true;
-  }
-  wake_.notify_all();
-  if (thread_.joinable()) thread_.join();
-}
-
-void LocalizationWorker::play() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    running_ = true;
-  }
-  wake_.notify_all();
-}
-
-void LocalizationWorker::pause() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  running_ = false;
-  step_request_ = false;
-}
-
-void LocalizationWorker::stepScan() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    step_request_ = true;
-    running_ = true;
-  }
-  wake_.notify_all();
-}
-
-void LocalizationWorker::setSpeed(double factor) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  speed_ = factor;
-}
+LocalizationWorker::~LocalizationWorker() { runner_.stop(); }
 
 std::string LocalizationWorker::error() const {
   std::lock_guard<std::mutex> lock(mutex_);
@@ -79,69 +41,36 @@ size_t LocalizationWorker::version() const {
   return state_.version;
 }
 
-void LocalizationWorker::loop() {
-  using clock = std::chrono::steady_clock;
-  clock::time_point wall0 = clock::now();
-  double log0 = -1;
-  bool was_running = false;
-  for (;;) {
-    {
-      std::unique_lock<std::mutex> lock(mutex_);
-      wake_.wait(lock, [&] { return stop_ || (running_ && !finished_); });
-      if (stop_) return;
-    }
-    if (!was_running) {  // resumed: pace from here
-      wall0 = clock::now();
-      log0 = -1;
-    }
-    // The localizer runs outside the lock: the GUI's snapshots never wait for a place search.
-    io::Measurement m;
-    std::optional<slam::LocalizedScan> r;
-    bool more = false;
-    std::string failure;
-    common::Stopwatch sw;
-    try {
-      more = source_->next(m);
-      if (more) r = localizer_->add(m);
-    } catch (const std::exception& e) {
-      failure = e.what();
-      more = false;
-    }
-    const double step_ms = sw.milliseconds();
-    double speed = 0, t = 0;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (!more) {
-        if (!failure.empty() && error_.empty()) error_ = failure;
-        if (failure.empty() && state_.stats.scans == 0 && error_.empty())
-          error_ = log_path_ + ": no laser scans the map's [input] options accept: nothing to localize";
-        finished_ = true;
-        running_ = false;
-        was_running = false;
-        state_.finished = true;
-        ++state_.version;
-        continue;
-      }
-      if (!r) continue;  // odometry: nothing to show
-      record(*r, step_ms);
-      if (step_request_) {
-        step_request_ = false;
-        running_ = false;
-      }
-      was_running = running_;
-      speed = speed_;
-      t = r->timestamp;
-    }
-    // Real-time pacing in short naps, so that pause and stop stay responsive.
-    if (speed > 0) {
-      if (log0 < 0) log0 = t;
-      for (;;) {
-        const double ahead = (t - log0) / speed - std::chrono::duration<double>(clock::now() - wall0).count();
-        if (ahead <= 0 || stop_ || !running_) break;
-        std::this_thread::sleep_for(std::chrono::duration<double>(std::min(ahead, 0.05)));
-      }
-    }
+PacedRunner::Step LocalizationWorker::step() {
+  // The localizer runs outside the lock: the GUI's snapshots never wait for a place search.
+  PacedRunner::Step s;
+  io::Measurement m;
+  std::optional<slam::LocalizedScan> r;
+  std::string failure;
+  common::Stopwatch sw;
+  try {
+    s.more = source_->next(m);
+    if (s.more) r = localizer_->add(m);
+  } catch (const std::exception& e) {
+    failure = e.what();
+    s.more = false;
   }
+  const double step_ms = sw.milliseconds();
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!s.more) {
+    if (!failure.empty() && error_.empty()) error_ = failure;
+    if (failure.empty() && state_.stats.scans == 0 && error_.empty())
+      error_ = log_path_ + ": no laser scans the map's [input] options accept: nothing to localize";
+    state_.finished = true;
+    ++state_.version;
+    return s;
+  }
+  if (!r) return s;  // odometry: nothing to show, no pause
+  record(*r, step_ms);
+  s.unit_done = true;
+  s.paced = true;
+  s.log_time = r->timestamp;
+  return s;
 }
 
 void LocalizationWorker::record(const slam::LocalizedScan& r, double step_ms) {

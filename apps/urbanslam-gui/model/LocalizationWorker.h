@@ -2,14 +2,12 @@
 // Localizes a log in a saved map (map.usmap) on its own thread, with the same play / pause /
 // step / speed controls as PipelineWorker: the map's keyframes are drawn as they were saved, and
 // the vehicle's pose in them scan by scan, tracked or lost (what `urbanslam localize` computes).
-#include <atomic>
-#include <condition_variable>
 #include <memory>
 #include <mutex>
 #include <string>
-#include <thread>
 
 #include "MapSnapshot.h"
+#include "PacedRunner.h"
 #include "urbanslam/io/DataSource.h"
 #include "urbanslam/slam/Localizer.h"
 #include "urbanslam/slam/Pipeline.h"
@@ -23,13 +21,13 @@ class LocalizationWorker {
   LocalizationWorker(const std::string& map_path, const std::string& log_path);
   ~LocalizationWorker();
 
-  void play();
-  void pause();
-  void stepScan();  // localizes the next scan, then pauses
+  void play() { runner_.play(); }
+  void pause() { runner_.pause(); }
+  void stepScan() { runner_.stepUnit(); }  // localizes the next scan, then pauses
   // 0 = as fast as possible; otherwise log seconds per wall second (1 = real time).
-  void setSpeed(double factor);
+  void setSpeed(double factor) { runner_.setSpeed(factor); }
 
-  bool finished() const { return finished_; }
+  bool finished() const { return runner_.finished(); }
   std::string error() const;
   const std::string& mapPath() const { return map_path_; }
   const std::string& logPath() const { return log_path_; }
@@ -38,7 +36,7 @@ class LocalizationWorker {
   size_t version() const;
 
  private:
-  void loop();
+  PacedRunner::Step step();
   void record(const slam::LocalizedScan& r, double step_ms);  // under mutex_
 
   std::string map_path_, log_path_;
@@ -46,15 +44,11 @@ class LocalizationWorker {
   std::unique_ptr<io::DataSource> source_;
   std::unique_ptr<slam::Localizer> localizer_;
 
-  mutable std::mutex mutex_;  // guards the control flags and state_
-  std::condition_variable wake_;
-  std::atomic<bool> running_{false}, finished_{false}, stop_{false};
-  bool step_request_ = false;
-  double speed_ = 0;
+  mutable std::mutex mutex_;  // guards error_ and state_
   std::string error_;
   MapSnapshot state_;
   double first_timestamp_ = -1;
-  std::thread thread_;
+  PacedRunner runner_{[this] { return step(); }};  // last: its thread ends before the rest goes
 };
 
 }  // namespace urbanslam::gui

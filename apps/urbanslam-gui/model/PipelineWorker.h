@@ -2,14 +2,12 @@
 // Runs the pipeline on its own thread with play / pause / step-one-keyframe / speed control, so
 // the window stays responsive. The GUI reads progress only through the SnapshotCollector and
 // touches the pipeline itself only through withPipeline() (exports), between two steps.
-#include <atomic>
-#include <condition_variable>
 #include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
-#include <thread>
 
+#include "PacedRunner.h"
 #include "SnapshotCollector.h"
 #include "urbanslam/slam/Pipeline.h"
 
@@ -24,15 +22,15 @@ class PipelineWorker {
                  const std::string& default_vocabulary = "");
   ~PipelineWorker();
 
-  void play();
-  void pause();
+  void play() { runner_.play(); }
+  void pause() { runner_.pause(); }
   // Runs until the next keyframe is made, then pauses.
-  void stepKeyframe();
+  void stepKeyframe() { runner_.stepUnit(); }
   // 0 = as fast as possible; otherwise log seconds per wall second (1 = real time).
-  void setSpeed(double factor);
+  void setSpeed(double factor) { runner_.setSpeed(factor); }
 
-  bool running() const { return running_; }
-  bool finished() const { return finished_; }
+  bool running() const { return runner_.running(); }
+  bool finished() const { return runner_.finished(); }
   // The error that stopped the run (bad data found mid-way), or "".
   std::string error() const;
   const std::string& logPath() const { return log_path_; }
@@ -44,7 +42,7 @@ class PipelineWorker {
   void withPipeline(const std::function<void(const slam::Pipeline&)>& f);
 
  private:
-  void loop();
+  PacedRunner::Step step();
   // Global SLAM may run behind on a thread of its own: paused or exporting, the map is whole.
   void waitForGlobalSlam();
 
@@ -54,13 +52,10 @@ class PipelineWorker {
   SnapshotCollector collector_;
   std::unique_ptr<slam::Pipeline> pipeline_;
 
-  mutable std::mutex mutex_;  // guards the pipeline and the control flags below
-  std::condition_variable wake_;
-  std::atomic<bool> running_{false}, finished_{false}, stop_{false};
-  bool step_request_ = false;
-  double speed_ = 0;
+  mutable std::mutex mutex_;  // guards the pipeline and error_
+  bool done_ = false;         // finish() was called
   std::string error_;
-  std::thread thread_;
+  PacedRunner runner_{[this] { return step(); }};  // last: its thread ends before the rest goes
 };
 
 }  // namespace urbanslam::gui
