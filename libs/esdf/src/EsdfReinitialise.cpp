@@ -2,6 +2,7 @@
 #include <Eigen/LU>
 #include <Eigen/SparseCholesky>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "urbanslam/esdf/Esdf.h"

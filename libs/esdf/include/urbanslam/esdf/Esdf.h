@@ -131,7 +131,8 @@ class Esdf {
   // the whole problem can undo a 2*pi twist that a stale estimate puts into a long loop; the
   // headings-first solution has none, and it costs two sparse solves smaller than Lambda's.
   // Returns the number of factors relinearised. Prior and relative-pose factors only
-  // (std::logic_error with motion-model factors).
+  // (std::logic_error with motion-model factors); it solves from the kept factors, so a filter
+  // that marginalised poses (predict()) loses their information here.
   long long reinitialiseFromHeadings();
 
   // Marginal covariance of pose i and joint covariance of (x_i, x_j) (6x6, i's block first).
