@@ -32,8 +32,9 @@ double printedResolution(const std::string& token) {
   const std::string mantissa = token.substr(0, e);
   const size_t dot = mantissa.find('.');
   const long decimals = dot == std::string::npos ? 0 : static_cast<long>(mantissa.size() - dot - 1);
-  const long exponent = e == std::string::npos ? 0 : std::strtol(token.c_str() + e + 1, nullptr, 10);
-  return std::pow(10.0, static_cast<double>(exponent - decimals));
+  // In double: an exponent as written can be as large as a long holds (strtol saturates).
+  const double exponent = e == std::string::npos ? 0.0 : static_cast<double>(std::strtol(token.c_str() + e + 1, nullptr, 10));
+  return std::pow(10.0, exponent - static_cast<double>(decimals));
 }
 
 // Significant digits as printed: "2670.16" -> 6, "0.0250" -> 3.
