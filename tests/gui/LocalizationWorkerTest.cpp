@@ -25,10 +25,10 @@ namespace {
 const std::string kLog = test::repoPath("rawlogs/intel-corrected-excerpt.log.gz");
 
 
-// The excerpt mapped with the default options and saved; its path.
-std::string excerptMap() {
-  const auto d = test::scratchDir("gui_localization_map");
-  const std::string path = (d / "map.usmap").string();
+// The excerpt mapped with the default options and saved as DIR/map.usmap; its path. (ctest runs
+// the tests in parallel: each passes a folder of its own.)
+std::string excerptMap(const std::filesystem::path& dir) {
+  const std::string path = (dir / "map.usmap").string();
   slam::Pipeline p(slam::PipelineOptions{});
   auto src = io::openDataSource(kLog);
   while (p.step(*src)) {
@@ -40,7 +40,7 @@ std::string excerptMap() {
 }  // namespace
 
 TEST(LocalizationWorker, LocalizesLikeTheBatchLocalizerAndDrawsTheMapAndThePath) {
-  const std::string map = excerptMap();
+  const std::string map = excerptMap(test::scratchDir("gui_localization_map"));
   // The reference: the library's own run over the same map and log.
   std::unique_ptr<slam::Pipeline> loaded = slam::loadMap(map);
   loaded->finish();
@@ -87,8 +87,8 @@ TEST(LocalizationWorker, LocalizesLikeTheBatchLocalizerAndDrawsTheMapAndThePath)
 
 TEST(LocalizationWorker, BadInputGivesTheCliMessage) {
   const auto d = test::scratchDir("gui_localization_bad");
-  const std::string not_a_map = (d / "map.usmap").string();
+  const std::string not_a_map = (d / "not_a_map.usmap").string();
   std::ofstream(not_a_map) << "not a map";
   EXPECT_THROW(gui::LocalizationWorker(not_a_map, kLog), common::InputError);
-  EXPECT_THROW(gui::LocalizationWorker(excerptMap(), (d / "missing.rawlog").string()), common::InputError);
+  EXPECT_THROW(gui::LocalizationWorker(excerptMap(d), (d / "missing.rawlog").string()), common::InputError);
 }
