@@ -52,10 +52,8 @@ TEST(GridTiles, EveryTileHoldsTheWholeGridsCells) {
   ASSERT_EQ(reference.rows, h);
   const auto [gx, gy] = yamlOrigin(d / "whole.yaml");
 
-  io::GridTileOptions o;
-  o.resolution_m = 0.1;
-  o.tile_cells = 64;  // 6.4 m: the excerpt spans several
-  const auto tiles = io::writeOccupancyGridTiles((d / "tiles").string(), posed, o);
+  // 64 cells: 6.4 m tiles, so that the excerpt spans several.
+  const auto tiles = io::writeOccupancyGridTiles((d / "tiles").string(), posed, whole, 64);
   ASSERT_GT(tiles.size(), 4u);
 
   // The whole grid's cells, tile by tile; an unknown cell is MRPT's grey for log-odds 0.

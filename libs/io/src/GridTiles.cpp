@@ -10,15 +10,17 @@
 #include <utility>
 
 #include "MrptConversions.h"
+#include "OccupancyGridMrpt.h"
 #include "urbanslam/common/AtomicFile.h"
 #include "urbanslam/common/Error.h"
 
 namespace urbanslam::io {
 
-std::vector<GridTile> writeOccupancyGridTiles(const std::string& dir, const std::vector<PosedScan>& scans, const GridTileOptions& o) {
-  if (!(o.resolution_m > 0) || o.tile_cells < 1) throw common::InputError(dir + ": bad grid tile options");
+std::vector<GridTile> writeOccupancyGridTiles(const std::string& dir, const std::vector<PosedScan>& scans, const OccupancyGridOptions& o,
+                                              int tile_cells) {
+  if (!(o.resolution_m > 0) || tile_cells < 1) throw common::InputError(dir + ": bad grid tile options");
   const double r = o.resolution_m;
-  const int t = o.tile_cells;
+  const int t = tile_cells;
   const double side = t * r;
   std::filesystem::create_directories(dir);
 
@@ -75,8 +77,7 @@ std::vector<GridTile> writeOccupancyGridTiles(const std::string& dir, const std:
     const double x0 = ij.first * side, y0 = ij.second * side;
     mrpt::maps::COccupancyGridMap2D grid(static_cast<float>(x0 - margin), static_cast<float>(x0 + side + margin),
                                          static_cast<float>(y0 - margin), static_cast<float>(y0 + side + margin), static_cast<float>(r));
-    grid.insertionOptions.maxDistanceInsertion = static_cast<float>(kGridInsertionRangeM);
-    grid.insertionOptions.wideningBeamsWithDistance = false;
+    detail::configureGridInsertion(grid);
     for (const size_t k : members) {
       const auto obs = detail::toMrptScan(scans[k].get(buffer));
       const mrpt::poses::CPose3D robot(scans[k].pose.x, scans[k].pose.y, 0, scans[k].pose.phi, 0, 0);
@@ -107,13 +108,7 @@ std::vector<GridTile> writeOccupancyGridTiles(const std::string& dir, const std:
     common::writeAtomically(base + ".png", [&](const std::string& tmp) {
       if (!tile.saveToFile(tmp)) throw common::InputError(base + ".png: cannot write");
     });
-    common::AtomicFile yaml(base + ".yaml");
-    char buf[512];
-    std::snprintf(buf, sizeof buf,
-                  "image: %s\nresolution: %.6f\norigin: [%.6f, %.6f, 0.0]\nnegate: 0\noccupied_thresh: %.3f\nfree_thresh: %.3f\n",
-                  g.png.c_str(), r, x0, y0, o.occupied_thresh, o.free_thresh);
-    yaml.stream() << buf;
-    yaml.commit();
+    detail::writeMapServerYaml(base + ".yaml", g.png, r, x0, y0, o);
     written.push_back(g);
   }
   common::AtomicFile index((std::filesystem::path(dir) / "tiles.csv").string());

@@ -11,6 +11,7 @@
 #include <filesystem>
 
 #include "MrptConversions.h"
+#include "OccupancyGridMrpt.h"
 #include "urbanslam/common/AtomicFile.h"
 #include "urbanslam/common/Error.h"
 #include "urbanslam/io/MapOutputs.h"
@@ -114,8 +115,7 @@ std::pair<int, int> writeOccupancyGrid(const std::string& prefix, const std::vec
   if (resolution_used) *resolution_used = resolution;
   mrpt::maps::COccupancyGridMap2D grid(static_cast<float>(x0 - margin), static_cast<float>(x1 + margin), static_cast<float>(y0 - margin),
                                        static_cast<float>(y1 + margin), static_cast<float>(resolution));
-  grid.insertionOptions.maxDistanceInsertion = 80.f;
-  grid.insertionOptions.wideningBeamsWithDistance = false;
+  detail::configureGridInsertion(grid);
   LaserScan buffer;
   for (const auto& ps : scans) {
     const auto obs = detail::toMrptScan(ps.get(buffer));
@@ -125,16 +125,8 @@ std::pair<int, int> writeOccupancyGrid(const std::string& prefix, const std::vec
   common::writeAtomically(prefix + ".png", [&](const std::string& tmp) {
     if (!grid.saveAsBitmapFile(tmp)) throw common::InputError(prefix + ".png: cannot write");
   });
-  // map_server: origin is the pose of the lower-left pixel; the PNG's first row is the top.
-  common::AtomicFile yaml(prefix + ".yaml");
   const std::string image = std::filesystem::path(prefix).filename().string() + ".png";
-  char buf[512];
-  std::snprintf(buf, sizeof buf,
-                "image: %s\nresolution: %.6f\norigin: [%.6f, %.6f, 0.0]\nnegate: 0\n"
-                "occupied_thresh: %.3f\nfree_thresh: %.3f\n",
-                image.c_str(), grid.getResolution(), grid.getXMin(), grid.getYMin(), options.occupied_thresh, options.free_thresh);
-  yaml.stream() << buf;
-  yaml.commit();
+  detail::writeMapServerYaml(prefix + ".yaml", image, grid.getResolution(), grid.getXMin(), grid.getYMin(), options);
   return {static_cast<int>(grid.getSizeX()), static_cast<int>(grid.getSizeY())};
 }
 

@@ -128,13 +128,10 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
     files.push("grid.yaml");
     if (o.output.write_grid_tiles && resolution > g.resolution_m) {
       // grid.png is an overview: the map at the resolution asked for, a tile at a time.
-      io::GridTileOptions t;
-      t.resolution_m = g.resolution_m;
-      t.tile_cells = o.map.grid_tile_cells;
-      const auto tiles = io::writeOccupancyGridTiles(path("grid_tiles"), posed, t);
+      const auto tiles = io::writeOccupancyGridTiles(path("grid_tiles"), posed, g, o.map.grid_tile_cells);
       grid["tiles"] = tiles.size();
-      grid["tile_cells"] = t.tile_cells;
-      grid["tiles_resolution_m"] = t.resolution_m;
+      grid["tile_cells"] = o.map.grid_tile_cells;
+      grid["tiles_resolution_m"] = g.resolution_m;
       files.push("grid_tiles/");
     }
   }

@@ -16,25 +16,16 @@
 
 namespace urbanslam::io {
 
-struct GridTileOptions {
-  double resolution_m = 0.05;
-  int tile_cells = 2000;  // a tile's side in cells (100 m at 5 cm)
-  double occupied_thresh = 0.65;
-  double free_thresh = 0.196;
-};
-
-// A grid cell reaches this far from the sensor (MRPT's maxDistanceInsertion as the single
-// grid is written with).
-constexpr double kGridInsertionRangeM = 80.0;
-
 struct GridTile {
   int i = 0, j = 0;  // lattice index
   std::string png;   // file name, relative to the folder
   double origin_x_m = 0, origin_y_m = 0;
 };
 
-// Writes the tiles into `dir` (created if needed) and `dir/tiles.csv`; returns the tiles
-// written. Each file is written atomically.
-std::vector<GridTile> writeOccupancyGridTiles(const std::string& dir, const std::vector<PosedScan>& scans, const GridTileOptions& options);
+// Writes the tiles of `tile_cells` a side at grid.resolution_m (grid.max_cells does not apply)
+// into `dir` (created if needed) and `dir/tiles.csv`; returns the tiles written. Each file is
+// written atomically.
+std::vector<GridTile> writeOccupancyGridTiles(const std::string& dir, const std::vector<PosedScan>& scans, const OccupancyGridOptions& grid,
+                                              int tile_cells);
 
 }  // namespace urbanslam::io

@@ -64,6 +64,9 @@ struct KeyframeScan {
 };
 std::vector<KeyframeScan> readSimpleMap(const std::string& path);
 
+// A grid cell is reached this far from the sensor at most (MRPT's maxDistanceInsertion).
+constexpr double kGridInsertionRangeM = 80.0;
+
 struct OccupancyGridOptions {
   double resolution_m = 0.05;
   double occupied_thresh = 0.65;  // map_server thresholds, written into the YAML
