@@ -1,7 +1,5 @@
 #include "LocalizationWorker.h"
 
-#include "SnapshotCollector.h"
-
 #include "urbanslam/common/Error.h"
 #include "urbanslam/common/Timing.h"
 #include "urbanslam/slam/MapFile.h"
@@ -77,12 +75,7 @@ void LocalizationWorker::record(const slam::LocalizedScan& r, double step_ms) {
   auto& s = state_.stats;
   if (first_timestamp_ < 0) first_timestamp_ = r.timestamp;
   ++s.scans;
-  s.log_time_s = r.timestamp - first_timestamp_;
-  s.processing_s += step_ms / 1000.0;
-  s.progress = source_->progress();
-  if (s.step_ms.size() >= SnapshotCollector::kStepHistory)
-    s.step_ms.erase(s.step_ms.begin(), s.step_ms.begin() + SnapshotCollector::kStepHistory / 2);
-  s.step_ms.push_back(step_ms);
+  s.addStep(r.timestamp - first_timestamp_, step_ms, source_->progress());
   const bool tracking = r.state == slam::LocalizationState::Tracking;
   if (!tracking) ++state_.lost_scans;
   if (r.relocalised) ++state_.relocalisations;

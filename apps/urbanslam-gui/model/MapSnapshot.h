@@ -39,6 +39,16 @@ struct RunStats {
   double processing_s = 0;  // time spent in the pipeline
   double progress = 0;
   std::vector<double> step_ms;  // recent per-scan processing times (bounded)
+
+  static constexpr size_t kStepHistory = 2000;
+  // One processed step: its log time since the first, its cost and the input's progress.
+  void addStep(double log_time, double ms, double input_progress) {
+    log_time_s = log_time;
+    processing_s += ms / 1000.0;
+    progress = input_progress;
+    if (step_ms.size() >= kStepHistory) step_ms.erase(step_ms.begin(), step_ms.begin() + kStepHistory / 2);
+    step_ms.push_back(ms);
+  }
 };
 
 // Localization in a saved map: the vehicle's pose at a localized scan.

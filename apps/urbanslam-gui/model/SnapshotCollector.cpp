@@ -68,11 +68,7 @@ void SnapshotCollector::onStep(const slam::StepEvent& e) {
   auto& s = state_.stats;
   if (first_timestamp_ < 0) first_timestamp_ = e.timestamp;
   s.scans = e.scans;
-  s.log_time_s = e.timestamp - first_timestamp_;
-  s.processing_s += e.step_ms / 1000.0;
-  s.progress = e.progress;
-  if (s.step_ms.size() >= kStepHistory) s.step_ms.erase(s.step_ms.begin(), s.step_ms.begin() + kStepHistory / 2);
-  s.step_ms.push_back(e.step_ms);
+  s.addStep(e.timestamp - first_timestamp_, e.step_ms, e.progress);
   ++state_.version;
 }
 

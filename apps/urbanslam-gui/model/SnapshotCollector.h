@@ -26,8 +26,6 @@ class SnapshotCollector : public slam::PipelineObserver {
   size_t version() const;
   void clear();
 
-  static constexpr size_t kStepHistory = 2000;
-
  private:
   mutable std::mutex mutex_;
   MapSnapshot state_;
