@@ -92,7 +92,7 @@ TEST(DeadReckoningPipeline, RangeLimitsInvalidateBeams) {
   p.run(*src);
   size_t valid = 0;
   for (const auto& k : p.keyframes()) {
-    const io::LaserScan scan = k.scan.expand();
+    const io::LaserScan scan = p.map().scan(k.index);
     for (size_t i = 0; i < scan.size(); ++i)
       if (scan.valid[i]) {
         ++valid;

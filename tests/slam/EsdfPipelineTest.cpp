@@ -74,6 +74,30 @@ TEST(EsdfPipeline, SameInputSameOutput) {
   EXPECT_EQ(a->loopClosures().size(), b->loopClosures().size());
 }
 
+// Keyframe scans pushed out to the spill file and read back (no cache at all) make the same
+// map as scans held in memory: the store is invisible to the estimate.
+TEST(EsdfPipeline, SpilledScansMakeTheSameMap) {
+  const std::string log = test::repoPath("rawlogs/fr079-raw-excerpt.clf.gz");  // closes loops
+  slam::PipelineOptions spilled;
+  spilled.map.scan_cache_mb = 0;
+  const auto a = runOn(log, {}), b = runOn(log, spilled);
+  EXPECT_EQ(a->map().scans().spilledBytes(), 0u);
+  EXPECT_EQ(b->map().scans().residentBytes(), 0u);
+  EXPECT_GT(b->map().scans().spilledBytes(), 500u * a->keyframes().size());
+  ASSERT_EQ(a->keyframes().size(), b->keyframes().size());
+  for (size_t i = 0; i < a->keyframes().size(); ++i) {
+    ASSERT_EQ(a->keyframes()[i].pose.x, b->keyframes()[i].pose.x) << i;
+    ASSERT_EQ(a->keyframes()[i].pose.phi, b->keyframes()[i].pose.phi) << i;
+  }
+  ASSERT_EQ(a->loopClosures().size(), b->loopClosures().size());
+  size_t accepted = 0;
+  for (size_t i = 0; i < a->loopClosures().size(); ++i) {
+    EXPECT_EQ(a->loopClosures()[i].accepted, b->loopClosures()[i].accepted) << i;
+    accepted += a->loopClosures()[i].accepted;
+  }
+  EXPECT_GT(accepted, 0u);  // the closures read earlier keyframes' scans back
+}
+
 // A deliberately corrupted candidate: keyframe k's scan replaced by keyframe i's, although the
 // filter knows they are metres apart. Alignment then "succeeds" perfectly (identical scans), so
 // only the innovation gate stands between it and the map — and it must reject it.
@@ -84,12 +108,13 @@ TEST(EsdfPipeline, WrongPlaceClosureIsGatedOut) {
   const auto p = runOn(log, o);
   auto filter = rebuild(*p);
   esdf::Esdf& f = *filter;
-  auto keyframes = p->keyframes();
+  const auto& keyframes = p->keyframes();
   const size_t k = keyframes.size() - 1;
   size_t i = 0;
   while (i < k && std::hypot(keyframes[i].pose.x - keyframes[k].pose.x, keyframes[i].pose.y - keyframes[k].pose.y) < 3.0) ++i;
   ASSERT_LT(i, k) << "the excerpt has no keyframe 3 m away from the last one";
-  keyframes[k].scan = keyframes[i].scan;
+  slam::Map corrupted(nullptr, 1.0);
+  for (const slam::Keyframe& kf : keyframes) corrupted.addKeyframe(kf, io::CompactScan(p->map().scan(kf.index == k ? i : kf.index)));
   slam::LoopClosureOptions lo;
   lo.method = slam::LoopClosureOptions::Method::CrfIcp;  // finds the (wrong) perfect match from metres away
   lo.min_constraint_ratio = 0;                           // the other refusals off: this is about the gate
@@ -97,7 +122,7 @@ TEST(EsdfPipeline, WrongPlaceClosureIsGatedOut) {
   lo.max_free_space_conflict = 1;
   slam::LoopCloser closer(lo);
   const size_t factors_before = f.factorCount();
-  const slam::LoopClosureRecord r = closer.tryClose(f, keyframes, i, k);
+  const slam::LoopClosureRecord r = closer.tryClose(f, corrupted, i, k);
   EXPECT_FALSE(r.accepted);
   EXPECT_EQ(r.reason, slam::ClosureReason::Gating) << "rms " << r.rms_m;
   EXPECT_GT(r.mahalanobis2, r.gate_threshold);

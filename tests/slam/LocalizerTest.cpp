@@ -171,13 +171,13 @@ std::unique_ptr<slam::Map> twinWings(const slam::Map& map, const common::Pose2& 
     if (std::hypot(k.pose.x - hole.x(), k.pose.y - hole.y()) < radius) continue;
     slam::Keyframe kf = k;
     kf.index = index++;
-    out->addKeyframe(kf);
+    out->addKeyframe(kf, io::CompactScan(map.scan(k.index)));
   }
   for (const slam::Keyframe& k : map.keyframes()) {
     slam::Keyframe kf = k;
     kf.index = index++;
     kf.pose = common::compose(offset, k.pose);
-    out->addKeyframe(kf);
+    out->addKeyframe(kf, io::CompactScan(map.scan(k.index)));
   }
   return out;
 }

@@ -22,7 +22,7 @@ constexpr double kDeg = M_PI / 180.0;
 // Two scans of the shipped Intel rawlog, 870 s apart in the same corridor, with the log's
 // corrected poses (GMapping's, the independent reference).
 struct Pair {
-  std::vector<slam::Keyframe> keyframes;
+  std::unique_ptr<slam::Map> map = std::make_unique<slam::Map>(nullptr, 1.0);
   common::Pose2 truth;  // pose of the second scan in the first's frame, from the corrected poses
 };
 
@@ -37,8 +37,8 @@ Pair logPair(const std::string& log, size_t a, size_t b) {
   }
   Pair p;
   if (std::max(a, b) >= scans.size() || scans.size() != ref.size()) return p;
-  p.keyframes.push_back({0, scans[a].timestamp, ref[a], io::CompactScan(scans[a]), false, {}});
-  p.keyframes.push_back({1, scans[b].timestamp, ref[b], io::CompactScan(scans[b]), false, {}});
+  p.map->addKeyframe({0, scans[a].timestamp, ref[a], true, false, {}}, io::CompactScan(scans[a]));
+  p.map->addKeyframe({1, scans[b].timestamp, ref[b], true, false, {}}, io::CompactScan(scans[b]));
   p.truth = common::between(ref[a], ref[b]);
   return p;
 }
@@ -69,7 +69,7 @@ double distance(const common::Pose2& a, const common::Pose2& b) {
 // ambiguity test must refuse it; without the test it passes alignment and gate.
 TEST(LoopCloser, AliasedMinimumAlongACorridorIsRefused) {
   Pair p = intelPair(149, 464);
-  ASSERT_EQ(p.keyframes.size(), 2u) << "rawlogs/intel.rawlog: scans or reference poses missing";
+  ASSERT_EQ(p.map->size(), 2u) << "rawlogs/intel.rawlog: scans or reference poses missing";
   ASSERT_GT(distance(p.truth, {}), 1.0);
   const common::Pose2 drifted{0.126, 0.130, -0.179};  // where the drifted map put scan 464
   ASSERT_GT(distance(p.truth, drifted), 1.0);
@@ -77,21 +77,21 @@ TEST(LoopCloser, AliasedMinimumAlongACorridorIsRefused) {
   slam::LoopClosureOptions off;  // everything else at the defaults
   off.ambiguity_offset_m = 0;
   off.max_free_space_conflict = 1;
-  auto f1 = filterWith(p.keyframes[0].pose, drifted);
-  const auto wrong = slam::LoopCloser(off).tryClose(*f1, p.keyframes, 0, 1, false);
+  auto f1 = filterWith(p.map->keyframes()[0].pose, drifted);
+  const auto wrong = slam::LoopCloser(off).tryClose(*f1, *p.map, 0, 1, false);
   ASSERT_TRUE(wrong.accepted) << slam::reasonName(wrong.reason);
   EXPECT_GT(distance(p.truth, wrong.measurement), 1.0);  // a false closure against the reference
 
   slam::LoopClosureOptions on = off;
   on.ambiguity_offset_m = 0.75;
-  auto f2 = filterWith(p.keyframes[0].pose, drifted);
-  const auto refused = slam::LoopCloser(on).tryClose(*f2, p.keyframes, 0, 1, false);
+  auto f2 = filterWith(p.map->keyframes()[0].pose, drifted);
+  const auto refused = slam::LoopCloser(on).tryClose(*f2, *p.map, 0, 1, false);
   EXPECT_FALSE(refused.accepted);
   EXPECT_EQ(refused.reason, slam::ClosureReason::Ambiguous);
 
   // From a correct estimate the same test lets the true closure through.
-  auto f3 = filterWith(p.keyframes[0].pose, p.truth);
-  const auto right = slam::LoopCloser(on).tryClose(*f3, p.keyframes, 0, 1, false);
+  auto f3 = filterWith(p.map->keyframes()[0].pose, p.truth);
+  const auto right = slam::LoopCloser(on).tryClose(*f3, *p.map, 0, 1, false);
   EXPECT_TRUE(right.accepted) << slam::reasonName(right.reason);
   EXPECT_LT(distance(p.truth, right.measurement), 0.1);
   EXPECT_LT(std::abs(common::between(p.truth, right.measurement).phi), 2 * kDeg);
@@ -105,19 +105,19 @@ TEST(LoopCloser, CorridorSlideConflictsWithFreeSpace) {
   const std::string log = test::sharedDataPath("freiburg_slam_benchmark/corrected_logs/csail-corrected.log.gz");
   if (log.empty()) GTEST_SKIP() << "../shared/data (Freiburg corrected logs) not present";
   Pair p = logPair(log, 122, 214);
-  ASSERT_EQ(p.keyframes.size(), 2u) << log << ": scans or reference poses missing";
+  ASSERT_EQ(p.map->size(), 2u) << log << ": scans or reference poses missing";
   const common::Pose2 drifted{3.601, -0.088, -2.859};  // the accepted (false) measurement
   ASSERT_GT(distance(p.truth, drifted), 1.0);
   slam::LoopClosureOptions o;
   o.max_free_space_conflict = 1;
-  auto f1 = filterWith(p.keyframes[0].pose, drifted);
-  const auto wrong = slam::LoopCloser(o).tryClose(*f1, p.keyframes, 0, 1, false);
+  auto f1 = filterWith(p.map->keyframes()[0].pose, drifted);
+  const auto wrong = slam::LoopCloser(o).tryClose(*f1, *p.map, 0, 1, false);
   ASSERT_TRUE(wrong.accepted) << slam::reasonName(wrong.reason);
   EXPECT_GT(distance(p.truth, wrong.measurement), 1.0);
 
   o.max_free_space_conflict = 0.2;
-  auto f2 = filterWith(p.keyframes[0].pose, drifted);
-  const auto refused = slam::LoopCloser(o).tryClose(*f2, p.keyframes, 0, 1, false);
+  auto f2 = filterWith(p.map->keyframes()[0].pose, drifted);
+  const auto refused = slam::LoopCloser(o).tryClose(*f2, *p.map, 0, 1, false);
   EXPECT_FALSE(refused.accepted);
   EXPECT_EQ(refused.reason, slam::ClosureReason::FreeSpace);
   EXPECT_GT(refused.free_space_conflict, 0.2);
@@ -125,7 +125,7 @@ TEST(LoopCloser, CorridorSlideConflictsWithFreeSpace) {
   // At the reference pose the two scans agree on free space. (PL-ICP started there slides to the
   // aliased minimum, which matches more points: this pair cannot be closed correctly from these
   // two scans alone, so it must not be closed at all.)
-  EXPECT_LT(alignment::mutualFreeSpaceConflict(p.keyframes[0].scan.expand(), p.keyframes[1].scan.expand(), p.truth), 0.05);
+  EXPECT_LT(alignment::mutualFreeSpaceConflict(p.map->scan(0), p.map->scan(1), p.truth), 0.05);
 }
 
 namespace {
@@ -134,8 +134,7 @@ namespace {
 // keyframe n at (x_now, 0), placed by a chain whose every link has `link_sigma_m`. The scans are
 // all the same (the test's scorer, not the scans, says which keyframes look alike).
 struct Street {
-  std::vector<slam::Keyframe> keyframes;
-  slam::KeyframeGrid grid{2.0};
+  std::unique_ptr<slam::Map> map = std::make_unique<slam::Map>(nullptr, 2.0);
   std::unique_ptr<esdf::Esdf> filter = std::make_unique<esdf::Esdf>();
 };
 
@@ -146,9 +145,8 @@ Street street(size_t n, double x_now, double link_sigma_m) {
   const esdf::Mat3 cov = esdf::Vec3(link_sigma_m * link_sigma_m, link_sigma_m * link_sigma_m, 1e-6).asDiagonal();
   for (size_t i = 0; i <= n; ++i) {
     const common::Pose2 pose{i < n ? static_cast<double>(i) : x_now, 0, 0};
-    if (i > 0) s.filter->augmentRelative(static_cast<int>(i - 1), esdf::toVec(common::between(s.keyframes.back().pose, pose)), cov.inverse());
-    s.keyframes.push_back({i, static_cast<double>(i), pose, io::CompactScan(scan), false, {}});
-    s.grid.insert(i, pose.x, pose.y);
+    if (i > 0) s.filter->augmentRelative(static_cast<int>(i - 1), esdf::toVec(common::between(s.map->back().pose, pose)), cov.inverse());
+    s.map->addKeyframe({i, static_cast<double>(i), pose, true, false, {}}, io::CompactScan(scan));
   }
   s.filter->recover();
   return s;
@@ -184,7 +182,7 @@ TEST(LoopCloser, AppearanceAddsCandidatesWhenThePoseIsTooUncertain) {
     Street s = street(n, x_now, 0.01);
     slam::LoopCloser closer(o);
     closer.setScorer(scorer);
-    const auto c = closer.candidates(*s.filter, s.keyframes, s.grid, n);
+    const auto c = closer.candidates(*s.filter, *s.map, n);
     nearestFirst(c);
     EXPECT_EQ(c.size(), 3u);
   }
@@ -192,7 +190,7 @@ TEST(LoopCloser, AppearanceAddsCandidatesWhenThePoseIsTooUncertain) {
     Street s = street(n, x_now, 0.5);
     slam::LoopCloser closer(o);
     closer.setScorer(scorer);
-    const auto c = closer.candidates(*s.filter, s.keyframes, s.grid, n);
+    const auto c = closer.candidates(*s.filter, *s.map, n);
     nearestFirst(c);
     ASSERT_EQ(c.size(), 5u);  // 108 (109 is the same place), then 93; 120 is no detection
     EXPECT_EQ(c[3].keyframe, 108u);
@@ -204,7 +202,7 @@ TEST(LoopCloser, AppearanceAddsCandidatesWhenThePoseIsTooUncertain) {
 
     // Without a classifier the same uncertain estimate has only the nearest keyframes.
     slam::LoopCloser plain(o);
-    const auto p = plain.candidates(*s.filter, s.keyframes, s.grid, n);
+    const auto p = plain.candidates(*s.filter, *s.map, n);
     nearestFirst(p);
     EXPECT_EQ(p.size(), 3u);
   }

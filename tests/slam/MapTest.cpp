@@ -14,14 +14,14 @@ namespace {
 TEST(Map, TrajectoryPassesThroughAnchoredScansAndBlendsBetweenThem) {
   Map map(nullptr, 4.0);
   map.addOdometry(0.0, {0, 0, 0});
-  map.addKeyframe({0, 0.0, {0, 0, 0}, {}, false, {}});
+  map.addKeyframe({0, 0.0, {0, 0, 0}, false, false, {}}, {});
   map.addAnchor({0.0, 0, {}, {0, 0, 0}});
   map.addOdometry(0.5, {0.5, 0, 0});
   map.addOdometry(1.0, {1.0, 0, 0});
   map.addAnchor({1.0, 0, {1.0, 0.1, 0}, {1.0, 0, 0}});  // the scan at t = 1 matched 0.1 m left of the odometry
   map.addOdometry(1.5, {1.5, 0, 0});
   map.addOdometry(2.0, {2.0, 0, 0});
-  map.addKeyframe({1, 2.0, {2.0, 0, 0}, {}, false, {}});
+  map.addKeyframe({1, 2.0, {2.0, 0, 0}, false, false, {}}, {});
   map.addAnchor({2.0, 1, {}, {2.0, 0, 0}});
 
   const auto scans = map.scanTrajectory();
@@ -45,8 +45,8 @@ TEST(Map, TrajectoryPassesThroughAnchoredScansAndBlendsBetweenThem) {
 
 TEST(Map, IndexFollowsThePosesAfterReindexing) {
   Map map(nullptr, 1.0);
-  map.addKeyframe({0, 0.0, {0, 0, 0}, {}, false, {}});
-  map.addKeyframe({1, 1.0, {10, 0, 0}, {}, false, {}});
+  map.addKeyframe({0, 0.0, {0, 0, 0}, false, false, {}}, {});
+  map.addKeyframe({1, 1.0, {10, 0, 0}, false, false, {}}, {});
   std::vector<size_t> near;
   map.index().query(10, 0, 0.5, near);
   ASSERT_EQ(near.size(), 1u);

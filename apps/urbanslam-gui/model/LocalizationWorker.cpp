@@ -15,7 +15,7 @@ LocalizationWorker::LocalizationWorker(const std::string& map_path, const std::s
   localizer_ = std::make_unique<slam::Localizer>(map_->map(), map_->options(), slam::localizerOptions(map_->options()));
   state_.localizing = true;
   for (const auto& k : map_->keyframes()) {
-    auto pts = std::make_shared<const std::vector<io::Point2>>(k.hasScan() ? io::scanToPoints(k.scan.expand(), true) : std::vector<io::Point2>{});
+    auto pts = std::make_shared<const std::vector<io::Point2>>(k.hasScan() ? io::scanToPoints(map_->map().scan(k.index), true) : std::vector<io::Point2>{});
     state_.keyframes.push_back({k.index, k.timestamp, k.pose, std::move(pts), nullptr});
   }
   state_.stats.keyframes = state_.keyframes.size();

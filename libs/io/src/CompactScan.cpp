@@ -74,6 +74,48 @@ size_t CompactScan::validCount() const {
   return n;
 }
 
+void CompactScan::write(common::BinaryWriter& w) const {
+  w.f64(timestamp_);
+  w.string(label_);
+  w.f64(angle_min_rad_);
+  w.f64(angle_increment_rad_);
+  w.f64(max_range_m_);
+  w.f64(sensor_pose_.x);
+  w.f64(sensor_pose_.y);
+  w.f64(sensor_pose_.phi);
+  w.f64(step_m_);
+  w.f32(far_m_);
+  w.u32(beams_);
+  w.size(data_.size());
+  for (const std::uint16_t v : data_) {
+    w.u8(static_cast<std::uint8_t>(v & 0xFF));
+    w.u8(static_cast<std::uint8_t>(v >> 8));
+  }
+}
+
+CompactScan CompactScan::read(common::BinaryReader& r) {
+  CompactScan s;
+  s.timestamp_ = r.f64();
+  s.label_ = r.string();
+  s.angle_min_rad_ = r.f64();
+  s.angle_increment_rad_ = r.f64();
+  s.max_range_m_ = r.f64();
+  s.sensor_pose_.x = r.f64();
+  s.sensor_pose_.y = r.f64();
+  s.sensor_pose_.phi = r.f64();
+  s.step_m_ = r.f64();
+  s.far_m_ = r.f32();
+  s.beams_ = r.u32();
+  const size_t words = r.count(2);
+  if (words != s.beams_ + flagWords(s.beams_)) r.fail("a compact scan's codes do not match its beam count");
+  s.data_.resize(words);
+  for (auto& v : s.data_) {
+    const std::uint16_t lo = r.u8();
+    v = static_cast<std::uint16_t>(lo | static_cast<std::uint16_t>(r.u8()) << 8);
+  }
+  return s;
+}
+
 LaserScan CompactScan::expand() const {
   LaserScan s;
   expandInto(s);

@@ -66,12 +66,16 @@ const LaserScan& PosedScan::get(LaserScan& buffer) const {
   if (scan) return *scan;
   if (compact)
     compact->expandInto(buffer);
+  else if (store)
+    store->expandInto(id, buffer);
   else
     buffer = LaserScan{};
   return buffer;
 }
 
-size_t PosedScan::validCount() const { return scan ? scan->validCount() : compact ? compact->validCount() : 0; }
+size_t PosedScan::validCount() const {
+  return scan ? scan->validCount() : compact ? compact->validCount() : store ? store->validCount(id) : 0;
+}
 
 size_t forEachMapPoint(const std::vector<PosedScan>& scans, int decimation,
                        const std::function<void(const std::vector<MapPoint>&)>& visit) {

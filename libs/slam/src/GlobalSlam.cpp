@@ -36,13 +36,13 @@ laser_loop::LoopDetector& GlobalSlam::laserDetector() {
     laser_detector_ = std::make_unique<laser_loop::LoopDetector>(laser_loop::LoopDetector::fromFile(laser_loop::kDefaultModelPath));
   // Features are a function of each keyframe's scan, computed once, when first needed (the
   // indoor logs never need them; a resumed run computes them from the saved scans).
-  for (size_t k = laser_detector_->size(); k < map_.size(); ++k) laser_detector_->addKeyframe(map_.keyframes()[k].scan.expand());
+  for (size_t k = laser_detector_->size(); k < map_.size(); ++k) laser_detector_->addKeyframe(map_.scan(k));
   return *laser_detector_;
 }
 
 GlobalSlam::~GlobalSlam() = default;
 
-std::array<double, 9> GlobalSlam::addKeyframe(Keyframe kf, const KeyframeConstraint& constraint) {
+std::array<double, 9> GlobalSlam::addKeyframe(Keyframe kf, io::CompactScan scan, const KeyframeConstraint& constraint) {
   const size_t k = map_.size();
   esdf::Esdf* filter = map_.filter();
   if (k == 0) {
@@ -64,7 +64,7 @@ std::array<double, 9> GlobalSlam::addKeyframe(Keyframe kf, const KeyframeConstra
   // Window recovery moved the last `recent_window` keyframes too.
   const size_t window = static_cast<size_t>(options_.estimator.recent_window);
   if (filter && k > 0) map_.pullPoses(k > window ? k - window : 0);
-  map_.addKeyframe(std::move(kf));
+  map_.addKeyframe(std::move(kf), std::move(scan));
   std::array<double, 9> c{};
   if (filter && k > 0) {
     const esdf::Mat3 m = filter->marginalCovariance(static_cast<int>(k), esdf::CovarianceMode::Conservative);
@@ -184,7 +184,7 @@ void GlobalSlam::closeLoops(size_t current, SteadyTime handed_over) {
   // the estimate is too uncertain the classifier's detections (keyframes with scans only:
   // alignment needs both).
   std::vector<Candidate> cands;
-  if (map_.keyframes()[current].hasScan()) cands = closer_.candidates(*map_.filter(), map_.keyframes(), map_.index(), current);
+  if (map_.keyframes()[current].hasScan()) cands = closer_.candidates(*map_.filter(), map_, current);
   std::vector<size_t> keyframes;
   for (const Candidate& c : cands) keyframes.push_back(c.keyframe);
   for (auto* o : observers_) o->onCandidates({current, &keyframes});
@@ -194,7 +194,7 @@ void GlobalSlam::closeLoops(size_t current, SteadyTime handed_over) {
     // 7-9. Alignment and gating (the update itself waits for a confirmation).
     ++stats_.closures_tried;
     const Detection* detection = c.detection ? &*c.detection : nullptr;
-    if (admit(closer_.tryClose(*map_.filter(), map_.keyframes(), c.keyframe, current, !confirm, detection), current) ==
+    if (admit(closer_.tryClose(*map_.filter(), map_, c.keyframe, current, !confirm, detection), current) ==
         Admission::Accepted) {
       accepted = true;
       break;  // one closure per keyframe; the next keyframe sees the corrected map
@@ -242,10 +242,10 @@ void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double scor
     esdf::Esdf& f = *map_.filter();
     LoopClosureRecord r;
     if (scans) {
-      r = closer_.tryClose(f, map_.keyframes(), earlier, current, !confirm, &detection);
+      r = closer_.tryClose(f, map_, earlier, current, !confirm, &detection);
     } else {
       const esdf::RelativeFactor factor = cameraFactor(*camera, f.mean(static_cast<int>(earlier)), f.mean(static_cast<int>(current)));
-      r = closer_.tryCloseMeasured(f, map_.keyframes(), earlier, current, factor.z, factor.omega, !confirm, detection);
+      r = closer_.tryCloseMeasured(f, map_, earlier, current, factor.z, factor.omega, !confirm, detection);
     }
     ++stats_.closures_tried;
     const ClosureReason reason = r.reason;

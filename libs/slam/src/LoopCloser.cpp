@@ -69,8 +69,9 @@ Eigen::Matrix3d LoopCloser::relativeCovariance(esdf::Esdf& filter, size_t i, siz
   return s;
 }
 
-std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, const KeyframeGrid& grid,
-                                              size_t current) {
+std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const Map& map, size_t current) {
+  const std::vector<Keyframe>& keyframes = map.keyframes();
+  const KeyframeGrid& grid = map.index();
   const auto& cur = keyframes[current];
   if (current < static_cast<size_t>(options_.min_keyframe_gap)) return {};
   const size_t newest_allowed = current - static_cast<size_t>(options_.min_keyframe_gap);
@@ -157,8 +158,9 @@ bool LoopCloser::ambiguous(esdf::Esdf& filter, const io::LaserScan& earlier_scan
   return false;
 }
 
-LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current,
+LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current,
                                        bool commit, const Detection* detection) {
+  const std::vector<Keyframe>& keyframes = map.keyframes();
   LoopClosureRecord r;
   r.from = earlier;
   r.to = current;
@@ -192,8 +194,9 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
   };
   // (Trying PL-ICP first on an uncertain guess was measured worse: it lands in wrong local
   // minima that pass the residual test — ATE 2.96 m vs 0.26 m on Intel.)
-  // The keyframes keep their scans compact: expanded once for this candidate's alignments.
-  const io::LaserScan earlier_scan = keyframes[earlier].scan.expand(), current_scan = keyframes[current].scan.expand();
+  // The map keeps its scans compact (and maybe on disk): expanded once for this candidate's
+  // alignments.
+  const io::LaserScan earlier_scan = map.scan(earlier), current_scan = map.scan(current);
   const alignment::AlignmentResult a = alignment::align(earlier_scan, current_scan, guess, ao);
   r.measurement = a.transform;
   r.rms_m = a.rms_residual_m;
@@ -231,9 +234,10 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const std::vector<Key
   return r;
 }
 
-LoopClosureRecord LoopCloser::tryCloseMeasured(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current,
+LoopClosureRecord LoopCloser::tryCloseMeasured(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current,
                                                const esdf::Vec3& z, const Eigen::Matrix3d& information, bool commit,
                                                const Detection& detection) {
+  const std::vector<Keyframe>& keyframes = map.keyframes();
   LoopClosureRecord r;
   r.from = earlier;
   r.to = current;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/esdf/PoseOps.h"
@@ -12,11 +14,15 @@ namespace {
 constexpr size_t kNone = std::numeric_limits<size_t>::max();
 }  // namespace
 
-Map::Map(std::unique_ptr<esdf::Esdf> filter, double index_cell_m) : index_(index_cell_m), filter_(std::move(filter)) {}
+Map::Map(std::unique_ptr<esdf::Esdf> filter, double index_cell_m, size_t scan_cache_bytes, std::string spill_dir)
+    : scans_(scan_cache_bytes, std::move(spill_dir)), index_(index_cell_m), filter_(std::move(filter)) {}
 
 Map::~Map() = default;
 
-void Map::addKeyframe(Keyframe kf) {
+void Map::addKeyframe(Keyframe kf, io::CompactScan scan) {
+  if (kf.index != keyframes_.size()) throw std::logic_error("Map::addKeyframe: keyframe " + std::to_string(kf.index) + " added as keyframe " + std::to_string(keyframes_.size()));
+  kf.has_scan = !scan.empty();
+  scans_.add(std::move(scan));
   index_.insert(kf.index, kf.pose.x, kf.pose.y);
   keyframes_.push_back(std::move(kf));
 }
@@ -104,7 +110,7 @@ std::vector<io::StampedPose> Map::scanTrajectory() const {
 std::vector<io::PosedScan> Map::posedKeyframes() const {
   std::vector<io::PosedScan> out;
   out.reserve(keyframes_.size());
-  for (const auto& k : keyframes_) out.push_back({k.pose, nullptr, &k.scan});
+  for (const auto& k : keyframes_) out.push_back({k.pose, nullptr, nullptr, &scans_, k.index});
   return out;
 }
 

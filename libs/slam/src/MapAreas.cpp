@@ -65,7 +65,7 @@ std::vector<size_t> MapAreas::tileKeyframes(int64_t key) const {
 
 alignment::PointSet MapAreas::keyframePoints(size_t k) const {
   const Keyframe& kf = map_.keyframes()[k];
-  return alignment::transformed(alignment::pointSetFromScan(kf.scan.expand(), options_.scan_model, true), kf.pose);
+  return alignment::transformed(alignment::pointSetFromScan(map_.scan(k), options_.scan_model, true), kf.pose);
 }
 
 MapAreas::Tile* MapAreas::find(std::list<Tile>& cache, int64_t key) {
@@ -84,7 +84,7 @@ const alignment::MatchReference* MapAreas::reference(double x, double y) {
   std::vector<alignment::ReferenceView> views;
   for (size_t k : tileKeyframes(key)) {
     // Each keyframe's free space in its own frame, placed by its pose (the matcher's step 2').
-    const alignment::PointSet own = alignment::pointSetFromScan(map_.keyframes()[k].scan.expand(), options_.scan_model, true);
+    const alignment::PointSet own = alignment::pointSetFromScan(map_.scan(k), options_.scan_model, true);
     views.push_back({alignment::BeamFreeSpace(own, options_.matcher.free_margin_m, options_.matcher.free_margin_fraction),
                      map_.keyframes()[k].pose});
     const alignment::PointSet placed = alignment::transformed(own, map_.keyframes()[k].pose);

@@ -39,7 +39,8 @@ std::unique_ptr<esdf::Esdf> makeFilter(const PipelineOptions& options) {
 Pipeline::Pipeline(PipelineOptions options)
     : options_(std::move(options)),
       input_(options_.input),
-      map_(makeFilter(options_), std::max(1.0, options_.loop_closure.search_radius_m)),
+      map_(makeFilter(options_), std::max(1.0, options_.loop_closure.search_radius_m),
+           static_cast<size_t>(options_.map.scan_cache_mb * 1024 * 1024), options_.map.scan_spill_dir),
       local_(options_),
       global_(options_, map_, stats_, observers_),
       images_(options_.loop_closure.image_max_offset_s),
@@ -221,9 +222,9 @@ void Pipeline::addKeyframe(io::LaserScan scan, const std::optional<CameraMeasure
   // The observers get the keyframe's scan as the map keeps it: the expanded copy local SLAM used
   // goes along rather than being expanded again there.
   //    Then the submap's keyframes as global SLAM sees them, for local SLAM to take later.
-  const size_t ticket = postToGlobalSlam([this, kf = Keyframe{k, timestamp, {}, std::move(kept), false, {}}, c, scan = std::move(scan),
+  const size_t ticket = postToGlobalSlam([this, kf = Keyframe{k, timestamp, {}, false, false, {}}, kept = std::move(kept), c, scan = std::move(scan),
                                           handed_over = std::chrono::steady_clock::now()]() mutable {
-    const std::array<double, 9> cov = global_.addKeyframe(std::move(kf), c);
+    const std::array<double, 9> cov = global_.addKeyframe(std::move(kf), std::move(kept), c);
     const Keyframe& added = map_.back();
     for (auto* o : observers_) o->onKeyframe({added.index, added.timestamp, added.pose, cov, &scan});
     global_.closeLoops(added.index, handed_over);

@@ -141,6 +141,8 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("grid_max_cells", o.map.grid_max_cells, 1e4, 1e9, "cells", "grid.png's size bound: a larger map is written coarser there");
   s.add("grid_tile_cells", o.map.grid_tile_cells, 100, 10000, "cells", "side of a tile of grid_tiles/");
   s.add("point_decimation", o.map.point_decimation, 1, 1000, "", "keep every n-th point in the point clouds");
+  s.add("scan_cache_mb", o.map.scan_cache_mb, 0, 1e6, "MB", "keyframe scans held in memory at most; the rest wait in a spill file");
+  s.add("scan_spill_dir", o.map.scan_spill_dir, {}, "folder of the spill file (deleted with the run); empty: the system's temporary folder");
 
   s.section("output", "Which files a run writes besides the trajectory, stats.json and config.ini");
   s.add("write_ply_binary", o.output.write_ply_binary, "map.ply (binary little-endian PLY)");

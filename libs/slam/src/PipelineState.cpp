@@ -266,11 +266,13 @@ void KeyframeGrid::readState(BinaryReader& r, size_t keyframes) {
 
 void Map::writeState(BinaryWriter& w) const {
   w.size(keyframes_.size());
+  io::LaserScan scan;
   for (const Keyframe& k : keyframes_) {
     w.size(k.index);
     w.f64(k.timestamp);
     writePose(w, k.pose);
-    writeScan(w, k.scan.expand());
+    scans_.expandInto(k.index, scan);
+    writeScan(w, scan);
     w.boolean(k.has_image);
     w.size(k.image_words.entries.size());
     for (const auto& e : k.image_words.entries) {
@@ -304,13 +306,16 @@ void Map::writeState(BinaryWriter& w) const {
 
 void Map::readState(BinaryReader& r) {
   keyframes_.resize(r.count(8 + 8 + 24 + 1));
+  scans_.clear();
   for (size_t i = 0; i < keyframes_.size(); ++i) {
     Keyframe& k = keyframes_[i];
     k.index = r.size();
     if (k.index != i) r.fail("keyframe " + std::to_string(i) + " numbered " + std::to_string(k.index));
     k.timestamp = r.f64();
     k.pose = readPose(r);
-    k.scan = io::CompactScan(readScan(r));
+    io::CompactScan scan(readScan(r));
+    k.has_scan = !scan.empty();
+    scans_.add(std::move(scan));
     k.has_image = r.boolean();
     k.image_words.entries.resize(r.count(8));
     for (auto& e : k.image_words.entries) {

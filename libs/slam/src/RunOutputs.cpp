@@ -187,6 +187,12 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   t["global_wait_s"] = s.global_wait_s;
   t["outputs_s"] = sw.seconds();
   t["peak_rss_mb"] = static_cast<double>(common::peakResidentBytes()) / (1024.0 * 1024.0);
+  // The keyframe scans: held in memory (bounded by [map] scan_cache_mb) and spilled to disk.
+  Json scans = Json::object();
+  scans["resident_mb"] = static_cast<double>(p.map().scans().residentBytes()) / (1024.0 * 1024.0);
+  scans["spilled_mb"] = static_cast<double>(p.map().scans().spilledBytes()) / (1024.0 * 1024.0);
+  scans["cache_mb"] = static_cast<double>(p.map().scans().cacheBytes()) / (1024.0 * 1024.0);
+  j["scan_store"] = std::move(scans);
   if (grid.size() > 0) j["grid"] = grid;
   j["files"] = files;
   j["config"] = optionsToJson(o);

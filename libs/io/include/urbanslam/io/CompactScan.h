@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "urbanslam/common/BinaryStream.h"
 #include "urbanslam/common/Pose2.h"
 #include "urbanslam/io/LaserScan.h"
 
@@ -35,6 +36,13 @@ class CompactScan {
   double stepM() const { return step_m_; }
   // Beams flagged valid (the expanded scan's validCount(), without expanding it).
   size_t validCount() const;
+  // Memory it takes, its buffers included.
+  size_t memoryBytes() const { return sizeof(*this) + label_.capacity() + data_.capacity() * sizeof(std::uint16_t); }
+
+  // Exactly as held (codes, not ranges): read gives back an equal scan. Not a file format for
+  // users (a map file writes scans expanded); the scan store's spill file.
+  void write(common::BinaryWriter& w) const;
+  static CompactScan read(common::BinaryReader& r);
 
  private:
   double timestamp_ = 0;

@@ -9,6 +9,7 @@
 #include "urbanslam/common/Pose2.h"
 #include "urbanslam/io/CompactScan.h"
 #include "urbanslam/io/LaserScan.h"
+#include "urbanslam/io/ScanStore.h"
 
 namespace urbanslam::io {
 
@@ -17,13 +18,15 @@ struct StampedPose {
   common::Pose2 pose;
 };
 
-// A scan and the vehicle pose it was taken from: a LaserScan, or a CompactScan (a map's
-// keyframes) that the writers expand one at a time, never all at once.
+// A scan and the vehicle pose it was taken from: a LaserScan, a CompactScan, or a scan store's
+// entry (a map's keyframes), which the writers expand one at a time, never all at once.
 struct PosedScan {
   common::Pose2 pose;
   const LaserScan* scan = nullptr;
   const CompactScan* compact = nullptr;  // used when scan is null
-  // The scan itself, or the compact one expanded into `buffer`.
+  const ScanStore* store = nullptr;      // used when both are null: its scan `id`
+  size_t id = 0;
+  // The scan itself, or the compact or stored one expanded into `buffer`.
   const LaserScan& get(LaserScan& buffer) const;
   size_t validCount() const;  // without expanding
 };

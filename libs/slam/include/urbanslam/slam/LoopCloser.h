@@ -20,7 +20,7 @@
 
 namespace urbanslam::slam {
 
-struct Keyframe;
+class Map;
 
 // Why a loop-closure hypothesis did not become a constraint.
 enum class ClosureReason {
@@ -78,20 +78,19 @@ class LoopCloser {
   // With a scorer, appearance adds candidates when the estimate is too uncertain to pick them.
   void setScorer(CandidateScorer scorer);
 
-  // The final candidate set for keyframe `current`; `grid` is the map's spatial index of the
-  // keyframes. First the max_candidates keyframes nearest the estimate (Mahalanobis). When the
+  // The final candidate set for keyframe `current` of `map` (its spatial index and estimates). First the max_candidates keyframes nearest the estimate (Mahalanobis). When the
   // pose relative to the nearest keyframe is uncertain beyond appearance_min_sigma_m, many
   // keyframes lie within reach and the nearest ones are as likely wrong as any: with a scorer,
   // up to max_candidates of the classifier's detections follow, best first and one per place
   // (search_radius_m apart).
-  std::vector<Candidate> candidates(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, const KeyframeGrid& grid, size_t current);
+  std::vector<Candidate> candidates(esdf::Esdf& filter, const Map& map, size_t current);
   // Alignment and gating of one candidate. With `commit`, a closure that passes is
   // added to the filter; without, it is only tested (accepted = passed) for later confirmation.
-  LoopClosureRecord tryClose(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current, bool commit = true,
+  LoopClosureRecord tryClose(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current, bool commit = true,
                              const Detection* detection = nullptr);
   // Gating (and with `commit` the update) of a relative-pose factor measured by another sensor
   // (the camera: CameraClosure.h) in place of a scan alignment.
-  LoopClosureRecord tryCloseMeasured(esdf::Esdf& filter, const std::vector<Keyframe>& keyframes, size_t earlier, size_t current,
+  LoopClosureRecord tryCloseMeasured(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current,
                                      const esdf::Vec3& z, const Eigen::Matrix3d& information, bool commit, const Detection& detection);
 
   // The relative covariances kept for the current keyframe (a later image proposal for it

@@ -4,6 +4,9 @@
 // keyframes, the filter's information form (the ESDF; none in dead reckoning), and the scans
 // and odometry readings hung from keyframes, from which the trajectory at every sensor time is
 // rebuilt on demand. Local and global SLAM read it; only global SLAM changes the filter.
+//
+// The keyframes' own scans live in a scan store (io::ScanStore): compact, in memory up to a
+// bound and in a spill file beyond it, so a city of a million keyframes does not hold them all.
 #include <Eigen/Core>
 #include <memory>
 #include <vector>
@@ -11,6 +14,7 @@
 #include "urbanslam/common/BinaryStream.h"
 #include "urbanslam/io/CompactScan.h"
 #include "urbanslam/io/MapOutputs.h"
+#include "urbanslam/io/ScanStore.h"
 #include "urbanslam/slam/KeyframeGrid.h"
 #include "urbanslam/vision_loop/BagOfWords.h"
 
@@ -24,13 +28,12 @@ struct Keyframe {
   size_t index = 0;
   double timestamp = 0;
   common::Pose2 pose;  // current estimate
-  // Kept so the map can be rebuilt from the current estimates; empty for keyframes made from
-  // camera images alone. Held compact (ranges to the millimetre, about 2 bytes a beam) because
-  // every keyframe of a run keeps it: scan.expand() gives the io::LaserScan to align or draw.
-  io::CompactScan scan;
+  // Its scan is in the map's scan store (Map::scan); none for keyframes made from camera
+  // images alone.
+  bool has_scan = false;
   bool has_image = false;               // an image was attached (nearest in time)
   vision_loop::BagOfWords image_words;  // its Tree of Words vector (tree_of_words only); no pixels
-  bool hasScan() const { return !scan.empty(); }
+  bool hasScan() const { return has_scan; }
 };
 
 // A constraint between two keyframes as it went into the filter (for the g2o output).
@@ -54,8 +57,10 @@ struct ScanAnchor {
 class Map {
  public:
   // `filter`: the estimator behind the poses (nullptr: dead reckoning, poses composed from the
-  // constraints). `index_cell_m`: the spatial index's cell.
-  Map(std::unique_ptr<esdf::Esdf> filter, double index_cell_m);
+  // constraints). `index_cell_m`: the spatial index's cell. `scan_cache_bytes`, `spill_dir`: the
+  // scan store's memory bound and spill folder (io::ScanStore).
+  Map(std::unique_ptr<esdf::Esdf> filter, double index_cell_m, size_t scan_cache_bytes = io::ScanStore::kDefaultCacheBytes,
+      std::string spill_dir = {});
   ~Map();
 
   const std::vector<Keyframe>& keyframes() const { return keyframes_; }
@@ -63,7 +68,14 @@ class Map {
   bool empty() const { return keyframes_.empty(); }
   const Keyframe& back() const { return keyframes_.back(); }
   Keyframe& keyframe(size_t i) { return keyframes_[i]; }
-  void addKeyframe(Keyframe kf);
+  // `kf.index` must be size(); `scan` is its scan (empty: none), kept to the millimetre.
+  void addKeyframe(Keyframe kf, io::CompactScan scan);
+
+  // Keyframe k's scan (empty for a keyframe without one), read back from the spill file when
+  // it is not in memory.
+  io::LaserScan scan(size_t k) const { return scans_.expand(k); }
+  void scanInto(size_t k, io::LaserScan& out) const { scans_.expandInto(k, out); }
+  const io::ScanStore& scans() const { return scans_; }
 
   const std::vector<GraphEdge>& edges() const { return edges_; }
   void addEdge(const GraphEdge& e) { edges_.push_back(e); }
@@ -104,6 +116,7 @@ class Map {
   };
 
   std::vector<Keyframe> keyframes_;
+  io::ScanStore scans_;  // keyframe k's scan has id k
   std::vector<GraphEdge> edges_;
   KeyframeGrid index_;
   std::unique_ptr<esdf::Esdf> filter_;

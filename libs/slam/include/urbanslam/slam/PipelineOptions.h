@@ -135,6 +135,10 @@ struct MapOptions {
   double grid_max_cells = 1e8;      // grid.png's size bound: a larger map is written coarser there
   int grid_tile_cells = 2000;       // side of a grid tile (grid_tiles/), in cells
   int point_decimation = 1;         // keep every n-th map point in the point clouds
+  // The keyframes' scans held in memory at most; the others wait in a spill file (deleted with
+  // the run) until a loop candidate or an output reads them.
+  double scan_cache_mb = 256;
+  std::string scan_spill_dir;  // the spill file's folder; empty: the system's temporary folder
 };
 
 struct OutputOptions {
