@@ -6,6 +6,7 @@ const std::vector<Command>& commands() {
   static const std::vector<Command> all = {
       {"run", "build a map and trajectory from a log (the main job)", runCommand},
       {"localize", "track a log's vehicle in the map of an earlier run (the map unchanged)", localizeCommand},
+      {"merge", "join the maps of separate runs into one by place recognition, optimised together", mergeCommand},
       {"convert", "write any supported log as an MRPT rawlog", convertCommand},
       {"eval", "accuracy of a run: relations, ATE/RPE, true/false loop closures", evalCommand},
       {"graph", "feed a g2o/TORO pose graph to the ESDF incrementally; chi2 and timings", graphCommand},

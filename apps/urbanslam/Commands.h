@@ -17,6 +17,7 @@ struct Command {
 
 int runCommand(const Argv& args);
 int localizeCommand(const Argv& args);
+int mergeCommand(const Argv& args);
 int convertCommand(const Argv& args);
 int checkIniCommand(const Argv& args);
 int evalCommand(const Argv& args);

@@ -11,6 +11,7 @@
 #include "urbanslam/sim/SimOptions.h"
 #include "urbanslam/sim/SimulatedSource.h"
 #include "urbanslam/slam/MapFile.h"
+#include "urbanslam/slam/MapSession.h"
 #include "urbanslam/slam/Pipeline.h"
 #include "urbanslam/slam/RunOutputs.h"
 
@@ -33,7 +34,7 @@ class ProgressObserver : public slam::PipelineObserver {
 }  // namespace
 
 int runCommand(const Argv& args) {
-  ArgParser ap("urbanslam run [--ini FILE] [--out DIR] [--quiet] [--json] [--resume MAP] [LOG | --simulate CITY_INI]",
+  ArgParser ap("urbanslam run [--ini FILE] [--out DIR] [--quiet] [--json] [--resume MAP | --map MAP] [LOG | --simulate CITY_INI]",
                "Builds a map and trajectory from a log: MRPT rawlog (either layout, gzipped or not),\n"
                "CARMEN log (raw or Freiburg-corrected), GMapping gfs log, Victoria Park (folder or zip) or a\n"
                "folder of camera images (one keyframe per image; image loop proposals need [loop_closure] image_detector).");
@@ -47,6 +48,12 @@ int runCommand(const Argv& args) {
                "continue the map of an earlier run (its map.usmap, or its output folder) with LOG, which\n"
                "must start where that run's log ended (e.g. the rest of a split log); the result is that of\n"
                "one run over both. An --ini may change only [map] and [output] keys");
+  ap.addOption("map", "MAP",
+               "map LOG as a new session of the map of an earlier run (its map.usmap, or its output folder),\n"
+               "starting anywhere: LOG is mapped on its own until place recognition finds it in the map\n"
+               "(a few agreeing places), then joined to the map and continued inside it; a LOG that never\n"
+               "meets the map ends as a map of its own (stats.json: sessions). An --ini may change only\n"
+               "[map] and [output] keys");
   ap.addOption("out", "DIR", "output folder (created if needed)", "out");
   ap.addFlag("quiet", "no progress bar and no summary on stderr");
   ap.addFlag("json", "print stats.json as one JSON object on stdout");
@@ -63,11 +70,16 @@ int runCommand(const Argv& args) {
     throw common::InputError("run: give either a LOG or --simulate CITY_INI, not both");
   if (ap.has("resume") && !ap.has("simulate") && ap.positional("LOG").empty())
     throw common::InputError("run --resume: give the LOG that continues the map");
+  if (ap.has("resume") && ap.has("map")) throw common::InputError("run: give either --resume MAP or --map MAP, not both");
+  if (ap.has("map") && !ap.has("simulate") && ap.positional("LOG").empty())
+    throw common::InputError("run --map: give the LOG to map into the map");
   const std::string log = ap.has("simulate")             ? ap.option("simulate")
                           : ap.positional("LOG").empty() ? defaultRawlog()
                                                          : ap.positional("LOG");
   const bool quiet = ap.flag("quiet");
-  const std::string map = ap.has("resume") ? slam::mapFilePath(ap.option("resume")) : "";
+  const std::string map = ap.has("resume") ? slam::mapFilePath(ap.option("resume"))
+                          : ap.has("map")  ? slam::mapFilePath(ap.option("map"))
+                                           : "";
   // Resuming without --ini keeps the map's own options.
   std::string ini = ap.has("ini") ? ap.option("ini") : map.empty() ? defaultIni() : "";
   std::string resolved;
@@ -90,8 +102,21 @@ int runCommand(const Argv& args) {
   // The simulator is a data source like a file reader: a drive of any length streams through.
   std::unique_ptr<io::DataSource> source =
       ap.has("simulate") ? std::make_unique<sim::SimulatedSource>(sim::loadSimOptions(log)) : io::openDataSource(log);
-  pipeline->addObserver(&progress);
-  pipeline->runInput(*source);
+  common::Json sessions;
+  bool joined = false;
+  if (ap.has("map")) {
+    // A new session of the map: on its own until it is found in the map, then inside it.
+    slam::SessionRun s = slam::runSessionInMap(std::move(pipeline), *source, {&progress});
+    pipeline = std::move(s.pipeline);
+    joined = s.join.joined;
+    sessions = common::Json::array();
+    sessions.push(slam::sessionJson(log, s.join, s.keyframes_before, s.joined_at_s));
+    if (!quiet && !s.join.joined)
+      std::cerr << "urbanslam run: " << log << " was not found in " << map << " (" << s.join.reason << "): its map is its own\n";
+  } else {
+    pipeline->addObserver(&progress);
+    pipeline->runInput(*source);
+  }
   // The map is saved before finish(): finish() drops the closures still awaiting confirmation,
   // which a continued run may yet confirm. It goes to a temporary file beside the run folder
   // (streamed, never whole in memory), which the outputs move into the folder; a run that
@@ -124,7 +149,8 @@ int runCommand(const Argv& args) {
                                                : ": none of its " + std::to_string(scans) + " laser scans could be used: nothing to map"));
   }
 
-  const common::Json stats = slam::writeRunOutputs(*pipeline, out, {log, source->format(), ini, resolved, map_file, map});
+  const common::Json stats = slam::writeRunOutputs(
+      *pipeline, out, {log, source->format(), ini, resolved, map_file, ap.has("map") && !joined ? "" : map, sessions});
   if (ap.flag("json")) std::cout << stats.dump() << "\n";
   if (!quiet) {
     const auto& t = stats.at("timing");

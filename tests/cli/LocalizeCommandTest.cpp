@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <filesystem>
 #include <regex>
-#include <sstream>
 
 #include "CliRunner.h"
 #include "TestFiles.h"
@@ -16,20 +15,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The FR079 excerpt split after its first `scans` laser scans; both parts keep the header lines.
+// The FR079 excerpt split after its first `scans` laser scans.
 std::pair<std::string, std::string> splitExcerpt(const fs::path& dir, size_t scans) {
-  std::istringstream in(gunzip(repoPath("rawlogs/fr079-raw-excerpt.clf.gz")));
-  std::string header, a, b, line;
-  size_t seen = 0;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#' || line.rfind("PARAM", 0) == 0) {
-      header += line + "\n";
-      continue;
-    }
-    if (line.rfind("FLASER", 0) == 0) ++seen;
-    (seen <= scans ? a : b) += line + "\n";
-  }
-  return {writeFile(dir / "first.clf", header + a), writeFile(dir / "rest.clf", header + b)};
+  return splitCarmenLog(repoPath("rawlogs/fr079-raw-excerpt.clf.gz"), dir, scans);
 }
 
 double jsonNumber(const std::string& json, const std::string& key) {

@@ -6,7 +6,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
+#include <utility>
 
 namespace urbanslam::test {
 
@@ -27,6 +29,23 @@ inline std::string writeGz(const std::filesystem::path& p, const std::string& by
   mrpt::io::CFileGZOutputStream out(p.string());
   out.Write(bytes.data(), bytes.size());
   return p.string();
+}
+
+// A CARMEN log (gzipped) split after its first `scans` laser scans into `dir`/first.clf and
+// `dir`/rest.clf; both parts keep the header lines (the sensor's description).
+inline std::pair<std::string, std::string> splitCarmenLog(const std::string& gz, const std::filesystem::path& dir, size_t scans) {
+  std::istringstream in(gunzip(gz));
+  std::string header, a, b, line;
+  size_t seen = 0;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#' || line.rfind("PARAM", 0) == 0) {
+      header += line + "\n";
+      continue;
+    }
+    if (line.rfind("FLASER", 0) == 0) ++seen;
+    (seen <= scans ? a : b) += line + "\n";
+  }
+  return {writeFile(dir / "first.clf", header + a), writeFile(dir / "rest.clf", header + b)};
 }
 
 }  // namespace urbanslam::test

@@ -138,7 +138,7 @@ std::shared_ptr<const CompactScan> ScanStore::readBackLocked(const Entry& e) con
 
 void ScanStore::openSpillFileLocked() const {
   if (spill_dir_.empty()) spill_dir_ = std::filesystem::temp_directory_path().string();
-  // Unlinked from the start: nothing to clean up after a crash, nothing a run folder shows.
+    // Unlinked from the start: nothing to clean up after a crash, nothing a run folder shows.
 #ifdef O_TMPFILE
   spill_fd_ = ::open(spill_dir_.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
 #endif

@@ -43,6 +43,10 @@ laser_loop::LoopDetector& GlobalSlam::laserDetector() {
 GlobalSlam::~GlobalSlam() = default;
 
 std::array<double, 9> GlobalSlam::addKeyframe(Keyframe kf, io::CompactScan scan, const KeyframeConstraint& constraint) {
+  return addKeyframeFrom(map_.empty() ? 0 : map_.size() - 1, std::move(kf), std::move(scan), constraint);
+}
+
+std::array<double, 9> GlobalSlam::addKeyframeFrom(size_t from, Keyframe kf, io::CompactScan scan, const KeyframeConstraint& constraint) {
   const size_t k = map_.size();
   esdf::Esdf* filter = map_.filter();
   if (k == 0) {
@@ -50,17 +54,17 @@ std::array<double, 9> GlobalSlam::addKeyframe(Keyframe kf, io::CompactScan scan,
     if (filter) filter->initialise(esdf::Vec3::Zero(), esdf::Mat3::Identity() * 1e-9);
   } else {
     const Eigen::Matrix3d info = constraint.cov.inverse();
-    map_.addEdge({k - 1, k, constraint.z, info, false});
+    map_.addEdge({from, k, constraint.z, info, false});
     if (filter) {
       // ESDF prediction with augmentation: the keyframe becomes a delayed pose, O(1); then the
       // recent poses are recovered (a bounded window: constant time between closures).
-      filter->augmentRelative(static_cast<int>(k - 1), esdf::toVec(constraint.z), info);
+      filter->augmentRelative(static_cast<int>(from), esdf::toVec(constraint.z), info);
       filter->recoverRecent(std::max(0, static_cast<int>(k) - options_.estimator.recent_window));
       dirty_since_recovery_ = true;
     }
   }
   kf.pose = filter ? esdf::toPose(filter->mean(static_cast<int>(k)))
-                   : (k == 0 ? common::Pose2{} : common::compose(map_.back().pose, constraint.z));
+                   : (k == 0 ? common::Pose2{} : common::compose(map_.keyframes()[from].pose, constraint.z));
   // Window recovery moved the last `recent_window` keyframes too.
   const size_t window = static_cast<size_t>(options_.estimator.recent_window);
   if (filter && k > 0) map_.pullPoses(k > window ? k - window : 0);
@@ -194,8 +198,7 @@ void GlobalSlam::closeLoops(size_t current, SteadyTime handed_over) {
     // 7-9. Alignment and gating (the update itself waits for a confirmation).
     ++stats_.closures_tried;
     const Detection* detection = c.detection ? &*c.detection : nullptr;
-    if (admit(closer_.tryClose(*map_.filter(), map_, c.keyframe, current, !confirm, detection), current) ==
-        Admission::Accepted) {
+    if (admit(closer_.tryClose(*map_.filter(), map_, c.keyframe, current, !confirm, detection), current) == Admission::Accepted) {
       accepted = true;
       break;  // one closure per keyframe; the next keyframe sees the corrected map
     }

@@ -20,7 +20,9 @@ Map::Map(std::unique_ptr<esdf::Esdf> filter, double index_cell_m, size_t scan_ca
 Map::~Map() = default;
 
 void Map::addKeyframe(Keyframe kf, io::CompactScan scan) {
-  if (kf.index != keyframes_.size()) throw std::logic_error("Map::addKeyframe: keyframe " + std::to_string(kf.index) + " added as keyframe " + std::to_string(keyframes_.size()));
+  if (kf.index != keyframes_.size())
+    throw std::logic_error("Map::addKeyframe: keyframe " + std::to_string(kf.index) + " added as keyframe " +
+                           std::to_string(keyframes_.size()));
   kf.has_scan = !scan.empty();
   scans_.add(std::move(scan));
   index_.insert(kf.index, kf.pose.x, kf.pose.y);
@@ -45,6 +47,19 @@ void Map::addAnchor(const ScanAnchor& anchor) {
 
 void Map::addOdometry(double timestamp, const common::Pose2& odom) {
   odometry_.push_back({timestamp, odom, anchors_.empty() ? kNone : anchors_.size() - 1});
+}
+
+void Map::appendTrajectory(const Map& other, size_t keyframe_offset) {
+  const size_t anchor_offset = anchors_.size();
+  for (ScanAnchor a : other.anchors_) {
+    a.keyframe += keyframe_offset;
+    anchors_.push_back(a);
+  }
+  // A reading before the other map's first anchor hangs from that anchor, not from this map's.
+  for (OdometrySample s : other.odometry_) {
+    s.anchor = s.anchor == kNone ? anchor_offset : s.anchor + anchor_offset;
+    odometry_.push_back(s);
+  }
 }
 
 std::vector<io::StampedPose> Map::odometryTrajectory() const {

@@ -142,6 +142,7 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   j["input_format"] = info.input_format;
   j["ini"] = info.ini_path;
   if (!info.resumed_map.empty()) j["resumed_map"] = info.resumed_map;
+  if (info.sessions.type() != Json::Type::Null) j["sessions"] = info.sessions;
   j["estimator"] = p.estimatorName();
   Json& c = j["counts"];
   c["measurements"] = s.measurements;

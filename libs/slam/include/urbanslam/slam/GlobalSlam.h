@@ -38,6 +38,9 @@ class GlobalSlam {
   // The keyframe joins the map with the constraint from the previous one. Returns its marginal
   // covariance (row-major; zero without a filter or for the first keyframe).
   std::array<double, 9> addKeyframe(Keyframe kf, io::CompactScan scan, const KeyframeConstraint& constraint);
+  // The same with the constraint from keyframe `from` (the first keyframe of a session joined to
+  // the map: Pipeline::appendSession).
+  std::array<double, 9> addKeyframeFrom(size_t from, Keyframe kf, io::CompactScan scan, const KeyframeConstraint& constraint);
   // Loop closures of keyframe `current` with earlier ones, when [loop_closure] asks for it now.
   // `handed_over`: when local SLAM handed the keyframe over, for the correction's latency.
   void closeLoops(size_t current, SteadyTime handed_over);

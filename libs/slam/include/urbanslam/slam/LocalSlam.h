@@ -50,6 +50,9 @@ class LocalSlam {
   // `scan` became the newest keyframe, `z` the constraint from the previous one that global SLAM
   // took: the scan joins the submap, and the motion starts again there.
   void keyframeAdded(const io::LaserScan& scan, const common::Pose2& z);
+  // The keyframes made so far are `keyframes` in number (this state continues a session that was
+  // appended to a map: Pipeline::appendSession).
+  void renumber(size_t keyframes) { keyframes_ = keyframes; }
   // Global SLAM's estimate of the submap's keyframes up to `e.keyframe`: their geometry replaces
   // the chain's there, anchored at that keyframe (so the chain's frame does not move, and the
   // keyframes after it keep their constraints).

@@ -92,6 +92,9 @@ class Map {
   // The trajectory at sensor times.
   void addAnchor(const ScanAnchor& anchor);
   void addOdometry(double timestamp, const common::Pose2& odom);
+  // The trajectory of another map whose keyframes were appended to this one from index
+  // `keyframe_offset` on: its scan anchors and odometry samples.
+  void appendTrajectory(const Map& other, size_t keyframe_offset);
   // Estimated pose at every odometry (or drive) reading's time and at every anchored scan (at a
   // scan's time this is the scan's pose), from the current keyframe estimates and the odometry
   // between the scans.

@@ -17,6 +17,9 @@ struct RunInfo {
   std::string input_path, input_format, ini_path, resolved_ini;
   std::string map_file;     // map.usmap written before finish() (writeMapFile), moved in; empty: none
   std::string resumed_map;  // the map this run continued, "" for a run from scratch
+  // Sessions joined to the map (`run --map`, `merge`): stats.json's "sessions" (sessionJson);
+  // null for none.
+  common::Json sessions;
 };
 
 // The keyframe pose graph (estimates, motion and loop-closure constraints) as g2o.

@@ -1,0 +1,97 @@
+// Another session's map appended to this one and optimised jointly (Pipeline::appendSession).
+#include <Eigen/LU>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "urbanslam/common/Error.h"
+#include "urbanslam/slam/Pipeline.h"
+
+namespace urbanslam::slam {
+
+void Pipeline::appendSession(const Pipeline& session, const common::Pose2& transform, const Eigen::Matrix3d& transform_cov) {
+  if (finished_ || session.finished_) throw std::logic_error("Pipeline::appendSession after finish()");
+  if (!map_.filter())
+    throw common::InputError("maps built in dead reckoning cannot be merged: they have no filter to optimise them jointly");
+  drainGlobalSlam();
+  session.global_worker_.drain();
+  const Map& other = session.map_;
+  const size_t n0 = map_.size();
+  if (other.empty()) return;
+
+  // The session's odometry constraints, by the keyframe they lead to.
+  std::vector<const GraphEdge*> chain(other.size(), nullptr);
+  for (const GraphEdge& e : other.edges())
+    if (!e.loop_closure && e.to == e.from + 1 && e.to < chain.size()) chain[e.to] = &e;
+
+  const auto now = std::chrono::steady_clock::now();
+  for (const Keyframe& k : other.keyframes()) {
+    KeyframeConstraint c;
+    if (k.index == 0) {
+      // The first keyframe hangs from this map's keyframe nearest to where the join puts it, by
+      // the join's transform with its uncertainty; the closures that global SLAM finds next tie
+      // the two maps together with their real weight.
+      const common::Pose2 placed = common::compose(transform, k.pose);
+      std::vector<size_t> near;
+      map_.index().query(placed.x, placed.y, 50.0, near);
+      size_t from = n0 - 1;
+      double best = std::numeric_limits<double>::infinity();
+      for (size_t i : near) {
+        const double d = std::hypot(map_.keyframes()[i].pose.x - placed.x, map_.keyframes()[i].pose.y - placed.y);
+        if (d < best) best = d, from = i;
+      }
+      c.z = common::between(map_.keyframes()[from].pose, placed);
+      c.cov = transform_cov;
+      global_.addKeyframeFrom(from, Keyframe{n0, k.timestamp, {}, false, k.has_image, k.image_words}, io::CompactScan(other.scan(0)), c);
+    } else {
+      const GraphEdge* e = chain[k.index];
+      if (!e)
+        throw common::InputError("the session's keyframe " + std::to_string(k.index) + " has no odometry constraint from the one before");
+      c.z = e->measurement;
+      c.cov = e->information.inverse();
+      global_.addKeyframe(Keyframe{n0 + k.index, k.timestamp, {}, false, k.has_image, k.image_words}, io::CompactScan(other.scan(k.index)),
+                          c);
+    }
+    // Loop closures as a run finds them: against this map and the session's earlier keyframes.
+    global_.closeLoops(n0 + k.index, now);
+  }
+  map_.appendTrajectory(other, n0);
+  reference_.insert(reference_.end(), session.reference_.begin(), session.reference_.end());
+
+  // Local SLAM continues the session: its state (motion, submap in its own frame) with the
+  // keyframes counted in the merged map, and global SLAM's estimate of the submap it will take.
+  common::BinaryWriter w;
+  session.local_.writeState(w);
+  common::BinaryReader r(w.bytes().data(), w.bytes().size(), "session state");
+  local_.readState(r);
+  local_.renumber(map_.size());
+  submap_corrections_.take(std::numeric_limits<size_t>::max());
+  keyframe_tickets_.clear();
+  const size_t lag = static_cast<size_t>(std::max(0, options_.local.correction_lag_keyframes));
+  const size_t n = map_.size();
+  for (size_t j = std::max(n0, n > lag + 1 ? n - lag - 1 : 0); j < n; ++j) {
+    SubmapEstimate e{j, {}};
+    const size_t count = std::min(j + 1 - n0, static_cast<size_t>(std::max(1, options_.local.submap_keyframes)));
+    for (size_t i = j + 1 - count; i <= j; ++i) e.poses.push_back(map_.keyframes()[i].pose);
+    submap_corrections_.publish(std::move(e));
+  }
+  images_ = KeyframeImageAssigner(options_.loop_closure.image_max_offset_s);
+
+  const PipelineStats& s = session.stats_;
+  stats_.measurements += s.measurements;
+  stats_.scans += s.scans;
+  stats_.scans_used += s.scans_used;
+  stats_.odometry += s.odometry;
+  stats_.drive += s.drive;
+  stats_.images += s.images;
+  stats_.gps += s.gps;
+  stats_.reference += s.reference;
+  stats_.scan_matches_used += s.scan_matches_used;
+  stats_.scan_matches_rejected += s.scan_matches_rejected;
+  stats_.scans_anchored += s.scans_anchored;
+  stats_.first_timestamp = std::min(stats_.first_timestamp, s.first_timestamp);
+  stats_.last_timestamp = std::max(stats_.last_timestamp, s.last_timestamp);
+  stats_.keyframes = map_.size();
+}
+
+}  // namespace urbanslam::slam

@@ -1,0 +1,94 @@
+// `urbanslam merge` and `urbanslam run --map`: the two halves of a log, each mapped in its own
+// frame, joined into one map; a map of another building is not joined; bad input is one line
+// and exit 2.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <regex>
+
+#include "CliRunner.h"
+#include "TestFiles.h"
+
+using namespace urbanslam::test;
+namespace fs = std::filesystem;
+
+namespace {
+
+double jsonNumber(const std::string& json, const std::string& key) {
+  std::smatch m;
+  if (!std::regex_search(json, m, std::regex("\"" + key + "\":(-?[0-9.eE+-]+)"))) return -1;
+  return std::stod(m[1]);
+}
+
+std::string runFr079(const fs::path& out, const std::string& log) {
+  return "run --quiet --ini " + repoPath("ini/fr079.ini") + " --out " + out.string() + " " + log;
+}
+
+}  // namespace
+
+TEST(MergeCommand, JoinsTheMapsOfTwoHalvesOfALog) {
+  const fs::path dir = scratchDir("merge_cli");
+  const auto [first, rest] = splitCarmenLog(repoPath("rawlogs/fr079-raw-excerpt.clf.gz"), dir, 600);
+  ASSERT_EQ(runCli(runFr079(dir / "a", first)).code, 0);
+  ASSERT_EQ(runCli(runFr079(dir / "b", rest)).code, 0);
+  const CliResult merged =
+      runCli("merge --quiet --json " + (dir / "a").string() + " " + (dir / "b").string() + " --out " + (dir / "m").string());
+  ASSERT_EQ(merged.code, 0) << merged.err;
+  EXPECT_NE(merged.out.find("\"sessions\":[{"), std::string::npos);
+  EXPECT_NE(merged.out.find("\"joined\":true"), std::string::npos);
+  EXPECT_GE(jsonNumber(merged.out, "fixes_agreeing"), 4);
+  for (const char* f : {"map.usmap", "trajectory_scans.tum", "grid.png", "pose_graph.g2o", "stats.json"})
+    EXPECT_TRUE(fs::exists(dir / "m" / f)) << f;
+
+  // Every relation of the log, across the two halves too, is scored on the merged map.
+  const std::string relations = repoPath("rawlogs/fr079-raw-excerpt.relations");
+  const CliResult eval = runCli("eval " + (dir / "m").string() + " --json --relations " + relations);
+  ASSERT_EQ(eval.code, 0) << eval.err;
+  EXPECT_EQ(jsonNumber(eval.out, "used"), 287);
+  EXPECT_LT(jsonNumber(eval.out, "abs_trans_mean_m"), 0.06);
+
+  // The second half mapped into the first half's map from an unknown start.
+  const CliResult mapped = runCli("run --quiet --json --map " + (dir / "a").string() + " --out " + (dir / "r").string() + " " + rest);
+  ASSERT_EQ(mapped.code, 0) << mapped.err;
+  EXPECT_NE(mapped.out.find("\"joined\":true"), std::string::npos);
+  EXPECT_GT(jsonNumber(mapped.out, "joined_at_s"), 1339);
+  const CliResult eval_mapped = runCli("eval " + (dir / "r").string() + " --json --relations " + relations);
+  EXPECT_EQ(jsonNumber(eval_mapped.out, "used"), 287);
+
+  // The merged map goes on like any run's.
+  EXPECT_EQ(runCli("localize --quiet --map " + (dir / "m").string() + " --out " + (dir / "loc").string() + " " + rest).code, 0);
+
+  // A map of another building is not found in it: exit 1, its reason, nothing written.
+  ASSERT_EQ(runCli("run --quiet --out " + (dir / "intel").string() + " --ini " + repoPath("ini/fr079.ini") + " " +
+                   repoPath("rawlogs/intel-corrected-excerpt.log.gz"))
+                .code,
+            0);
+  const CliResult other =
+      runCli("merge --quiet " + (dir / "a").string() + " " + (dir / "intel").string() + " --out " + (dir / "x").string());
+  EXPECT_EQ(other.code, 1) << other.err;
+  EXPECT_NE(other.err.find("was not found"), std::string::npos) << other.err;
+  EXPECT_FALSE(fs::exists(dir / "x"));
+}
+
+TEST(MergeCommand, BadInputIsOneLineAndExitTwo) {
+  const fs::path dir = scratchDir("merge_bad");
+  const auto [first, rest] = splitCarmenLog(repoPath("rawlogs/fr079-raw-excerpt.clf.gz"), dir, 100);
+  ASSERT_EQ(runCli(runFr079(dir / "a", first)).code, 0);
+  // Another configuration: the default ini's [input] differs from fr079.ini's.
+  ASSERT_EQ(runCli("run --quiet --out " + (dir / "d").string() + " " + rest).code, 0);
+  const std::string not_a_map = writeFile(dir / "map.usmap", "not a map");
+  const auto expectBad = [](const CliResult& r, const std::string& names) {
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(names), std::string::npos) << r.err;
+  };
+  expectBad(runCli("merge " + (dir / "a").string()), "MAPS");
+  expectBad(runCli("merge " + (dir / "a").string() + " " + not_a_map), not_a_map);
+  expectBad(runCli("merge " + (dir / "a").string() + " " + (dir / "d").string()), "[input]");
+  expectBad(runCli("run --map " + (dir / "a").string() + " --resume " + (dir / "a").string() + " " + rest), "not both");
+  expectBad(runCli("run --map " + not_a_map + " " + rest), not_a_map);
+  const CliResult help = runCli("merge --help");
+  EXPECT_EQ(help.code, 0);
+  EXPECT_NE(help.out.find("place recognition"), std::string::npos);
+}
