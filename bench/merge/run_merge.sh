@@ -48,9 +48,11 @@ for ds in ${DATASETS:-intel aces fr079 csail}; do
   for r in full merge map; do
     if [ -f "$W/$r/stats.json" ]; then "$U" eval "$W/$r" --relations "$rel" --json > "$W/eval_$r.json"; else echo '{}' > "$W/eval_$r.json"; fi
   done
-  python3 - "$ds" "$W" "$(echo "$end - $start" | bc)" "$(zcat "$src" | awk -v h=$half '/^FLASER/{k++; if (k==h+1) {print $(NF-2); exit}}')" <<'PY'
+  python3 - "$ds" "$W" "$(echo "$end - $start" | bc)" <<'PY'
 import json, sys
-ds, w, merge_s, split_t = sys.argv[1], sys.argv[2], float(sys.argv[3]), float(sys.argv[4])
+ds, w, merge_s = sys.argv[1], sys.argv[2], float(sys.argv[3])
+# The second half's first scan time (a FLASER line's timestamp is its third field from the end).
+split_t = next(float(l.split()[-3]) for l in open(f"{w}/second.clf") if l.startswith("FLASER"))
 def rel(r):
     j = json.load(open(f"{w}/eval_{r}.json")).get("relations")
     return (j["used"], j["abs_trans_mean_m"], j["abs_rot_mean_deg"]) if j else (0, float("nan"), float("nan"))

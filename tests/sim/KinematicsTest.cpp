@@ -2,7 +2,9 @@
 // car on the streets.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "urbanslam/sim/Bicycle.h"
 #include "urbanslam/sim/Driver.h"
@@ -60,4 +62,34 @@ TEST(Driver, StaysInTheRightLaneOfOpenStreetsAndSlowsForTurns) {
   EXPECT_NEAR(max_speed, o.route.speed_mps, 0.5);
   EXPECT_LT(min_speed, o.route.turn_speed_mps + 1.0);
   EXPECT_GT(samples, 100);
+}
+
+// Another route seed drives another way through the same city, from the same start; route seed
+// 0 is the city's own seed.
+TEST(Driver, AnotherRouteSeedDrivesAnotherWayThroughTheSameCity) {
+  SimOptions o;
+  o.city.area_km2 = 0.5;
+  o.city.seed = 3;
+  o.route.route_length_km = 1.0;
+  const StreetGrid g(o.city);
+  const auto drive = [&](int route_seed) {
+    SimOptions r = o;
+    r.route.seed = route_seed;
+    Driver d(g, r);
+    std::vector<common::Pose2> poses;
+    for (double t = 0; !d.finished() && t < 1000; t += 1.0) {
+      d.advanceTo(t);
+      poses.push_back(d.state().pose);
+    }
+    return poses;
+  };
+  const auto own = drive(0), same = drive(3), other = drive(4);
+  ASSERT_EQ(own.size(), same.size());
+  for (size_t i = 0; i < own.size(); ++i) ASSERT_EQ(own[i].x, same[i].x) << i;
+  ASSERT_GT(other.size(), 10u);
+  // The same intersection to start from (heading to a neighbour the route picks).
+  EXPECT_LT(std::hypot(own[0].x - other[0].x, own[0].y - other[0].y), g.streetWidth());
+  double apart = 0;
+  for (size_t i = 0; i < std::min(own.size(), other.size()); ++i) apart = std::max(apart, std::hypot(own[i].x - other[i].x, own[i].y - other[i].y));
+  EXPECT_GT(apart, 100.0);
 }

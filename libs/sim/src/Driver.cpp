@@ -16,7 +16,7 @@ Driver::Driver(const StreetGrid& grid, const SimOptions& options)
       vehicle_(options.vehicle),
       route_(options.route),
       route_length_m_(options.route.route_length_km * 1000.0),
-      planner_(grid, options.route, static_cast<uint64_t>(options.city.seed)) {
+      planner_(grid, options.route, static_cast<uint64_t>(options.route.seed != 0 ? options.route.seed : options.city.seed)) {
   nodes_.push_back(planner_.current());
   while (path_.size() < 4) extendPath();
   const Vec2 a = path_[0].p, b = path_[1].p;

@@ -50,6 +50,7 @@ void declareSimOptions(common::OptionsSchema& s, SimOptions& o) {
 
   auto& r = o.route;
   s.section("route", "Where and how the car drives");
+  s.add("seed", r.seed, 0, 1000000000, "", "the route's choices at intersections; 0: the city's seed (another drive through the same city: another seed)");
   s.add("route_length_km", r.route_length_km, 0.01, 10000.0, "km", "the drive ends after this distance");
   s.add("speed_mps", r.speed_mps, 1.0, 30.0, "m/s", "cruising speed");
   s.add("turn_speed_mps", r.turn_speed_mps, 0.5, 30.0, "m/s", "speed through turns");

@@ -19,6 +19,7 @@ struct VehicleOptions {
 };
 
 struct RouteOptions {
+  int seed = 0;  // the route's choices at intersections; 0: the city's seed (another drive through the same city: another seed)
   double route_length_km = 3.0;
   double speed_mps = 10.0;              // cruising speed on straight streets
   double turn_speed_mps = 4.0;          // speed through a turn
