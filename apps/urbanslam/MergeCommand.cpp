@@ -57,7 +57,7 @@ int mergeCommand(const Argv& args) {
       return 1;
     }
     sessions.push(slam::sessionJson(paths[i], join, map->keyframes().size()));
-    map->appendSession(*other, join.transform, join.transform_cov);
+    map->appendSession(*other, join);
   }
 
   std::string out = ap.option("out");

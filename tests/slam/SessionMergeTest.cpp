@@ -113,7 +113,7 @@ TEST(SessionMerge, TwoMapsJoinedKeepEachSessionsAccuracyAndCloseLoopsAcross) {
   const auto first_alone = byPart(*s.first, split), second_alone = byPart(*s.second, split);
   const slam::SessionJoin join = slam::findSessionJoin(s.first->map(), s.first->options(), s.second->map());
   ASSERT_TRUE(join.joined) << join.reason;
-  s.first->appendSession(*s.second, join.transform, join.transform_cov);
+  s.first->appendSession(*s.second, join);
   s.first->finish();
   ASSERT_EQ(s.first->keyframes().size(), n0 + n1);
   size_t across = 0;

@@ -40,7 +40,7 @@ SessionRun runSessionInMap(std::unique_ptr<Pipeline> map, io::DataSource& source
       out.join = joiner.update(session->map());
       if (!out.join.joined) continue;
       out.joined_at_s = session->keyframes().back().timestamp;
-      map->appendSession(*session, out.join.transform, out.join.transform_cov);
+      map->appendSession(*session, out.join);
       break;
     }
   }

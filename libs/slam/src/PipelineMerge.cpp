@@ -9,7 +9,8 @@
 
 namespace urbanslam::slam {
 
-void Pipeline::appendSession(const Pipeline& session, const common::Pose2& transform, const Eigen::Matrix3d& transform_cov) {
+void Pipeline::appendSession(const Pipeline& session, const SessionJoin& join) {
+  const common::Pose2& transform = join.transform;
   if (finished_ || session.finished_) throw std::logic_error("Pipeline::appendSession after finish()");
   if (!map_.filter())
     throw common::InputError("maps built in dead reckoning cannot be merged: they have no filter to optimise them jointly");
@@ -41,7 +42,7 @@ void Pipeline::appendSession(const Pipeline& session, const common::Pose2& trans
         if (d < best) best = d, from = i;
       }
       c.z = common::between(map_.keyframes()[from].pose, placed);
-      c.cov = transform_cov;
+      c.cov = join.transform_cov;
       global_.addKeyframeFrom(from, Keyframe{n0, k.timestamp, {}, false, k.has_image, k.image_words}, io::CompactScan(other.scan(0)), c);
     } else {
       const GraphEdge* e = chain[k.index];
@@ -51,6 +52,22 @@ void Pipeline::appendSession(const Pipeline& session, const common::Pose2& trans
       c.cov = e->information.inverse();
       global_.addKeyframe(Keyframe{n0 + k.index, k.timestamp, {}, false, k.has_image, k.image_words}, io::CompactScan(other.scan(k.index)),
                           c);
+    }
+    // The places the join recognised, tied to this map's keyframe nearest to each.
+    for (size_t i : join.agreeing) {
+      const SessionFix& f = join.fixes[i];
+      if (f.keyframe != k.index) continue;
+      std::vector<size_t> near;
+      map_.index().query(f.pose.x, f.pose.y, 10.0, near);
+      size_t earlier = n0;
+      double best = std::numeric_limits<double>::infinity();
+      for (size_t a : near) {
+        if (a >= n0 || !map_.keyframes()[a].hasScan()) continue;
+        const double d = std::hypot(map_.keyframes()[a].pose.x - f.pose.x, map_.keyframes()[a].pose.y - f.pose.y);
+        if (d < best) best = d, earlier = a;
+      }
+      if (earlier < n0)
+        global_.addPlaceFix(earlier, n0 + k.index, common::between(map_.keyframes()[earlier].pose, f.pose), f.cov.inverse(), f.margin_per_point);
     }
     // Loop closures as a run finds them: against this map and the session's earlier keyframes.
     global_.closeLoops(n0 + k.index, now);

@@ -19,7 +19,8 @@ double wrap(double a) { return std::atan2(std::sin(a), std::cos(a)); }
 }  // namespace
 
 struct SessionJoiner::Search {
-  Search(const Map& map, const LocalizerOptions& lo) : areas(map, lo.areas), places(map, areas, lo.places) {}
+  Search(const Map& map, const LocalizerOptions& lo) : localizer(lo), areas(map, lo.areas), places(map, areas, lo.places) {}
+  LocalizerOptions localizer;
   MapAreas areas;
   PlaceRecognizer places;
 };
@@ -31,30 +32,70 @@ SessionJoiner::SessionJoiner(const Map& map, const PipelineOptions& map_options,
 
 SessionJoiner::~SessionJoiner() = default;
 
+void SessionJoiner::extendPath(const Map& session) {
+  const auto& kf = session.keyframes();
+  for (size_t i = path_.size(); i < kf.size(); ++i)
+    path_.push_back(i == 0 ? 0.0 : path_.back() + std::hypot(kf[i].pose.x - kf[i - 1].pose.x, kf[i].pose.y - kf[i - 1].pose.y));
+}
+
+bool SessionJoiner::probe(const Map& session, size_t k) {
+  ++join_.probes;
+  const alignment::PointSet points = alignment::pointSetFromScan(session.scan(k), search_->areas.options().scan_model, true);
+  const PlaceHypothesis h = search_->places.locate(points, search_->areas.options().matcher);
+  if (!h.found) return false;
+  SessionFix f;
+  f.keyframe = k;
+  f.pose = h.pose;
+  // As the localizer takes a match (LocalizerOptions): scaled for the correlated errors of
+  // matches against the same map points, with floors for the map's own disagreements.
+  const LocalizerOptions& lo = search_->localizer;
+  f.cov = lo.covariance_scale * h.cov;
+  const double sxy = lo.min_sigma_xy_m, sphi = lo.min_sigma_deg * kDeg;
+  f.cov(0, 0) = std::max(f.cov(0, 0), sxy * sxy);
+  f.cov(1, 1) = std::max(f.cov(1, 1), sxy * sxy);
+  f.cov(2, 2) = std::max(f.cov(2, 2), sphi * sphi);
+  f.margin_per_point = h.margin_per_point;
+  join_.fixes.push_back(f);
+  decide(session);
+  return join_.joined;
+}
+
 const SessionJoin& SessionJoiner::update(const Map& session, const std::function<void(double)>& progress) {
   const auto& kf = session.keyframes();
-  bool new_fix = false;
-  // 1. Fixes: the session's scans searched for in the whole map, one every probe_spacing_m.
-  for (; seen_ < kf.size(); ++seen_) {
+  extendPath(session);
+  // The session's scans searched for in the whole map, one every probe_spacing_m of its path,
+  // until the join is found.
+  for (; seen_ < kf.size() && !join_.joined; ++seen_) {
     if (progress) progress(static_cast<double>(seen_) / static_cast<double>(kf.size()));
-    const Keyframe& k = kf[seen_];
-    path_.push_back(seen_ == 0 ? 0.0 : path_.back() + std::hypot(k.pose.x - kf[seen_ - 1].pose.x, k.pose.y - kf[seen_ - 1].pose.y));
-    if (!k.hasScan() || path_.back() < next_probe_m_) continue;
-    next_probe_m_ = path_.back() + options_.probe_spacing_m;
-    ++join_.probes;
-    const alignment::PointSet points = alignment::pointSetFromScan(session.scan(k.index), search_->areas.options().scan_model, true);
-    const PlaceHypothesis h = search_->places.locate(points, search_->areas.options().matcher);
-    if (!h.found) continue;
-    SessionFix f;
-    f.keyframe = k.index;
-    f.pose = h.pose;
-    f.cov = h.cov;
-    f.margin_per_point = h.margin_per_point;
-    f.transform = common::compose(h.pose, common::inverse(k.pose));
-    join_.fixes.push_back(f);
-    new_fix = true;
+    if (!kf[seen_].hasScan() || path_[seen_] < next_probe_m_) continue;
+    next_probe_m_ = path_[seen_] + options_.probe_spacing_m;
+    probe(session, seen_);
   }
-  if (new_fix) decide(session);
+  return join_;
+}
+
+const SessionJoin& SessionJoiner::searchAll(const Map& session, const std::function<void(double)>& progress) {
+  const auto& kf = session.keyframes();
+  extendPath(session);
+  std::vector<size_t> probes;
+  for (; seen_ < kf.size(); ++seen_) {
+    if (!kf[seen_].hasScan() || path_[seen_] < next_probe_m_) continue;
+    next_probe_m_ = path_[seen_] + options_.probe_spacing_m;
+    probes.push_back(seen_);
+  }
+  // Coarse to fine (the probes in bit-reversed order: the whole path at a wide spacing first,
+  // then the gaps halved): a session that shares much of its path with the map is joined after a
+  // few searches instead of one every probe_spacing_m along it.
+  size_t bits = 0;
+  while ((size_t{1} << bits) < probes.size()) ++bits;
+  size_t done = 0;
+  for (size_t i = 0; i < (size_t{1} << bits) && !join_.joined; ++i) {
+    size_t r = 0;
+    for (size_t b = 0; b < bits; ++b) r |= ((i >> b) & 1u) << (bits - 1 - b);
+    if (r >= probes.size()) continue;
+    if (progress) progress(static_cast<double>(done++) / static_cast<double>(probes.size()));
+    probe(session, probes[r]);
+  }
   return join_;
 }
 
@@ -83,8 +124,13 @@ void SessionJoiner::decide(const Map& session) {
         (support[i].size() == support[best].size() && out.fixes[i].margin_per_point > out.fixes[best].margin_per_point))
       best = i;
   out.agreeing = support[best];
-  out.transform = out.fixes[best].transform;
-  const double sxy = o.agree_m + o.agree_per_m * path_[out.fixes[best].keyframe], sphi = o.agree_deg * kDeg;
+  // The transform of the agreeing fix nearest to the session's start along its path: the one
+  // least affected by the session's drift there, where the session will hang from the map.
+  size_t anchor = best;
+  for (size_t j : out.agreeing)
+    if (path_[out.fixes[j].keyframe] < path_[out.fixes[anchor].keyframe]) anchor = j;
+  out.transform = out.fixes[anchor].transform;
+  const double sxy = o.agree_m + o.agree_per_m * path_[out.fixes[anchor].keyframe], sphi = o.agree_deg * kDeg;
   out.transform_cov = Eigen::Vector3d(sxy * sxy, sxy * sxy, sphi * sphi).asDiagonal();
   // The largest set among the fixes that disagree with the best one.
   const auto inBest = [&](size_t i) { return std::find(out.agreeing.begin(), out.agreeing.end(), i) != out.agreeing.end(); };
@@ -122,7 +168,7 @@ void SessionJoiner::decide(const Map& session) {
 SessionJoin findSessionJoin(const Map& map, const PipelineOptions& map_options, const Map& session, const SessionJoinOptions& options,
                             const std::function<void(double)>& progress) {
   SessionJoiner joiner(map, map_options, options);
-  return joiner.update(session, progress);
+  return joiner.searchAll(session, progress);
 }
 
 }  // namespace urbanslam::slam

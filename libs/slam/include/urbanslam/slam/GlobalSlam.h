@@ -50,6 +50,10 @@ class GlobalSlam {
   // recorded with the reason it cannot be. Observers hear its fate.
   void proposeImageClosure(size_t earlier, size_t current, double score, const std::optional<CameraMeasurement>& camera,
                            SteadyTime handed_over);
+  // A place that a session join recognised: keyframe `current` (the session's) found at `z` from
+  // the map's keyframe `earlier`. Gated and, when it passes, a closure (detector "place"); the
+  // fixes that agree with it are its confirmation.
+  void addPlaceFix(size_t earlier, size_t current, const common::Pose2& z, const Eigen::Matrix3d& information, double score);
   // End of input: hypotheses still awaiting confirmation are dropped, the last poses recovered.
   void finish();
 

@@ -25,6 +25,7 @@
 #include "urbanslam/slam/Observer.h"
 #include "urbanslam/slam/PipelineOptions.h"
 #include "urbanslam/slam/PipelineStats.h"
+#include "urbanslam/slam/SessionJoin.h"
 #include "urbanslam/vision_loop/BagOfWords.h"
 #include "urbanslam/vision_loop/FeatureExtractor.h"
 
@@ -65,14 +66,14 @@ class Pipeline {
   void writeState(common::BinaryWriter& w) const;
   void readState(common::BinaryReader& r);
 
-  // Another session's map joined to this one (SessionJoin.h found `transform`, the session's
-  // frame in this map's, uncertain by `transform_cov`): its keyframes, scans and odometry
-  // constraints appended after this map's, the first tied to this map's keyframe nearest to where
-  // the join puts it, and global SLAM closing loops for each as a run would, so that both are
-  // optimised jointly. The session's local SLAM becomes this pipeline's: a continued run
-  // continues the session. Both must have the same options (loadMap checks them). Before
-  // finish(), of both. PipelineMerge.cpp.
-  void appendSession(const Pipeline& session, const common::Pose2& transform, const Eigen::Matrix3d& transform_cov);
+  // Another session's map joined to this one (`join`: SessionJoin.h): its keyframes, scans and
+  // odometry constraints appended after this map's, the first tied to this map's keyframe nearest
+  // to where the join's transform puts it, each place the join recognised added as a closure,
+  // and global SLAM closing loops for each keyframe as a run would, so that both are optimised
+  // jointly. The session's local SLAM becomes this pipeline's: a continued run continues the
+  // session. Both must have the same options (loadMap checks them). Before finish(), of both.
+  // PipelineMerge.cpp.
+  void appendSession(const Pipeline& session, const SessionJoin& join);
 
   // Keyframes made so far by local SLAM (global SLAM may not have taken them all yet).
   size_t keyframesMade() const { return local_.keyframes(); }

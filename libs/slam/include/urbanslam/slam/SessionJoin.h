@@ -8,7 +8,8 @@
 // agree, accepted only when it has at least min_agreeing fixes spread over min_span_m of the
 // session's path, holds at least min_agreeing_share of all fixes, and no other set of
 // min_agreeing fixes disagrees with it (two places that both explain the session: no join
-// rather than a wrong one).
+// rather than a wrong one). The search stops at the first fix that makes the join: a log being
+// mapped is joined as early as it can be, and a finished session is searched coarse to fine.
 #include <functional>
 #include <memory>
 #include <string>
@@ -38,7 +39,7 @@ struct SessionJoinOptions {
 struct SessionFix {
   size_t keyframe = 0;  // the session's keyframe
   common::Pose2 pose;   // where it was found, map frame
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Identity();  // as the localizer takes a place search's answer
   double margin_per_point = 0;
   common::Pose2 transform;  // session frame -> map frame, from this fix
 };
@@ -46,7 +47,7 @@ struct SessionFix {
 struct SessionJoin {
   bool joined = false;
   std::string reason;       // why not
-  common::Pose2 transform;  // session frame -> map frame (the best agreeing fix's)
+  common::Pose2 transform;  // session frame -> map frame (the agreeing fix's nearest to the session's start)
   // Its uncertainty at the session's first keyframe: the agreement's tolerance, grown by the
   // drift allowance over the session's path from there to the best fix.
   Eigen::Matrix3d transform_cov = Eigen::Matrix3d::Identity();
@@ -66,10 +67,14 @@ class SessionJoiner {
   // Probes the session's keyframes not seen yet; returns the join as it stands. `progress`
   // (optional) is told the share of the session's keyframes seen.
   const SessionJoin& update(const Map& session, const std::function<void(double)>& progress = {});
+  // A whole session at once, the probes coarse to fine along its path, until it is joined.
+  const SessionJoin& searchAll(const Map& session, const std::function<void(double)>& progress = {});
   const SessionJoin& join() const { return join_; }
 
  private:
   void decide(const Map& session);
+  void extendPath(const Map& session);
+  bool probe(const Map& session, size_t keyframe);  // true: joined now
 
   struct Search;
   std::unique_ptr<Search> search_;
@@ -80,7 +85,7 @@ class SessionJoiner {
   double next_probe_m_ = 0;
 };
 
-// The whole session at once.
+// The whole session at once (SessionJoiner::searchAll).
 SessionJoin findSessionJoin(const Map& map, const PipelineOptions& map_options, const Map& session, const SessionJoinOptions& options = {},
                             const std::function<void(double)>& progress = {});
 
