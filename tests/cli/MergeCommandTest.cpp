@@ -76,7 +76,7 @@ TEST(MergeCommand, BadInputIsOneLineAndExitTwo) {
   const auto [first, rest] = splitCarmenLog(repoPath("rawlogs/fr079-raw-excerpt.clf.gz"), dir, 100);
   ASSERT_EQ(runCli(runFr079(dir / "a", first)).code, 0);
   // Another configuration: the default ini's [input] differs from fr079.ini's.
-  ASSERT_EQ(runCli("run --quiet --out " + (dir / "d").string() + " " + rest).code, 0);
+  ASSERT_EQ(runCli("run --quiet --out " + (dir / "d").string() + " " + first).code, 0);
   const std::string not_a_map = writeFile(dir / "map.usmap", "not a map");
   const auto expectBad = [](const CliResult& r, const std::string& names) {
     EXPECT_EQ(r.code, 2) << r.err;

@@ -56,36 +56,10 @@ Sessions sessions() {
   return s;
 }
 
-// The same, shared by the tests that only read them.
-const Sessions& sharedSessions() {
-  static const Sessions s = sessions();
-  return s;
-}
-
 common::Pose2 at(const slam::Pipeline& p, double t) {
   common::Pose2 out;
   EXPECT_TRUE(evaluation::interpolatePose(p.scanTrajectory(), t, 1.0, out)) << t;
   return out;
-}
-
-}  // namespace
-
-// The second session's frame is found in the first's: its keyframes land where the full run
-// put them.
-TEST(SessionMerge, TheJoinPutsTheSecondSessionWhereTheFullRunHasIt) {
-  const Sessions& s = sharedSessions();
-  const slam::SessionJoin join = slam::findSessionJoin(s.first->map(), s.first->options(), s.second->map());
-  ASSERT_TRUE(join.joined) << join.reason;
-  EXPECT_GE(join.agreeing.size(), 3u);
-  double worst_m = 0, worst_deg = 0;
-  for (size_t i : join.agreeing) {
-    const slam::Keyframe& k = s.second->keyframes()[join.fixes[i].keyframe];
-    const common::Pose2 placed = common::compose(join.transform, k.pose), truth = at(*s.full, k.timestamp);
-    worst_m = std::max(worst_m, std::hypot(placed.x - truth.x, placed.y - truth.y));
-    worst_deg = std::max(worst_deg, std::abs(common::wrapToPi(placed.phi - truth.phi)) * 180 / M_PI);
-  }
-  EXPECT_LT(worst_m, 0.5);
-  EXPECT_LT(worst_deg, 3.0);
 }
 
 // Relation errors of `p`'s scans for the relations with both ends before `split` (part 0),
@@ -102,17 +76,30 @@ std::array<evaluation::RelationMetrics, 3> byPart(const slam::Pipeline& p, doubl
   return out;
 }
 
-// Two finished maps joined offline: each session's relations are met as well as that session
-// met them alone (the merge keeps every keyframe constraint the sessions made), the relations
-// across the two are met, and loops close across them. (The second session's own constraints
-// were made without the first map; a log mapped into the map, below, does better.)
-TEST(SessionMerge, TwoMapsJoinedKeepEachSessionsAccuracyAndCloseLoopsAcross) {
+}  // namespace
+
+// Two finished maps joined offline. The join puts the second session's keyframes where the full
+// run has them. Then each session's relations are met as well as that session met them alone
+// (the merge keeps every keyframe constraint the sessions made), the relations across the two
+// are met, and loops close across them. (The second session's own constraints were made without
+// the first map; a log mapped into the map, below, does better.)
+TEST(SessionMerge, TwoMapsAreJoinedWhereTheFullRunHasThemAndKeepEachSessionsAccuracy) {
   Sessions s = sessions();
   const size_t n0 = s.first->keyframes().size(), n1 = s.second->keyframes().size();
   const double split = s.second->keyframes().front().timestamp;
   const auto first_alone = byPart(*s.first, split), second_alone = byPart(*s.second, split);
   const slam::SessionJoin join = slam::findSessionJoin(s.first->map(), s.first->options(), s.second->map());
   ASSERT_TRUE(join.joined) << join.reason;
+  EXPECT_GE(join.agreeing.size(), 4u);
+  double worst_m = 0, worst_deg = 0;
+  for (size_t i : join.agreeing) {
+    const slam::Keyframe& k = s.second->keyframes()[join.fixes[i].keyframe];
+    const common::Pose2 placed = common::compose(join.transform, k.pose), truth = at(*s.full, k.timestamp);
+    worst_m = std::max(worst_m, std::hypot(placed.x - truth.x, placed.y - truth.y));
+    worst_deg = std::max(worst_deg, std::abs(common::wrapToPi(placed.phi - truth.phi)) * 180 / M_PI);
+  }
+  EXPECT_LT(worst_m, 0.5);
+  EXPECT_LT(worst_deg, 3.0);
   s.first->appendSession(*s.second, join);
   s.first->finish();
   ASSERT_EQ(s.first->keyframes().size(), n0 + n1);
@@ -137,7 +124,8 @@ TEST(SessionMerge, TwoMapsJoinedKeepEachSessionsAccuracyAndCloseLoopsAcross) {
 
 // The second half of the log mapped into the map of the first, with no idea where it starts.
 // It starts where the first ended but leaves at once for a room the first never saw, so it is
-// joined only when it comes back (about 1446 s); from then on it continues inside the map.
+// joined only when it comes back (about 1446 s); from then on it continues inside the map. (A
+// log of another building is never joined.)
 // Between scans less than 5 s apart (most relations) it is then as good as the one run over the
 // whole log, except in its first 10 s: it started with an empty submap where the one run had the
 // first half's.
@@ -145,6 +133,14 @@ TEST(SessionMerge, ALogMappedIntoAMapMeetsTheRelationsAsTheFullRunDoes) {
   Sessions s = sessions();
   const size_t n0 = s.first->keyframes().size();
   const double split = s.second->keyframes().front().timestamp, end = s.full->keyframes().back().timestamp;
+  {
+    // A session from another building is not joined, however many of its scans look like one.
+    slam::Pipeline intel(slam::PipelineOptions{});
+    intel.runInput(*io::openDataSource(test::repoPath("rawlogs/intel-corrected-excerpt.log.gz")));
+    const slam::SessionJoin other = slam::findSessionJoin(s.first->map(), s.first->options(), intel.map());
+    EXPECT_FALSE(other.joined) << other.agreeing.size() << " agreeing fixes of " << other.fixes.size();
+    EXPECT_GT(other.probes, 10u);
+  }
   test::SkippingSource rest(io::openDataSource(excerpt()), s.first->stats().measurements);
   slam::SessionRun run = slam::runSessionInMap(std::move(s.first), rest);
   ASSERT_TRUE(run.join.joined) << run.join.reason;
@@ -173,14 +169,4 @@ TEST(SessionMerge, ALogMappedIntoAMapMeetsTheRelationsAsTheFullRunDoes) {
   std::cerr << "relations after the session's first 10 s: mapped into the map " << m.abs_trans_m.mean << " m " << m.abs_rot_deg.mean
             << " deg, one run " << f.abs_trans_m.mean << " m " << f.abs_rot_deg.mean << " deg; joined " << run.joined_at_s - split
             << " s after the split\n";
-}
-
-// A session from another building is not joined, however many of its scans look like one.
-TEST(SessionMerge, ASessionFromAnotherBuildingIsNotJoined) {
-  const Sessions& s = sharedSessions();
-  slam::Pipeline intel(slam::PipelineOptions{});
-  intel.runInput(*io::openDataSource(test::repoPath("rawlogs/intel-corrected-excerpt.log.gz")));
-  const slam::SessionJoin join = slam::findSessionJoin(s.first->map(), s.first->options(), intel.map());
-  EXPECT_FALSE(join.joined) << join.agreeing.size() << " agreeing fixes of " << join.fixes.size();
-  EXPECT_GT(join.probes, 10u);
 }

@@ -67,7 +67,8 @@ void Pipeline::appendSession(const Pipeline& session, const SessionJoin& join) {
         if (d < best) best = d, earlier = a;
       }
       if (earlier < n0)
-        global_.addPlaceFix(earlier, n0 + k.index, common::between(map_.keyframes()[earlier].pose, f.pose), f.cov.inverse(), f.margin_per_point);
+        global_.addPlaceFix(earlier, n0 + k.index, common::between(map_.keyframes()[earlier].pose, f.pose), f.cov.inverse(),
+                            f.margin_per_point);
     }
     // Loop closures as a run finds them: against this map and the session's earlier keyframes.
     global_.closeLoops(n0 + k.index, now);

@@ -3,8 +3,8 @@
 // delayed pose (ESDF prediction with augmentation, constant time) with local SLAM's constraint;
 // then the loop-closure candidates (near the estimate, Mahalanobis-gated; with the laser
 // classifier's detections too where the estimate is too uncertain), alignment, the innovation
-// gate, confirmation by a second agreeing closure, the update, and the recovery after it. Tree of Words proposals take the same path from the
-// alignment on.
+// gate, confirmation by a second agreeing closure, the update, and the recovery after it. Tree of Words proposals take the same path from
+// the alignment on.
 #include <array>
 #include <chrono>
 #include <deque>

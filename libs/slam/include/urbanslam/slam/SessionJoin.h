@@ -37,8 +37,8 @@ struct SessionJoinOptions {
 };
 
 struct SessionFix {
-  size_t keyframe = 0;  // the session's keyframe
-  common::Pose2 pose;   // where it was found, map frame
+  size_t keyframe = 0;                                // the session's keyframe
+  common::Pose2 pose;                                 // where it was found, map frame
   Eigen::Matrix3d cov = Eigen::Matrix3d::Identity();  // as the localizer takes a place search's answer
   double margin_per_point = 0;
   common::Pose2 transform;  // session frame -> map frame, from this fix
