@@ -12,6 +12,7 @@
 #include "SkippingSource.h"
 #include "TestPaths.h"
 #include "urbanslam/evaluation/Evaluation.h"
+#include "urbanslam/slam/MapFile.h"
 #include "urbanslam/slam/MapSession.h"
 #include "urbanslam/slam/Pipeline.h"
 #include "urbanslam/slam/SessionJoin.h"
@@ -76,15 +77,12 @@ std::array<evaluation::RelationMetrics, 3> byPart(const slam::Pipeline& p, doubl
   return out;
 }
 
-}  // namespace
-
 // Two finished maps joined offline. The join puts the second session's keyframes where the full
 // run has them. Then each session's relations are met as well as that session met them alone
 // (the merge keeps every keyframe constraint the sessions made), the relations across the two
 // are met, and loops close across them. (The second session's own constraints were made without
 // the first map; a log mapped into the map, below, does better.)
-TEST(SessionMerge, TwoMapsAreJoinedWhereTheFullRunHasThemAndKeepEachSessionsAccuracy) {
-  Sessions s = sessions();
+void twoMapsAreJoinedWhereTheFullRunHasThemAndKeepEachSessionsAccuracy(Sessions& s) {
   const size_t n0 = s.first->keyframes().size(), n1 = s.second->keyframes().size();
   const double split = s.second->keyframes().front().timestamp;
   const auto first_alone = byPart(*s.first, split), second_alone = byPart(*s.second, split);
@@ -129,8 +127,7 @@ TEST(SessionMerge, TwoMapsAreJoinedWhereTheFullRunHasThemAndKeepEachSessionsAccu
 // Between scans less than 5 s apart (most relations) it is then as good as the one run over the
 // whole log, except in its first 10 s: it started with an empty submap where the one run had the
 // first half's.
-TEST(SessionMerge, ALogMappedIntoAMapMeetsTheRelationsAsTheFullRunDoes) {
-  Sessions s = sessions();
+void aLogMappedIntoAMapMeetsTheRelationsAsTheFullRunDoes(Sessions& s) {
   const size_t n0 = s.first->keyframes().size();
   const double split = s.second->keyframes().front().timestamp, end = s.full->keyframes().back().timestamp;
   {
@@ -169,4 +166,24 @@ TEST(SessionMerge, ALogMappedIntoAMapMeetsTheRelationsAsTheFullRunDoes) {
   std::cerr << "relations after the session's first 10 s: mapped into the map " << m.abs_trans_m.mean << " m " << m.abs_rot_deg.mean
             << " deg, one run " << f.abs_trans_m.mean << " m " << f.abs_rot_deg.mean << " deg; joined " << run.joined_at_s - split
             << " s after the split\n";
+}
+
+}  // namespace
+
+// The two halves of the excerpt: the sessions (and the run over the whole excerpt) are made once
+// for both checks, the first half's map saved and loaded again for the second (a loaded map
+// continues exactly as the one in memory: MapResume).
+TEST(SessionMerge, TheSecondHalfJoinsTheFirstOfflineAndAsItIsMapped) {
+  Sessions s = sessions();
+  const auto path = test::scratchDir("session_merge") / "first.usmap";
+  slam::saveMap(*s.first, path.string());
+  {
+    SCOPED_TRACE("merge");
+    twoMapsAreJoinedWhereTheFullRunHasThemAndKeepEachSessionsAccuracy(s);
+  }
+  s.first = slam::loadMap(path.string());
+  {
+    SCOPED_TRACE("run --map");
+    aLogMappedIntoAMapMeetsTheRelationsAsTheFullRunDoes(s);
+  }
 }
