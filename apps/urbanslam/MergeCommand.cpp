@@ -5,7 +5,6 @@
 
 #include "ArgParser.h"
 #include "Commands.h"
-#include "urbanslam/common/AtomicFile.h"
 #include "urbanslam/common/Error.h"
 #include "urbanslam/common/Progress.h"
 #include "urbanslam/slam/MapFile.h"
@@ -62,28 +61,13 @@ int mergeCommand(const Argv& args) {
 
   std::string out = ap.option("out");
   while (out.size() > 1 && out.back() == '/') out.pop_back();
-  const std::string map_target = out + ".usmap";
-  common::removeStaleTemporaries(map_target);
-  const std::string map_file = common::temporaryPathFor(map_target);
-  struct RemoveAtExit {
-    std::string path;
-    ~RemoveAtExit() {
-      std::error_code ec;
-      std::filesystem::remove(path, ec);
-    }
-  } map_file_guard{map_file};
-  {
-    std::error_code ec;
-    const auto parent = std::filesystem::path(out).parent_path();
-    if (!parent.empty() && !std::filesystem::is_directory(parent, ec) && !std::filesystem::create_directories(parent, ec))
-      throw common::InputError(out + ": cannot create the output folder (is its parent writable?)");
-  }
-  slam::writeMapFile(*map, map_file);
+  const slam::StagedMapFile map_file(out, *map);
   map->finish();
   std::string inputs;
   for (size_t i = 1; i < paths.size(); ++i) inputs += (i > 1 ? " " : "") + paths[i];
   const common::Json stats = slam::writeRunOutputs(
-      *map, out, {inputs, "usmap", paths[0] + " (its saved options)", slam::optionsToIni(map->options()), map_file, paths[0], sessions});
+      *map, out,
+      {inputs, "usmap", paths[0] + " (its saved options)", slam::optionsToIni(map->options()), map_file.path(), paths[0], sessions});
   if (ap.flag("json")) std::cout << stats.dump() << "\n";
   if (!quiet)
     std::cerr << "urbanslam merge: " << paths.size() << " maps, " << map->keyframes().size() << " keyframes; outputs in "

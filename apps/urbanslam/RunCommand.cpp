@@ -5,7 +5,6 @@
 #include "ArgParser.h"
 #include "Commands.h"
 #include "DefaultPaths.h"
-#include "urbanslam/common/AtomicFile.h"
 #include "urbanslam/common/Error.h"
 #include "urbanslam/common/Progress.h"
 #include "urbanslam/sim/SimOptions.h"
@@ -117,29 +116,10 @@ int runCommand(const Argv& args) {
     pipeline->addObserver(&progress);
     pipeline->runInput(*source);
   }
-  // The map is saved before finish(): finish() drops the closures still awaiting confirmation,
-  // which a continued run may yet confirm. It goes to a temporary file beside the run folder
-  // (streamed, never whole in memory), which the outputs move into the folder; a run that
-  // fails or is killed leaves only a temporary, removed now or by the next run.
+  // The map is saved before finish() (StagedMapFile).
   std::string out = ap.option("out");
   while (out.size() > 1 && out.back() == '/') out.pop_back();
-  const std::string map_target = out + ".usmap";
-  common::removeStaleTemporaries(map_target);
-  const std::string map_file = pipeline->keyframes().empty() ? std::string() : common::temporaryPathFor(map_target);
-  struct RemoveAtExit {
-    std::string path;
-    ~RemoveAtExit() {
-      std::error_code ec;
-      if (!path.empty()) std::filesystem::remove(path, ec);
-    }
-  } map_file_guard{map_file};
-  if (!map_file.empty()) {
-    std::error_code ec;
-    const auto parent = std::filesystem::path(out).parent_path();
-    if (!parent.empty() && !std::filesystem::is_directory(parent, ec) && !std::filesystem::create_directories(parent, ec))
-      throw common::InputError(out + ": cannot create the output folder (is its parent writable?)");
-    slam::writeMapFile(*pipeline, map_file);
-  }
+  const slam::StagedMapFile map_file(out, *pipeline);
   pipeline->finish(*source);
   bar.finish();
   // A log without a single keyframe has nothing to map: outputs would only look like a run.
@@ -150,7 +130,7 @@ int runCommand(const Argv& args) {
   }
 
   const common::Json stats = slam::writeRunOutputs(
-      *pipeline, out, {log, source->format(), ini, resolved, map_file, ap.has("map") && !joined ? "" : map, sessions});
+      *pipeline, out, {log, source->format(), ini, resolved, map_file.path(), ap.has("map") && !joined ? "" : map, sessions});
   if (ap.flag("json")) std::cout << stats.dump() << "\n";
   if (!quiet) {
     const auto& t = stats.at("timing");

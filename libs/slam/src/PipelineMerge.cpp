@@ -10,7 +10,6 @@
 namespace urbanslam::slam {
 
 void Pipeline::appendSession(const Pipeline& session, const SessionJoin& join) {
-  const common::Pose2& transform = join.transform;
   if (finished_ || session.finished_) throw std::logic_error("Pipeline::appendSession after finish()");
   if (!map_.filter())
     throw common::InputError("maps built in dead reckoning cannot be merged: they have no filter to optimise them jointly");
@@ -19,6 +18,21 @@ void Pipeline::appendSession(const Pipeline& session, const SessionJoin& join) {
   const Map& other = session.map_;
   const size_t n0 = map_.size();
   if (other.empty()) return;
+
+  // This map's keyframe nearest to `p` within `radius_m` among its own (not the session's), with
+  // a scan when `scan` says so; none: n0.
+  const auto nearestOwn = [&](const common::Pose2& p, double radius_m, bool scan) {
+    std::vector<size_t> near;
+    map_.index().query(p.x, p.y, radius_m, near);
+    size_t found = n0;
+    double best = std::numeric_limits<double>::infinity();
+    for (size_t i : near) {
+      if (i >= n0 || (scan && !map_.keyframes()[i].hasScan())) continue;
+      const double d = std::hypot(map_.keyframes()[i].pose.x - p.x, map_.keyframes()[i].pose.y - p.y);
+      if (d < best) best = d, found = i;
+    }
+    return found;
+  };
 
   // The session's odometry constraints, by the keyframe they lead to.
   std::vector<const GraphEdge*> chain(other.size(), nullptr);
@@ -32,15 +46,9 @@ void Pipeline::appendSession(const Pipeline& session, const SessionJoin& join) {
       // The first keyframe hangs from this map's keyframe nearest to where the join puts it, by
       // the join's transform with its uncertainty; the closures that global SLAM finds next tie
       // the two maps together with their real weight.
-      const common::Pose2 placed = common::compose(transform, k.pose);
-      std::vector<size_t> near;
-      map_.index().query(placed.x, placed.y, 50.0, near);
-      size_t from = n0 - 1;
-      double best = std::numeric_limits<double>::infinity();
-      for (size_t i : near) {
-        const double d = std::hypot(map_.keyframes()[i].pose.x - placed.x, map_.keyframes()[i].pose.y - placed.y);
-        if (d < best) best = d, from = i;
-      }
+      const common::Pose2 placed = common::compose(join.transform, k.pose);
+      size_t from = nearestOwn(placed, 50.0, false);
+      if (from == n0) from = n0 - 1;
       c.z = common::between(map_.keyframes()[from].pose, placed);
       c.cov = join.transform_cov;
       global_.addKeyframeFrom(from, Keyframe{n0, k.timestamp, {}, false, k.has_image, k.image_words}, io::CompactScan(other.scan(0)), c);
@@ -57,15 +65,7 @@ void Pipeline::appendSession(const Pipeline& session, const SessionJoin& join) {
     for (size_t i : join.agreeing) {
       const SessionFix& f = join.fixes[i];
       if (f.keyframe != k.index) continue;
-      std::vector<size_t> near;
-      map_.index().query(f.pose.x, f.pose.y, 10.0, near);
-      size_t earlier = n0;
-      double best = std::numeric_limits<double>::infinity();
-      for (size_t a : near) {
-        if (a >= n0 || !map_.keyframes()[a].hasScan()) continue;
-        const double d = std::hypot(map_.keyframes()[a].pose.x - f.pose.x, map_.keyframes()[a].pose.y - f.pose.y);
-        if (d < best) best = d, earlier = a;
-      }
+      const size_t earlier = nearestOwn(f.pose, 10.0, true);
       if (earlier < n0)
         global_.addPlaceFix(earlier, n0 + k.index, common::between(map_.keyframes()[earlier].pose, f.pose), f.cov.inverse(),
                             f.margin_per_point);

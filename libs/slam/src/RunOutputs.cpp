@@ -17,6 +17,23 @@ namespace urbanslam::slam {
 
 namespace fs = std::filesystem;
 
+StagedMapFile::StagedMapFile(const std::string& dir, const Pipeline& pipeline) {
+  const std::string target = dir + ".usmap";
+  common::removeStaleTemporaries(target);
+  if (pipeline.keyframes().empty()) return;
+  std::error_code ec;
+  const fs::path parent = fs::path(dir).parent_path();
+  if (!parent.empty() && !fs::is_directory(parent, ec) && !fs::create_directories(parent, ec))
+    throw common::InputError(dir + ": cannot create the output folder (is its parent writable?)");
+  path_ = common::temporaryPathFor(target);
+  writeMapFile(pipeline, path_);
+}
+
+StagedMapFile::~StagedMapFile() {
+  std::error_code ec;
+  if (!path_.empty()) fs::remove(path_, ec);  // moved into the folder already, or a failed run's
+}
+
 namespace {
 
 constexpr const char* kConfigHeader = "// Resolved configuration of this run";

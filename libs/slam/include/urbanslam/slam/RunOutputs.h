@@ -22,6 +22,24 @@ struct RunInfo {
   common::Json sessions;
 };
 
+// map.usmap for the run folder `dir`, staged: the pipeline's state saved now, before finish()
+// (which drops the closures still awaiting confirmation that a continued run may yet confirm),
+// streamed to a temporary file beside `dir`, which writeRunOutputs moves into the folder
+// (RunInfo::map_file). Temporaries of earlier killed runs are removed first, and this one is
+// removed when the run fails before the move. A pipeline without keyframes has no map: path()
+// is then empty. Throws InputError when dir's parent cannot be created.
+class StagedMapFile {
+ public:
+  StagedMapFile(const std::string& dir, const Pipeline& pipeline);
+  ~StagedMapFile();
+  StagedMapFile(const StagedMapFile&) = delete;
+  StagedMapFile& operator=(const StagedMapFile&) = delete;
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
 // The keyframe pose graph (estimates, motion and loop-closure constraints) as g2o.
 void writePoseGraphG2o(const Pipeline& pipeline, const std::string& path);
 

@@ -49,7 +49,7 @@ struct SessionJoin {
   std::string reason;       // why not
   common::Pose2 transform;  // session frame -> map frame (the agreeing fix's nearest to the session's start)
   // Its uncertainty at the session's first keyframe: the agreement's tolerance, grown by the
-  // drift allowance over the session's path from there to the best fix.
+  // drift allowance over the session's path from there to that fix.
   Eigen::Matrix3d transform_cov = Eigen::Matrix3d::Identity();
   size_t probes = 0;              // place searches made
   std::vector<SessionFix> fixes;  // every fix found
