@@ -35,11 +35,7 @@ for ds in ${DATASETS:-intel aces fr079 csail}; do
   W=$OUT/$ds
   mkdir -p "$W"
   src=$D/raw_logs/${LOG[$ds]}.clf.gz
-  n=$(zcat "$src" | grep -c '^FLASER')
-  half=$((n / 2))
-  # The first half: every line up to the middle scan; the second: the header lines and the rest.
-  zcat "$src" | awk -v h=$half '/^FLASER/{k++} k<=h {print}' > "$W/first.clf"
-  zcat "$src" | awk -v h=$half '/^FLASER/{k++} k>h || /^#/ || /^PARAM/ {print}' > "$W/second.clf"
+  $HERE/split_half.sh "$src" "$W"
   [ -f "$W/full/stats.json" ] || "$U" run --quiet --ini ini/$ds.ini --out "$W/full" "$src"
   "$U" run --quiet --ini ini/$ds.ini --out "$W/map" "$W/first.clf"
   initial=$(python3 $HERE/last_pose.py "$W/map/trajectory_scans.tum")

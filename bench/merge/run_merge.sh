@@ -33,11 +33,7 @@ for ds in ${DATASETS:-intel aces fr079 csail}; do
   mkdir -p "$W"
   src=$D/raw_logs/${LOG[$ds]}.clf.gz
   rel=$D/relations/${LOG[$ds]}.relations
-  n=$(zcat "$src" | grep -c '^FLASER')
-  half=$((n / 2))
-  # The first half: every line up to the middle scan; the second: the header lines and the rest.
-  zcat "$src" | awk -v h=$half '/^FLASER/{k++} k<=h {print}' > "$W/first.clf"
-  zcat "$src" | awk -v h=$half '/^FLASER/{k++} k>h || /^#/ || /^PARAM/ {print}' > "$W/second.clf"
+  bench/localize/split_half.sh "$src" "$W"
   [ -f "$W/full/stats.json" ] || "$U" run --quiet --ini ini/$ds.ini --out "$W/full" "$src"
   "$U" run --quiet --ini ini/$ds.ini --out "$W/first" "$W/first.clf"
   "$U" run --quiet --ini ini/$ds.ini --out "$W/second" "$W/second.clf"
