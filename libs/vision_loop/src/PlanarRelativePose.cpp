@@ -6,6 +6,7 @@
 
 #include "urbanslam/common/Pose2.h"
 #include "urbanslam/vision_loop/GeometricVerification.h"
+#include "urbanslam/vision_loop/PlanarEpipolar.h"
 
 namespace urbanslam::vision_loop {
 
@@ -59,13 +60,27 @@ PlanarRelativePose planarRelativePose(const std::vector<cv::Point2f>& a, const s
     r.failure_reason = "too few inliers";
     return r;
   }
+  // The planar model fitted to the inliers, from RANSAC's pose (normalised image coordinates).
+  std::vector<Eigen::Vector2d> na, nb;
+  for (size_t i = 0; i < ia.size(); ++i) {
+    na.emplace_back((ia[i].x - camera.cx) / camera.fx, (ia[i].y - camera.cy) / camera.fy);
+    nb.emplace_back((ib[i].x - camera.cx) / camera.fx, (ib[i].y - camera.cy) / camera.fy);
+  }
+  const PlanarEpipolarFit fit = fitPlanarEpipolar(na, nb, x(0), x(1), o.min_residual_px / (0.5 * (camera.fx + camera.fy)));
+  if (!fit.converged) {
+    r.failure_reason = "planar fit failed";
+    return r;
+  }
+  x = Eigen::Vector2d(fit.bearing_rad, fit.heading_rad);
   r.bearing_rad = x(0);
   r.heading_rad = x(1);
-  // Bootstrap over the inliers: the spread of the estimate about the full one.
+  // Bootstrap over the inliers: the spread of the five-point estimates of resampled sets about
+  // the planar one. A resample on which RANSAC lands elsewhere (a flipped or degenerate solution)
+  // would dominate a plain second moment: samples beyond three robust standard deviations (from
+  // the median absolute deviation) on either axis are left out of it.
   std::mt19937 rng(o.seed);
   std::uniform_int_distribution<size_t> pick(0, ia.size() - 1);
-  Eigen::Matrix2d s = Eigen::Matrix2d::Zero();
-  int n = 0;
+  std::vector<Eigen::Vector2d> deviations;
   for (int k_sample = 0; k_sample < o.bootstrap_samples; ++k_sample) {
     std::vector<cv::Point2f> sa, sb;
     for (size_t i = 0; i < ia.size(); ++i) {
@@ -75,7 +90,26 @@ PlanarRelativePose planarRelativePose(const std::vector<cv::Point2f>& a, const s
     }
     Eigen::Vector2d y;
     if (!estimate(sa, sb, k, o, &y, nullptr)) continue;
-    const Eigen::Vector2d d(common::wrapToPi(y(0) - x(0)), common::wrapToPi(y(1) - x(1)));
+    deviations.emplace_back(common::wrapToPi(y(0) - x(0)), common::wrapToPi(y(1) - x(1)));
+  }
+  if (deviations.size() < 5) {
+    r.failure_reason = "unstable under resampling";
+    return r;
+  }
+  Eigen::Vector2d limit;
+  for (int axis = 0; axis < 2; ++axis) {
+    std::vector<double> v;
+    for (const auto& d : deviations) v.push_back(d(axis));
+    std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+    const double median = v[v.size() / 2];
+    for (double& e : v) e = std::abs(e - median);
+    std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+    limit(axis) = std::max(3 * 1.4826 * v[v.size() / 2], 1e-9);
+  }
+  Eigen::Matrix2d s = Eigen::Matrix2d::Zero();
+  int n = 0;
+  for (const auto& d : deviations) {
+    if (std::abs(d(0)) > limit(0) || std::abs(d(1)) > limit(1)) continue;
     s += d * d.transpose();
     ++n;
   }

@@ -5,9 +5,16 @@
 // seen from the first. A single camera cannot see the length of the translation; the filter
 // takes that from the odometry (esdf/BearingHeading.h).
 //
+// The five-point RANSAC's inliers then fit the planar model itself (PlanarEpipolar.h: bearing
+// and heading by robust Levenberg-Marquardt on the Sampson residuals): two parameters instead of
+// the essential matrix's five, so the level camera's constraint is used, not only read off.
+//
 // The covariance of (bearing, heading) is estimated by resampling the inliers (bootstrap): the
-// spread of the estimates from resampled correspondence sets, which follows the inliers'
-// residuals and their layout in the image (few, clustered or distant points give a wide spread).
+// spread of the five-point estimates from resampled correspondence sets about the planar one,
+// which follows the inliers' residuals and their layout in the image (few, clustered or distant
+// points give a wide spread), and, as RANSAC runs again, a facade pattern that offers two
+// consistent sets of matches. (The fit's own first-order covariance is consistent on Gaussian
+// pixel noise but not there: PlanarEpipolarTest, bench/camera/RESULTS.md.)
 #include <string>
 
 #include <Eigen/Core>
@@ -25,8 +32,9 @@ struct PlanarRelativePoseOptions {
   double ransac_threshold_px = 1.0;  // distance to the epipolar line of an inlier
   double ransac_confidence = 0.999;
   int min_inliers = 20;
-  int bootstrap_samples = 40;  // resampled inlier sets for the covariance
-  unsigned seed = 1;           // of the resampling (the result is reproducible)
+  double min_residual_px = 0.1;  // floor on the residuals' robust standard deviation (the planar fit's weights)
+  int bootstrap_samples = 40;    // resampled inlier sets for the covariance
+  unsigned seed = 1;             // of the resampling (the result is reproducible)
 };
 
 struct PlanarRelativePose {
