@@ -5,9 +5,11 @@
 # closures accepted and how many of them join two views of the same place (true positions
 # within 25 m: a camera closure measures bearing and heading, so `eval`'s whole-pose check,
 # `eval_false`, does not apply to it; a laser closure may join scans further apart), and the
-# real-time factor.
+# real-time factor. AREA_KM2 and ROUTE_KM give both runs another city size and drive length
+# (default: the inis' own, 1 km² and 3 km).
 #
 #   bash bench/camera/run_camera.sh [BUILD_DIR] [OUT_DIR]
+#   AREA_KM2=10 ROUTE_KM=10 bash bench/camera/run_camera.sh [BUILD_DIR] [OUT_DIR]
 set -euo pipefail
 BUILD=${1:-build}
 OUT=${2:-out/bench-camera}
@@ -18,6 +20,10 @@ printf '%-8s %9s %10s %8s %7s %9s %10s %10s %6s\n' run keyframes driven_m ate_m 
 for spec in camera:ini/city-camera.ini laser:ini/city-1km2.ini; do
   name=${spec%%:*}
   ini=${spec#*:}
+  if [[ -n ${AREA_KM2:-} || -n ${ROUTE_KM:-} ]]; then
+    sed -e "s/^area_km2 .*/area_km2 = ${AREA_KM2:-1}/" -e "s/^route_length_km .*/route_length_km = ${ROUTE_KM:-3}/" "$ini" > "$OUT/$name.ini"
+    ini=$OUT/$name.ini
+  fi
   "$U" run --simulate "$ini" --out "$OUT/$name" --quiet --json > "$OUT/$name.json"
   "$U" eval "$OUT/$name" --reference "$OUT/$name/reference.tum" --json > "$OUT/$name.eval.json"
   python3 - "$OUT/$name" "$name" <<'PY'
