@@ -26,7 +26,13 @@ StagedMapFile::StagedMapFile(const std::string& dir, const Pipeline& pipeline) {
   if (!parent.empty() && !fs::is_directory(parent, ec) && !fs::create_directories(parent, ec))
     throw common::InputError(dir + ": cannot create the output folder (is its parent writable?)");
   path_ = common::temporaryPathFor(target);
-  writeMapFile(pipeline, path_);
+  try {
+    writeMapFile(pipeline, path_);
+  } catch (...) {
+    // A constructor that throws runs no destructor: the half-written temporary goes now.
+    fs::remove(path_, ec);
+    throw;
+  }
 }
 
 StagedMapFile::~StagedMapFile() {
