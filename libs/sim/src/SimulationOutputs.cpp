@@ -11,6 +11,7 @@
 #include "urbanslam/common/Error.h"
 #include "urbanslam/io/MapOutputs.h"
 #include "urbanslam/io/RawlogWriter.h"
+#include "urbanslam/sim/ImageLoopTruth.h"
 #include "urbanslam/sim/LoopTruth.h"
 #include "urbanslam/sim/SimulatedSource.h"
 #include "urbanslam/sim/WallsOutput.h"
@@ -35,18 +36,22 @@ SimulationSummary writeSimulation(const SimOptions& options, const std::string& 
   common::AtomicFile loops(dir + "/loops.csv");
   loops.stream() << "t_old,t_new,overlap,distance_m\n";
   LoopTruthFinder finder(options.loops);
-  // Image loop truth: the wall points the image columns see, paired like scans, and the views'
-  // directions within image_max_heading_deg (from the other side of a thin object, or along a
-  // wall from the other end, points are shared without the images looking alike).
+  // Image loop truth: views that see the same wall points (ImageLoopTruth.h), pointing within
+  // image_max_heading_deg (from the other side of a thin object, or along a wall from the other
+  // end, points are shared without the images looking alike).
   std::unique_ptr<common::AtomicFile> image_loops;
   if (camera) {
     image_loops = std::make_unique<common::AtomicFile>(dir + "/image_loops.csv");
     image_loops->stream() << "t_old,t_new,overlap,distance_m\n";
   }
-  LoopTruthFinder image_finder(options.loops);
-  std::map<double, std::pair<std::string, double>> image_at;                  // time -> (name, camera heading)
+  std::unique_ptr<ImageLoopTruth> image_finder;
+  if (camera) {
+    std::vector<double> bearings(static_cast<size_t>(options.camera.width_px));
+    for (size_t x = 0; x < bearings.size(); ++x) bearings[x] = source.camera()->columnBearing(static_cast<int>(x));
+    image_finder = std::make_unique<ImageLoopTruth>(options.loops, std::move(bearings));
+  }
+  std::map<double, std::string> image_at;                                     // time -> image name
   std::vector<std::pair<std::string, std::vector<std::string>>> image_truth;  // eval-image-loop format
-  const double max_heading = options.loops.image_max_heading_deg * M_PI / 180.0;
   // The truth at scan times: 32 bytes a scan (a 1000 km drive: ~3 MB), written at the end.
   std::vector<io::StampedPose> truth;
   common::Pose2 last_truth;
@@ -84,23 +89,15 @@ SimulationSummary writeSimulation(const SimOptions& options, const std::string& 
         std::snprintf(buf, sizeof buf, "_%06zu", sum.images - 1);
         std::string name = rawlog ? rawlog->lastImageFile() : img->label + buf;
         name = name.substr(0, name.rfind('.'));
-        image_at[img->timestamp] = {name, cam.phi};
-        const CameraRenderer& r = *source.camera();
-        const std::vector<double> ranges = r.columnRanges(cam);
-        std::vector<Vec2> points;
-        for (size_t x = 0; x < ranges.size(); x += static_cast<size_t>(options.loops.image_column_stride)) {
-          if (!(ranges[x] < kNoHit)) continue;
-          const double a = cam.phi + r.columnBearing(static_cast<int>(x));
-          points.push_back({cam.x + ranges[x] * std::cos(a), cam.y + ranges[x] * std::sin(a)});
-        }
+        image_at[img->timestamp] = name;
         std::vector<std::string> matches;
-        for (const LoopPair& p : image_finder.add(img->timestamp, {cam.x, cam.y}, points)) {
+        for (const LoopPair& p : image_finder->add(img->timestamp, cam, source.camera()->columnRanges(cam))) {
           const auto old = image_at.find(p.t_old);
-          if (old == image_at.end() || std::fabs(common::wrapToPi(cam.phi - old->second.second)) > max_heading) continue;
+          if (old == image_at.end()) continue;
           std::snprintf(buf, sizeof buf, "%.6f,%.6f,%.4f,%.3f\n", p.t_old, p.t_new, p.overlap, p.distance_m);
           image_loops->stream() << buf;
           ++sum.image_loop_pairs;
-          matches.push_back(old->second.first);
+          matches.push_back(old->second);
         }
         if (!matches.empty()) image_truth.emplace_back(name, std::move(matches));
       }
