@@ -31,9 +31,12 @@ int evalImageLoopCommand(const Argv& args) {
   ap.addOption("out", "DIR", "writes pr_curve.csv, pr_curve.png, detections.csv here", "out/eval-image-loop");
   ap.addOption("max-features", "N", "features per image", "500");
   ap.addOption("max-image-side", "PX", "larger images are downscaled to this longer side (0: never)", "1024");
+  ap.addOption("min-image-side", "PX",
+               "smaller images (after any downscaling) are upscaled to this longer side before detection (0: never)", "320");
   ap.addOption("alpha", "A", "detector threshold on the normalised score (reported point)", "0.3");
   ap.addOption("exclude-recent", "N", "the last N frames are never loop candidates", "10");
   ap.addOption("consistency", "K", "earlier consecutive queries whose islands must agree (DBoW2 k)", "1");
+  ap.addOption("sequence", "L", "sequence matching over the last L queries (1: off)", "1");
   ap.addOption("min-inliers", "N", "geometric verification: minimum fundamental-matrix inliers", "20");
   ap.addOption("ransac-px", "PX", "geometric verification: max distance to the epipolar line", "3");
   ap.addFlag("no-verification", "skip geometric verification");
@@ -51,10 +54,13 @@ int evalImageLoopCommand(const Argv& args) {
   fo.type = vocabulary->descriptorType();
   fo.max_features = static_cast<int>(ap.optionInt("max-features"));
   fo.max_image_side_px = static_cast<int>(ap.optionInt("max-image-side"));
+  fo.min_image_side_px = static_cast<int>(ap.optionInt("min-image-side"));
   LoopDetectorOptions lo;
   lo.min_normalized_score = static_cast<float>(ap.optionDouble("alpha"));
   lo.exclude_recent_frames = static_cast<int>(ap.optionInt("exclude-recent"));
   lo.temporal_consistency = static_cast<int>(ap.optionInt("consistency"));
+  lo.sequence_frames = static_cast<int>(ap.optionInt("sequence"));
+  if (lo.sequence_frames < 1 || lo.sequence_frames > 100) throw common::InputError("--sequence: L must be 1..100");
   lo.verification.min_inliers = static_cast<int>(ap.optionInt("min-inliers"));
   lo.verification.ransac_threshold_px = ap.optionDouble("ransac-px");
   lo.geometric_verification = !ap.flag("no-verification");
@@ -143,6 +149,7 @@ int evalImageLoopCommand(const Argv& args) {
   j["mean_verification_ms"] = sweep.mean_verification_ms;
   j["geometric_verification"] = lo.geometric_verification;
   j["temporal_consistency"] = lo.temporal_consistency;
+  j["sequence_frames"] = lo.sequence_frames;
   j["pr_curve_csv"] = (out / "pr_curve.csv").string();
   j["pr_curve_png"] = (out / "pr_curve.png").string();
   if (ap.flag("json")) {

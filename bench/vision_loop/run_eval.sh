@@ -46,5 +46,32 @@ for d in sift orb; do
   printf '%-22s ' "excerpt $d:"; cat "$OUT/excerpt_$d.json"
 done
 
-# 3. Speed: quantisation, query vs database size (10^3..10^6), vocabulary load, per frame.
+# 3. Small images (160x120, a low-resolution camera): the RTAB-Map sequence shrunk to 160 px,
+# and the simulated city's camera rendered at 160x120 (its true image loops by co-visibility).
+# Plain, upscaled to 320 px before detection (the default), and upscaled with sequence matching.
+lowres() {  # NAME VOCAB SEQUENCE GT [extra options]
+  name=$1 voc=$2 seq=$3 gt=$4; shift 4
+  extra="$*"
+  for mode in "plain --min-image-side 0" "upscaled" "sequence5 --sequence 5"; do
+    tag=${mode%% *}; opts=${mode#"$tag"}
+    # shellcheck disable=SC2086 # word splitting of the option lists is intended
+    "$U" eval-image-loop "$voc" "$seq" --gt "$gt" --out "$OUT/lowres_${name}_$tag" --quiet --json $extra $opts > "$OUT/lowres_${name}_$tag.json"
+    printf '%-34s ' "lowres $name $tag:"; cat "$OUT/lowres_${name}_$tag.json"
+  done
+}
+if [ -d "$R/samples" ]; then
+  for d in sift orb; do
+    lowres "rtabmap_$d" "share/vision_loop/${d}_k10_L4.usvoc" "$R/samples" "$R/ground_truth_loops.txt" --max-image-side 160
+  done
+fi
+C=$OUT/city160
+sed -e 's/^width_px .*/width_px = 160/' -e 's/^height_px .*/height_px = 120/' -e 's/^cy_px .*/cy_px = 90/' \
+  ini/city-camera.ini > "$OUT/city160.ini"
+printf '\n[loops]\nimage_column_stride = 2\n' >> "$OUT/city160.ini"
+"$U" simulate --ini "$OUT/city160.ini" --out "$C" --quiet --json > "$OUT/city160_simulate.json"
+for d in sift orb; do
+  lowres "city160_$d" "share/vision_loop/${d}_k10_L4.usvoc" "$C/city_Images" "$C/image_loops.txt"
+done
+
+# 4. Speed: quantisation, query vs database size (10^3..10^6), vocabulary load, per frame.
 "$BUILD/bench/vision_loop/vision_loop_bench" --benchmark_out="$OUT/bench.json" --benchmark_out_format=json

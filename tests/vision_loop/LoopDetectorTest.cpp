@@ -145,6 +145,38 @@ TEST(LoopDetector, FindsTheSecondLapWithoutFalsePositives) {
   }
 }
 
+TEST(LoopDetector, SmallImagesFindTheSecondLapWhenUpscaledBeforeDetection) {
+  // The excerpt's 512x384 frames shrunk to 160x120 (a low-resolution camera): few features
+  // survive and geometric verification rejects most true loops, unless the small image is
+  // upscaled before detection. Sequence matching must not add a false positive either.
+  const auto gt = GroundTruthLoops::load(repoPath(kExcerpt + "/ground_truth_loops.txt"));
+  for (const char* name : {"sift_k10_L4.usvoc", "orb_k10_L4.usvoc"}) {
+    const auto vocabulary = shippedVocabulary(name);
+    auto count = [&](int min_side, int sequence_frames) {
+      FeatureOptions fo;
+      fo.type = vocabulary->descriptorType();
+      fo.max_image_side_px = 160;
+      fo.min_image_side_px = min_side;
+      const auto frames = excerptFrames(*vocabulary, fo);
+      EXPECT_EQ(frames.front().features.image_size.width, min_side ? min_side : 160);
+      LoopDetectorOptions lo;
+      lo.sequence_frames = sequence_frames;
+      LoopDetector detector(vocabulary, fo, lo);
+      std::pair<size_t, size_t> tp_fp{0, 0};
+      for (const auto& f : frames) {
+        const LoopResult r = detector.process(f.features, f.bag);
+        if (r.detected()) (gt.isMatch(f.name, frames[r.match].name) ? tp_fp.first : tp_fp.second)++;
+      }
+      return tp_fp;
+    };
+    const auto plain = count(0, 1), upscaled = count(320, 1), sequence = count(320, 5);
+    EXPECT_EQ(plain.second + upscaled.second + sequence.second, 0u) << name;
+    EXPECT_GE(upscaled.first, 10u) << name << ": of 16 loop frames";
+    EXPECT_GT(upscaled.first, plain.first) << name;
+    EXPECT_GE(sequence.first, 10u) << name;
+  }
+}
+
 TEST(LoopDetector, CandidateRestrictionOnlyReturnsCandidates) {
   const auto vocabulary = shippedVocabulary("orb_k10_L4.usvoc");
   FeatureOptions fo;

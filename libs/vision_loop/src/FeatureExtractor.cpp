@@ -35,6 +35,13 @@ ImageFeatures FeatureExtractor::extract(const cv::Mat& image) const {
     cv::resize(gray, small, cv::Size(), s, s, cv::INTER_AREA);
     gray = small;
   }
+  const int side_now = std::max(gray.cols, gray.rows);
+  if (options_.min_image_side_px > 0 && side_now > 0 && side_now < options_.min_image_side_px) {
+    const double s = static_cast<double>(options_.min_image_side_px) / side_now;
+    cv::Mat large;
+    cv::resize(gray, large, cv::Size(), s, s, cv::INTER_CUBIC);
+    gray = large;
+  }
   f.image_size = gray.size();
   detector_->detectAndCompute(gray, cv::noArray(), f.keypoints, f.descriptors);
   // SIFT's cap is applied before orientation assignment and may return a few extra keypoints

@@ -6,9 +6,12 @@ void declareImageLoopOptions(common::OptionsSchema& s, ImageLoopOptions& o) {
   s.add("vocabulary", o.vocabulary, {}, "vocabulary file (build-vocabulary); empty: share/vision_loop/sift_k10_L4.usvoc");
   s.add("max_features", o.max_features, 10, 100000, "features", "strongest features kept per image");
   s.add("max_image_side_px", o.max_image_side_px, 0, 100000, "px", "larger images are downscaled first; 0: never");
+  s.add("min_image_side_px", o.min_image_side_px, 0, 100000, "px", "smaller images are upscaled before detection; 0: never");
   s.add("min_normalized_score", o.min_normalized_score, 0.0, 100.0, "", "alpha: score relative to the previous frame's");
   s.add("exclude_recent_frames", o.exclude_recent_frames, 0, 1000000, "frames", "the last frames are never loop candidates");
   s.add("temporal_consistency", o.temporal_consistency, 0, 100, "queries", "earlier consecutive queries whose islands must agree");
+  s.add("sequence_frames", o.sequence_frames, 1, 100, "frames",
+        "sequence matching: the last n queries must match earlier frames in order (1: off)");
   s.add("island_gap_frames", o.island_gap_frames, 0, 1000, "frames", "matches this close form one island");
   s.add("max_island_distance_frames", o.max_island_distance_frames, 0, 1000, "frames",
         "islands of consecutive queries agree when this close");
@@ -25,6 +28,7 @@ FeatureOptions featureOptions(const ImageLoopOptions& o, DescriptorType type) {
   f.type = type;
   f.max_features = o.max_features;
   f.max_image_side_px = o.max_image_side_px;
+  f.min_image_side_px = o.min_image_side_px;
   return f;
 }
 
@@ -33,6 +37,7 @@ LoopDetectorOptions detectorOptions(const ImageLoopOptions& o) {
   d.min_normalized_score = static_cast<float>(o.min_normalized_score);
   d.exclude_recent_frames = o.exclude_recent_frames;
   d.temporal_consistency = o.temporal_consistency;
+  d.sequence_frames = o.sequence_frames;
   d.island_gap_frames = o.island_gap_frames;
   d.max_island_distance_frames = o.max_island_distance_frames;
   d.max_query_results = static_cast<size_t>(o.max_query_results);

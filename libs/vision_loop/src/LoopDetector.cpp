@@ -37,7 +37,8 @@ LoopDetector::LoopDetector(std::shared_ptr<const Vocabulary> vocabulary, const F
         return features;
       }()),
       options_(options),
-      database_(vocabulary_->wordCount()) {}
+      database_(vocabulary_->wordCount()),
+      sequence_(options.sequence_frames) {}
 
 LoopResult LoopDetector::process(const cv::Mat& image, const std::vector<ImageId>* candidates) {
   common::Stopwatch sw;
@@ -82,6 +83,8 @@ LoopResult LoopDetector::process(ImageFeatures features, BagOfWords bag, const s
       d.database_.add(b);
       d.frames_.push_back(std::move(f));
       d.previous_bag_ = std::move(b);
+      d.sequence_.push(std::move(d.query_results_));
+      d.query_results_.clear();
     }
   } add_on_exit{*this, features, bag};
 
@@ -99,12 +102,28 @@ LoopResult LoopDetector::process(ImageFeatures features, BagOfWords bag, const s
     r.status = LoopStatus::LowPriorScore;
     return r;
   }
+  const bool sequence = options_.sequence_frames > 1;
   QueryOptions q;
   q.max_results = options_.max_query_results;
   q.max_image = static_cast<ImageId>(limit);
   q.candidates = candidates;
-  q.min_score = options_.min_normalized_score * prior;  // η ≥ α
-  std::vector<QueryResult> hits = database_.query(bag, q);
+  // η ≥ α; with sequences every result is kept, since a weak match now may support a strong
+  // sequence later.
+  q.min_score = sequence ? 0.f : options_.min_normalized_score * prior;
+  const std::vector<QueryResult> raw = database_.query(bag, q);
+  // The ranked results: score = η̄ · prior, so that islands and α work on η̄ as they do on η.
+  std::vector<QueryResult> hits;
+  std::map<ImageId, float> raw_score;
+  for (const auto& h : raw) {
+    raw_score[h.image] = h.score;
+    if (!sequence) {
+      hits.push_back(h);
+      continue;
+    }
+    query_results_.push_back({h.image, h.score / prior});
+    const float ranked = sequence_.score(h.image, h.score / prior);
+    if (ranked >= options_.min_normalized_score) hits.push_back({h.image, ranked * prior});
+  }
   timings_.query_ms = sw.milliseconds();
   if (hits.empty()) {
     r.status = LoopStatus::NoCandidates;
@@ -128,9 +147,13 @@ LoopResult LoopDetector::process(ImageFeatures features, BagOfWords bag, const s
   std::vector<QueryResult> members = best.members;
   std::sort(members.begin(), members.end(),
             [](const QueryResult& a, const QueryResult& b) { return a.score > b.score || (a.score == b.score && a.image < b.image); });
-  r.match = members.front().image;
-  r.score = members.front().score;
-  r.normalized_score = r.score / prior;
+  auto report = [&](const QueryResult& m) {
+    r.match = m.image;
+    r.score = raw_score.at(m.image);
+    r.normalized_score = r.score / prior;
+    r.sequence_score = m.score / prior;
+  };
+  report(members.front());
 
   if (!consistentWithPrevious(best, r.query)) {
     r.status = LoopStatus::NotConsistent;
@@ -155,20 +178,14 @@ LoopResult LoopDetector::process(ImageFeatures features, BagOfWords bag, const s
     }
     if (i == 0 || v.accepted) {
       r.verification = v;
-      r.match = m;
-      r.score = members[i].score;
-      r.normalized_score = r.score / prior;
+      report(members[i]);
     }
     if (v.accepted) {
       r.status = LoopStatus::Detected;
       break;
     }
   }
-  if (r.status != LoopStatus::Detected) {
-    r.match = members.front().image;
-    r.score = members.front().score;
-    r.normalized_score = r.score / prior;
-  }
+  if (r.status != LoopStatus::Detected) report(members.front());
   timings_.verification_ms = sw.milliseconds();
   return r;
 }

@@ -14,6 +14,10 @@ struct FeatureOptions {
   DescriptorType type = DescriptorType::Sift;
   int max_features = 500;        // strongest responses kept (SIFT: contrast, ORB: Harris score)
   int max_image_side_px = 1024;  // larger images are downscaled first (0: never); wallpapers are 4K
+  // Smaller images are upscaled (bicubic) to this longer side before detection (0: never): on a
+  // 160x120 image most of the frame lies within ORB's 31-pixel border and SIFT finds few
+  // extrema; upscaled, both find features at the finer scales the image does hold.
+  int min_image_side_px = 0;
 };
 
 struct ImageFeatures {

@@ -12,6 +12,8 @@
 //     agree (overlap or be close);
 //  4. geometric verification (ratio-test matches + RANSAC fundamental matrix) of the island's
 //     best images.
+// With sequence_frames L > 1, step 2 ranks by the sequence score η̄ (SequenceScore.h) instead
+// of η: the last L queries must have matched the frames before the candidate, in order.
 // A detection proposes a loop closure; laser alignment then measures the relative pose.
 #include <map>
 #include <memory>
@@ -22,6 +24,7 @@
 #include "urbanslam/vision_loop/FeatureExtractor.h"
 #include "urbanslam/vision_loop/GeometricVerification.h"
 #include "urbanslam/vision_loop/ImageDatabase.h"
+#include "urbanslam/vision_loop/SequenceScore.h"
 #include "urbanslam/vision_loop/Vocabulary.h"
 
 namespace urbanslam::vision_loop {
@@ -35,6 +38,7 @@ struct LoopDetectorOptions {
   int temporal_consistency = 1;        // k: earlier consecutive queries whose islands must agree
   int max_island_distance_frames = 3;  // islands of consecutive queries agree when this close
   int max_query_gap_frames = 2;        // queries further apart are not "consecutive"
+  int sequence_frames = 1;             // L: queries whose matches must advance together (1: off)
   bool geometric_verification = true;
   int verify_candidates = 3;  // best images of the winning island tried in turn
   VerificationOptions verification;
@@ -57,6 +61,7 @@ struct LoopResult {
   ImageId match = 0;           // best image of the winning island (when there is one)
   float score = 0;             // s(v_t, v_match)
   float normalized_score = 0;  // η of the match
+  float sequence_score = 0;    // η̄ of the match (= η without sequence matching)
   VerificationResult verification;
   bool detected() const { return status == LoopStatus::Detected; }
 };
@@ -104,6 +109,8 @@ class LoopDetector {
   ImageDatabase database_;
   std::vector<ImageFeatures> frames_;  // kept for geometric verification
   BagOfWords previous_bag_;
+  SequenceScore sequence_;
+  std::vector<ScoredImage> query_results_;  // this frame's, for the sequence history
   FrameTimings timings_;
   std::shared_ptr<VerificationCache> cache_;
   // Temporal window (DBoW2): the last query that produced an island, that island, and how many
