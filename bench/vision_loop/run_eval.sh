@@ -73,5 +73,10 @@ for d in sift orb; do
   lowres "city160_$d" "share/vision_loop/${d}_k10_L4.usvoc" "$C/city_Images" "$C/image_loops.txt"
 done
 
-# 4. Speed: quantisation, query vs database size (10^3..10^6), vocabulary load, per frame.
+# 4. The camera's planar relative pose on 1000 simulated street-view pairs: errors and NEES per
+# covariance method.
+"$BUILD/bench/vision_loop/relative_pose_nees" 1000 --json > "$OUT/relative_pose_nees.json"
+printf '%-22s ' "relative pose NEES:"; cat "$OUT/relative_pose_nees.json"
+
+# 5. Speed: quantisation, query vs database size (10^3..10^6), vocabulary load, per frame.
 "$BUILD/bench/vision_loop/vision_loop_bench" --benchmark_out="$OUT/bench.json" --benchmark_out_format=json

@@ -74,22 +74,34 @@ PlanarRelativePose planarRelativePose(const std::vector<cv::Point2f>& a, const s
   x = Eigen::Vector2d(fit.bearing_rad, fit.heading_rad);
   r.bearing_rad = x(0);
   r.heading_rad = x(1);
-  // Bootstrap over the inliers: the spread of the five-point estimates of resampled sets about
-  // the planar one. A resample on which RANSAC lands elsewhere (a flipped or degenerate solution)
-  // would dominate a plain second moment: samples beyond three robust standard deviations (from
-  // the median absolute deviation) on either axis are left out of it.
+  if (o.covariance == PoseCovariance::FirstOrder) {
+    r.cov = fit.cov;
+    r.valid = true;
+    return r;
+  }
+  // Bootstrap over the inliers: the spread of the estimates of resampled sets about the planar
+  // one. A resample on which RANSAC lands elsewhere (a flipped or degenerate solution) would
+  // dominate a plain second moment: samples beyond three robust standard deviations (from the
+  // median absolute deviation) on either axis are left out of it.
   std::mt19937 rng(o.seed);
   std::uniform_int_distribution<size_t> pick(0, ia.size() - 1);
   std::vector<Eigen::Vector2d> deviations;
+  const double min_sigma = o.min_residual_px / (0.5 * (camera.fx + camera.fy));
   for (int k_sample = 0; k_sample < o.bootstrap_samples; ++k_sample) {
-    std::vector<cv::Point2f> sa, sb;
-    for (size_t i = 0; i < ia.size(); ++i) {
-      const size_t j = pick(rng);
-      sa.push_back(ia[j]);
-      sb.push_back(ib[j]);
-    }
+    std::vector<size_t> idx(ia.size());
+    for (size_t& j : idx) j = pick(rng);
     Eigen::Vector2d y;
-    if (!estimate(sa, sb, k, o, &y, nullptr)) continue;
+    if (o.covariance == PoseCovariance::PlanarBootstrap) {
+      std::vector<Eigen::Vector2d> sa, sb;
+      for (size_t j : idx) sa.push_back(na[j]), sb.push_back(nb[j]);
+      const PlanarEpipolarFit f = fitPlanarEpipolar(sa, sb, x(0), x(1), min_sigma);
+      if (!f.converged) continue;
+      y = Eigen::Vector2d(f.bearing_rad, f.heading_rad);
+    } else {
+      std::vector<cv::Point2f> sa, sb;
+      for (size_t j : idx) sa.push_back(ia[j]), sb.push_back(ib[j]);
+      if (!estimate(sa, sb, k, o, &y, nullptr)) continue;
+    }
     deviations.emplace_back(common::wrapToPi(y(0) - x(0)), common::wrapToPi(y(1) - x(1)));
   }
   if (deviations.size() < 5) {

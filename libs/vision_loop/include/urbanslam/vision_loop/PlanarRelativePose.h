@@ -27,6 +27,13 @@ struct PinholeCamera {
   double fx = 500, fy = 500, cx = 320, cy = 240;  // pixels
 };
 
+// How the covariance of (bearing, heading) is estimated (the pose is the planar fit in every case).
+enum class PoseCovariance {
+  FivePointBootstrap,  // spread of five-point RANSAC estimates of resampled inlier sets (RANSAC reruns)
+  PlanarBootstrap,     // spread of planar fits to resampled inlier sets (no RANSAC reruns)
+  FirstOrder,          // the planar fit's own σ² (J'WJ)⁻¹
+};
+
 struct PlanarRelativePoseOptions {
   double ratio = 0.8;                // Lowe's ratio test
   double ransac_threshold_px = 1.0;  // distance to the epipolar line of an inlier
@@ -34,7 +41,8 @@ struct PlanarRelativePoseOptions {
   int min_inliers = 20;
   double min_residual_px = 0.1;  // floor on the residuals' robust standard deviation (the planar fit's weights)
   int bootstrap_samples = 40;    // resampled inlier sets for the covariance
-  unsigned seed = 1;             // of the resampling (the result is reproducible)
+  PoseCovariance covariance = PoseCovariance::FivePointBootstrap;
+  unsigned seed = 1;  // of the resampling (the result is reproducible)
 };
 
 struct PlanarRelativePose {
