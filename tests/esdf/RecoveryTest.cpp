@@ -169,6 +169,21 @@ TEST(Recovery, NotPositiveDefiniteThrows) {
   EXPECT_THROW(chol.factorize(s, 0, 2), std::runtime_error);
 }
 
+TEST(Recovery, AStoredFactorWithColumnPointersPastItsRowsIsRefusedBeforeAnyRead) {
+  // One pose (3 columns) and 3 stored entries, but the first column claims entries 0..99: its
+  // range must be refused before the rows are read, although the last pointer matches.
+  SparseCholesky::Matrix m;
+  m.first = 0;
+  m.last = 1;
+  m.colptr = {0, 100, 2, 3};
+  m.rowind = {0, 1, 2};
+  m.values = {1, 1, 1};
+  SparseCholesky chol;
+  EXPECT_THROW(chol.factorize(m), std::invalid_argument);
+  m.colptr = {0, 1, 2, 3};  // the diagonal: a valid factor
+  EXPECT_NO_THROW(chol.factorize(m));
+}
+
 }  // namespace
 }  // namespace urbanslam::esdf
 

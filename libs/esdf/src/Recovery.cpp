@@ -160,8 +160,11 @@ void SparseCholesky::factorize(const Matrix& m) {
   if (m.colptr.size() != n + 1 || m.colptr.front() != 0 || m.rowind.size() != m.values.size() ||
       static_cast<size_t>(m.colptr.back()) != m.rowind.size())
     throw std::invalid_argument("factorize: inconsistent matrix sizes");
-  for (size_t c = 0; c < n; ++c) {
+  // All column pointers first: non-decreasing from 0 to the row count keeps every column's
+  // range inside the row indices before any is read.
+  for (size_t c = 0; c < n; ++c)
     if (m.colptr[c + 1] < m.colptr[c]) throw std::invalid_argument("factorize: decreasing column pointers");
+  for (size_t c = 0; c < n; ++c) {
     // Lower triangle, sorted rows, the diagonal first (as factorize(state) builds it).
     for (int k = m.colptr[c]; k < m.colptr[c + 1]; ++k) {
       const int r = m.rowind[static_cast<size_t>(k)];
