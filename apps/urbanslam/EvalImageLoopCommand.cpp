@@ -35,8 +35,8 @@ int evalImageLoopCommand(const Argv& args) {
                "smaller images (after any downscaling) are upscaled to this longer side before detection (0: never)", "320");
   ap.addOption("alpha", "A", "detector threshold on the normalised score (reported point)", "0.3");
   ap.addOption("exclude-recent", "N", "the last N frames are never loop candidates", "10");
-  ap.addOption("consistency", "K", "earlier consecutive queries whose islands must agree (DBoW2 k)", "1");
-  ap.addOption("sequence", "L", "sequence matching over the last L queries (1: off)", "1");
+  ap.addOption("consistency", "K", "earlier consecutive queries whose islands must agree (DBoW2 k)", "0");
+  ap.addOption("sequence", "L", "sequence matching over the last L queries (1: off)", "3");
   ap.addOption("min-inliers", "N", "geometric verification: minimum fundamental-matrix inliers", "20");
   ap.addOption("ransac-px", "PX", "geometric verification: max distance to the epipolar line", "3");
   ap.addFlag("no-verification", "skip geometric verification");

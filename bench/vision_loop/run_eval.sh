@@ -30,8 +30,8 @@ fi
 R=../shared/data/images/rtabmap_samples
 if [ -d "$R/samples" ]; then
   for d in sift orb; do
-    for v in "" --no-verification; do
-      tag=$d${v:+_bow_only}
+    for v in "" --no-verification "--sequence 1 --consistency 1"; do
+      case $v in --no-verification) tag=${d}_bow_only ;; --seq*) tag=${d}_dbow2_scheme ;; *) tag=$d ;; esac
       "$U" eval-image-loop "share/vision_loop/${d}_k10_L4.usvoc" "$R/samples" --gt "$R/ground_truth_loops.txt" \
         --out "$OUT/rtabmap_$tag" --quiet --json $v > "$OUT/rtabmap_$tag.json"
       printf '%-22s ' "rtabmap $tag:"; cat "$OUT/rtabmap_$tag.json"
@@ -48,11 +48,12 @@ done
 
 # 3. Small images (160x120, a low-resolution camera): the RTAB-Map sequence shrunk to 160 px,
 # and the simulated city's camera rendered at 160x120 (its true image loops by co-visibility).
-# Plain, upscaled to 320 px before detection (the default), and upscaled with sequence matching.
+# Plain, upscaled to 320 px before detection (the default), and upscaled with DBoW2's scheme
+# instead of sequence matching (one query's islands, two consecutive queries agreeing).
 lowres() {  # NAME VOCAB SEQUENCE GT [extra options]
   name=$1 voc=$2 seq=$3 gt=$4; shift 4
   extra="$*"
-  for mode in "plain --min-image-side 0" "upscaled" "sequence5 --sequence 5"; do
+  for mode in "plain --min-image-side 0" "upscaled" "dbow2 --sequence 1 --consistency 1"; do
     tag=${mode%% *}; opts=${mode#"$tag"}
     # shellcheck disable=SC2086 # word splitting of the option lists is intended
     "$U" eval-image-loop "$voc" "$seq" --gt "$gt" --out "$OUT/lowres_${name}_$tag" --quiet --json $extra $opts > "$OUT/lowres_${name}_$tag.json"

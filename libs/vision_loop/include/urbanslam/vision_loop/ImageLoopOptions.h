@@ -20,8 +20,8 @@ struct ImageLoopOptions {
   int min_image_side_px = 320;  // smaller images are upscaled before detection
   double min_normalized_score = 0.3;  // α
   int exclude_recent_frames = 10;
-  int temporal_consistency = 1;
-  int sequence_frames = 1;
+  int temporal_consistency = 0;
+  int sequence_frames = 3;
   int island_gap_frames = 3;
   int max_island_distance_frames = 3;
   int max_query_results = 50;

@@ -12,8 +12,11 @@
 //     agree (overlap or be close);
 //  4. geometric verification (ratio-test matches + RANSAC fundamental matrix) of the island's
 //     best images.
-// With sequence_frames L > 1, step 2 ranks by the sequence score η̄ (SequenceScore.h) instead
-// of η: the last L queries must have matched the frames before the candidate, in order.
+// With sequence_frames L > 1 (3 by default), step 2 ranks by the sequence score η̄
+// (SequenceScore.h) instead of η: the last L queries must have matched the frames before the
+// candidate, in order. That is the temporal check by default; step 3 (k = temporal_consistency)
+// is then off. On the RTAB-Map loop it removes the one confident false match that limited
+// DBoW2's scheme (libs/vision_loop/README.md).
 // A detection proposes a loop closure; laser alignment then measures the relative pose.
 #include <map>
 #include <memory>
@@ -35,10 +38,10 @@ struct LoopDetectorOptions {
   int exclude_recent_frames = 10;      // the last frames are the current place, not a loop
   size_t max_query_results = 50;       // top-k asked from the database
   int island_gap_frames = 3;           // matches at most this far apart form one island
-  int temporal_consistency = 1;        // k: earlier consecutive queries whose islands must agree
+  int temporal_consistency = 0;        // k: earlier consecutive queries whose islands must agree
   int max_island_distance_frames = 3;  // islands of consecutive queries agree when this close
   int max_query_gap_frames = 2;        // queries further apart are not "consecutive"
-  int sequence_frames = 1;             // L: queries whose matches must advance together (1: off)
+  int sequence_frames = 3;             // L: queries whose matches must advance together (1: off)
   bool geometric_verification = true;
   int verify_candidates = 3;  // best images of the winning island tried in turn
   VerificationOptions verification;
