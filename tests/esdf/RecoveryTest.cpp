@@ -182,6 +182,16 @@ TEST(Recovery, AStoredFactorWithColumnPointersPastItsRowsIsRefusedBeforeAnyRead)
   EXPECT_THROW(chol.factorize(m), std::invalid_argument);
   m.colptr = {0, 1, 2, 3};  // the diagonal: a valid factor
   EXPECT_NO_THROW(chol.factorize(m));
+  // Every column needs its diagonal (no entries at all, or a sub-diagonal entry first: refused
+  // here, where CHOLMOD would fail on the empty pattern or factorise a singular matrix).
+  m.colptr = {0, 0, 0, 0};
+  m.rowind.clear();
+  m.values.clear();
+  EXPECT_THROW(chol.factorize(m), std::invalid_argument);
+  m.colptr = {0, 2, 3, 4};
+  m.rowind = {1, 2, 1, 2};
+  m.values = {1, 1, 1, 1};
+  EXPECT_THROW(chol.factorize(m), std::invalid_argument);
 }
 
 }  // namespace

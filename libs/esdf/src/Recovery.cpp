@@ -129,7 +129,7 @@ void SparseCholesky::factorizeLower(std::vector<int> colptr, std::vector<int> ro
   if (!same_pattern) {
     if (impl_->factor) cholmod_free_factor(&impl_->factor, cm);
     impl_->factor = cholmod_analyze(&a, cm);
-    if (!impl_->factor) throw std::runtime_error("CHOLMOD analyze failed");
+    if (!impl_->factor) throw std::runtime_error("CHOLMOD analyze failed (status " + std::to_string(cm->status) + ")");
     impl_->last_p = std::move(colptr);
     impl_->last_i = std::move(rowind);
   }
@@ -165,7 +165,10 @@ void SparseCholesky::factorize(const Matrix& m) {
   for (size_t c = 0; c < n; ++c)
     if (m.colptr[c + 1] < m.colptr[c]) throw std::invalid_argument("factorize: decreasing column pointers");
   for (size_t c = 0; c < n; ++c) {
-    // Lower triangle, sorted rows, the diagonal first (as factorize(state) builds it).
+    // Lower triangle, sorted rows, the diagonal first (as factorize(state) builds it): a column
+    // without its diagonal cannot belong to a positive definite matrix.
+    if (m.colptr[c + 1] == m.colptr[c] || m.rowind[static_cast<size_t>(m.colptr[c])] != static_cast<int>(c))
+      throw std::invalid_argument("factorize: column " + std::to_string(c) + " lacks its diagonal");
     for (int k = m.colptr[c]; k < m.colptr[c + 1]; ++k) {
       const int r = m.rowind[static_cast<size_t>(k)];
       if (r < static_cast<int>(c) || static_cast<size_t>(r) >= n || (k > m.colptr[c] && r <= m.rowind[static_cast<size_t>(k) - 1]))
