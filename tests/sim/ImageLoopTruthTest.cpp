@@ -118,6 +118,7 @@ TEST(ImageLoopTruth, PairsNeedTimeGapDistanceAndHeading) {
   EXPECT_TRUE(truth.add(10, {0.2, 0, M_PI / 2}, r).empty());                    // too soon
   EXPECT_TRUE(truth.add(40, {0.2, 0, M_PI / 2 + 50 * M_PI / 180}, r).empty());  // turned away
   EXPECT_EQ(truth.add(80, {0.3, 0, M_PI / 2}, r).size(), 2u);                   // both earlier views
+  EXPECT_TRUE(truth.add(120, {16.0, 0, M_PI / 2}, r).empty());                  // over 15 m from every earlier view
 }
 
 TEST(ImageLoopTruth, RejectsColumnsThatDoNotMatchTheCamera) {

@@ -16,12 +16,6 @@ ImageLoopTruth::ImageLoopTruth(const LoopTruthOptions& options, std::vector<doub
     if (!(bearings_[i] < bearings_[i - 1])) throw common::InputError("image loop truth: column bearings must decrease");
 }
 
-int64_t ImageLoopTruth::cellKey(double x, double y) const {
-  const auto cx = static_cast<int64_t>(std::floor(x / options_.max_distance_m));
-  const auto cy = static_cast<int64_t>(std::floor(y / options_.max_distance_m));
-  return static_cast<int64_t>(static_cast<uint64_t>(cx) << 32) ^ (cy & 0xffffffff);
-}
-
 int ImageLoopTruth::columnOf(double bearing) const {
   if (bearing > bearings_.front() || bearing < bearings_.back()) return -1;
   // First column whose bearing is not above `bearing` (the array decreases).
@@ -66,7 +60,7 @@ std::vector<LoopPair> ImageLoopTruth::add(double t, const common::Pose2& camera,
   const double max_heading = options_.image_max_heading_deg * M_PI / 180.0;
   for (int dx = -1; dx <= 1; ++dx)
     for (int dy = -1; dy <= 1; ++dy) {
-      const auto it = cells_.find(cellKey(camera.x + dx * d, camera.y + dy * d));
+      const auto it = cells_.find(positionCellKey(camera.x + dx * d, camera.y + dy * d, d));
       if (it == cells_.end()) continue;
       for (uint32_t k : it->second) {
         const View& o = views_[k];
@@ -78,7 +72,7 @@ std::vector<LoopPair> ImageLoopTruth::add(double t, const common::Pose2& camera,
       }
     }
   std::sort(out.begin(), out.end(), [](const LoopPair& a, const LoopPair& b) { return a.t_old < b.t_old; });
-  cells_[cellKey(camera.x, camera.y)].push_back(static_cast<uint32_t>(views_.size()));
+  cells_[positionCellKey(camera.x, camera.y, d)].push_back(static_cast<uint32_t>(views_.size()));
   views_.push_back(std::move(v));
   return out;
 }

@@ -18,9 +18,9 @@ std::vector<Vec2> LoopTruthFinder::endPoints(const io::LaserScan& scan, const co
   return out;
 }
 
-int64_t LoopTruthFinder::cellKey(Vec2 p) const {
-  const auto cx = static_cast<int64_t>(std::floor(p.x / options_.max_distance_m));
-  const auto cy = static_cast<int64_t>(std::floor(p.y / options_.max_distance_m));
+int64_t positionCellKey(double x, double y, double cell_m) {
+  const auto cx = static_cast<int64_t>(std::floor(x / cell_m));
+  const auto cy = static_cast<int64_t>(std::floor(y / cell_m));
   // Shifted unsigned: a left shift of a negative value is undefined behaviour.
   return static_cast<int64_t>(static_cast<uint64_t>(cx) << 32) ^ (cy & 0xffffffff);
 }
@@ -43,7 +43,7 @@ std::vector<LoopPair> LoopTruthFinder::add(double t, Vec2 sensor, const std::vec
   if (n_new > 0) {
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy) {
-        auto it = cells_.find(cellKey({e.sensor.x + dx * d, e.sensor.y + dy * d}));
+        auto it = cells_.find(positionCellKey(e.sensor.x + dx * d, e.sensor.y + dy * d, d));
         if (it == cells_.end()) continue;
         for (uint32_t k : it->second) {
           const Entry& o = scans_[k];
@@ -66,7 +66,7 @@ std::vector<LoopPair> LoopTruthFinder::add(double t, Vec2 sensor, const std::vec
       }
   }
   std::sort(out.begin(), out.end(), [](const LoopPair& a, const LoopPair& b) { return a.t_old < b.t_old; });
-  cells_[cellKey(e.sensor)].push_back(static_cast<uint32_t>(scans_.size()));
+  cells_[positionCellKey(e.sensor.x, e.sensor.y, options_.max_distance_m)].push_back(static_cast<uint32_t>(scans_.size()));
   scans_.push_back(std::move(e));
   return out;
 }

@@ -113,16 +113,14 @@ LoopResult LoopDetector::process(ImageFeatures features, BagOfWords bag, const s
   const std::vector<QueryResult> raw = database_.query(bag, q);
   // The ranked results: score = η̄ · prior, so that islands and α work on η̄ as they do on η.
   std::vector<QueryResult> hits;
-  std::map<ImageId, float> raw_score;
-  for (const auto& h : raw) {
-    raw_score[h.image] = h.score;
-    if (!sequence) {
-      hits.push_back(h);
-      continue;
+  if (!sequence) {
+    hits = raw;
+  } else {
+    for (const auto& h : raw) {
+      query_results_.push_back({h.image, h.score / prior});
+      const float ranked = sequence_.score(h.image, h.score / prior);
+      if (ranked >= options_.min_normalized_score) hits.push_back({h.image, ranked * prior});
     }
-    query_results_.push_back({h.image, h.score / prior});
-    const float ranked = sequence_.score(h.image, h.score / prior);
-    if (ranked >= options_.min_normalized_score) hits.push_back({h.image, ranked * prior});
   }
   timings_.query_ms = sw.milliseconds();
   if (hits.empty()) {
@@ -149,7 +147,7 @@ LoopResult LoopDetector::process(ImageFeatures features, BagOfWords bag, const s
             [](const QueryResult& a, const QueryResult& b) { return a.score > b.score || (a.score == b.score && a.image < b.image); });
   auto report = [&](const QueryResult& m) {
     r.match = m.image;
-    r.score = raw_score.at(m.image);
+    r.score = std::find_if(raw.begin(), raw.end(), [&](const QueryResult& h) { return h.image == m.image; })->score;
     r.normalized_score = r.score / prior;
     r.sequence_score = m.score / prior;
   };

@@ -2,7 +2,7 @@
 // Ground-truth image loop pairs: two images far apart in time show the same place when most of
 // the wall points one camera sees are seen by the other camera too. A point counts as seen when
 // it lies inside the other camera's field of view, that camera's ray towards it ends on it (no
-// nearer wall hides it) and it is at most max_scale_ratio times nearer or further (a facade seen
+// nearer wall hides it) and it is at most kMaxScaleRatio times nearer or further (a facade seen
 // from much further away is a different picture).
 //
 // The scans' truth (LoopTruth.h) compares end points with end points, which suits a laser whose
@@ -43,8 +43,7 @@ class ImageLoopTruth {
     common::Pose2 pose;
     std::vector<float> ranges;  // per column; +inf: no wall within range
   };
-  int64_t cellKey(double x, double y) const;
-  // The column whose ray is nearest to `bearing` (camera frame), or -1 outside the view.
+  // The first column whose ray is not left of `bearing` (camera frame), or -1 outside the view.
   int columnOf(double bearing) const;
 
   LoopTruthOptions options_;

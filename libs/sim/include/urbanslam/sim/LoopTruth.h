@@ -13,6 +13,10 @@
 
 namespace urbanslam::sim {
 
+// Key of the square cell of side `cell_m` holding (x, y): the spatial hash both loop-truth
+// finders (scans here, images in ImageLoopTruth.h) look up sensor positions in.
+int64_t positionCellKey(double x, double y, double cell_m);
+
 struct LoopPair {
   double t_old = 0, t_new = 0;
   double overlap = 0;     // fraction in [0, 1]
@@ -36,7 +40,6 @@ class LoopTruthFinder {
     Vec2 sensor;
     std::vector<float> xy;  // end points, interleaved (floats: half the memory of a long drive)
   };
-  int64_t cellKey(Vec2 p) const;
 
   LoopTruthOptions options_;
   std::vector<Entry> scans_;

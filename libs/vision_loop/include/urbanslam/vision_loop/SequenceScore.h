@@ -7,12 +7,13 @@
 // says little, this is what still separates the two.
 //
 // Score of database image j at the present query t, over a window of L queries:
-//   η̄(j) = (1/L) Σ_{k=0}^{L-1} max_{i ∈ C_k(j)} min(η_{t-k}(i), 1),  C_0 = {j},
+//   η̄(j) = (1/L) Σ_{k=0}^{L-1} max_{i ∈ C_k(j)} η_{t-k}(i),  C_0 = {j},
 //   C_k(j) = [j - 2k, j - max(1, ⌊k/2⌋)]
 // where η_q(i) is query q's normalised score of image i (0 when i was not among its results).
 // The cone allows the revisit to run at half to twice the speed of the first visit, but not to
 // stand still, so an image that matches every frame of a stretch (a hub) gets no support from
-// the sequence. Capping η at 1 keeps one exceptional frame from carrying the mean.
+// the sequence. η is not capped: a cap at 1 made every strong sequence score the same, and α
+// could no longer rank a copied facade's run below a true revisit.
 #include <deque>
 #include <vector>
 
@@ -27,9 +28,8 @@ struct ScoredImage {
 
 class SequenceScore {
  public:
-  // `frames`: L ≥ 1 (1: the present query's capped score alone).
+  // `frames`: L ≥ 1 (1: the present query's score alone).
   explicit SequenceScore(int frames);
-  int frames() const { return frames_; }
 
   // η̄ of `image` with present score `eta_now`, from the last L - 1 queries pushed.
   float score(ImageId image, float eta_now) const;
