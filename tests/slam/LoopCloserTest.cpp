@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -205,5 +206,38 @@ TEST(LoopCloser, AppearanceAddsCandidatesWhenThePoseIsTooUncertain) {
     const auto p = plain.candidates(*s.filter, *s.map, n);
     nearestFirst(p);
     EXPECT_EQ(p.size(), 3u);
+  }
+}
+
+// Far from the map (the pose relative to the nearest keyframe uncertain beyond
+// appearance_min_sigma_m) the keyframes nearest the estimate are candidates at every
+// far_every_n_keyframes-th keyframe only, and at every keyframe while a closure waits for its
+// confirmation; the classifier's detections at every keyframe. Near the map, at every keyframe.
+TEST(LoopCloser, FarFromTheMapTheNearestKeyframesAreSearchedAtEveryNthKeyframe) {
+  slam::LoopClosureOptions o;
+  o.appearance_min_sigma_m = 3;
+  o.far_every_n_keyframes = 4;
+  const auto scorer = [](size_t earlier, size_t) { return earlier == 108 ? 2.0 : -1.0; };
+  const auto nearest = [](const std::vector<slam::Candidate>& c) {
+    return std::count_if(c.begin(), c.end(), [](const slam::Candidate& k) { return !k.detection; });
+  };
+  for (const size_t n : {201, 202, 203, 204}) {
+    const bool nth = n % 4 == 0;
+    {  // ~5 m relative to keyframe 100: far.
+      Street s = street(n, 100, 0.5);
+      slam::LoopCloser closer(o);
+      EXPECT_EQ(nearest(closer.candidates(*s.filter, *s.map, n)), nth ? 3 : 0) << n;
+      EXPECT_EQ(nearest(closer.candidates(*s.filter, *s.map, n, true)), 3) << n;  // confirming
+      closer.setScorer(scorer);
+      const auto c = closer.candidates(*s.filter, *s.map, n);
+      EXPECT_EQ(nearest(c), nth ? 3 : 0) << n;
+      ASSERT_FALSE(c.empty()) << n;
+      EXPECT_EQ(c.back().keyframe, 108u);
+      EXPECT_TRUE(c.back().detection.has_value());
+    }
+    {  // ~0.1 m: near the map, every keyframe searches.
+      Street s = street(n, 100, 0.01);
+      EXPECT_EQ(nearest(slam::LoopCloser(o).candidates(*s.filter, *s.map, n)), 3) << n;
+    }
   }
 }

@@ -1,5 +1,6 @@
 #include "urbanslam/alignment/CrfMatch.h"
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -200,23 +201,26 @@ RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, c
     incident[edges[e].b].emplace_back(static_cast<int>(e), 0);  // msg 2e arrives at b
     incident[edges[e].a].emplace_back(static_cast<int>(e), 1);  // msg 2e+1 arrives at a
   }
+  // The dense per-state loops below are written on Eigen arrays, which vectorise them (sums and
+  // divisions included): belief propagation is most of CRF-match's time, and CRF-match most of
+  // a loop closure's.
+  using Arr = Eigen::Map<Eigen::ArrayXd>;
+  using ConstArr = Eigen::Map<const Eigen::ArrayXd>;
   std::vector<double> belief(static_cast<size_t>(N) * S);
   auto computeBeliefs = [&]() {
     for (int i = 0; i < N; ++i) {
-      double* bl = &belief[static_cast<size_t>(i) * S];
-      const double* ph = &phi[static_cast<size_t>(i) * S];
-      for (int j = 0; j < S; ++j) bl[j] = ph[j];
+      Arr bl(&belief[static_cast<size_t>(i) * S], S);
+      bl = ConstArr(&phi[static_cast<size_t>(i) * S], S);
       for (const auto& [e, dir] : incident[i]) {
-        const double* m = &msg[(2 * static_cast<size_t>(e) + dir) * S];
-        double z = 0;
-        for (int j = 0; j < S; ++j) z += (bl[j] *= m[j]);
-        if (z > 0)
-          for (int j = 0; j < S; ++j) bl[j] /= z;  // keep the products in range
+        bl *= ConstArr(&msg[(2 * static_cast<size_t>(e) + dir) * S], S);
+        const double z = bl.sum();
+        if (z > 0) bl *= 1.0 / z;  // keep the products in range
       }
     }
   };
   std::vector<double> h(S), out(S);
   std::vector<double> next(msg.size());
+  Arr hv(h.data(), S), outv(out.data(), S);
   int iter = 0;
   for (iter = 1; iter <= options.bp_iterations; ++iter) {
     computeBeliefs();
@@ -226,17 +230,13 @@ RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, c
       for (int dir = 0; dir < 2; ++dir) {
         // dir 0: from a to b (uses belief of a without the b -> a message); dir 1: b to a.
         const int from = dir == 0 ? t.a : t.b;
-        const double* back = &msg[(2 * e + (dir == 0 ? 1 : 0)) * S];
-        const double* bl = &belief[static_cast<size_t>(from) * S];
-        double hs = 0;
-        for (int j = 0; j < S; ++j) {
-          h[j] = bl[j] / std::max(back[j], 1e-300);
-          hs += h[j];
-        }
+        const ConstArr back(&msg[(2 * e + (dir == 0 ? 1 : 0)) * S], S);
+        hv = ConstArr(&belief[static_cast<size_t>(from) * S], S) / back.max(1e-300);
+        const double hs = hv.sum();
         const double h_states = hs - h[OUT];
         // psi(j,k) = floor + g(j,k) for two reference points (rows j: state of node a,
         // columns k: state of node b), outlier_pair when either side is the outlier state.
-        for (int k = 0; k < M; ++k) out[k] = options.pair_floor * h_states + options.outlier_pair * h[OUT];
+        outv.head(M).setConstant(options.pair_floor * h_states + options.outlier_pair * h[OUT]);
         if (dir == 0) {
           for (int j = 0; j < M; ++j) {
             if (h[j] == 0) continue;
@@ -250,15 +250,11 @@ RegistrationResult crfMatch(const PointSet& reference, const PointSet& moving, c
           }
         }
         out[OUT] = options.outlier_pair * hs;
-        double z = 0;
-        for (int k = 0; k < S; ++k) z += out[k];
-        double* dst = &next[(2 * e + dir) * S];
-        const double* old = &msg[(2 * e + dir) * S];
-        for (int k = 0; k < S; ++k) {
-          const double v = (1.0 - options.bp_damping) * (out[k] / z) + options.bp_damping * old[k];
-          change = std::max(change, std::abs(v - old[k]));
-          dst[k] = v;
-        }
+        const double z = outv.sum();
+        Arr dst(&next[(2 * e + dir) * S], S);
+        const ConstArr old(&msg[(2 * e + dir) * S], S);
+        dst = ((1.0 - options.bp_damping) / z) * outv + options.bp_damping * old;
+        change = std::max(change, (dst - old).abs().maxCoeff());
       }
     }
     msg.swap(next);

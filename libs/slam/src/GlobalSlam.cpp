@@ -188,7 +188,7 @@ void GlobalSlam::closeLoops(size_t current, SteadyTime handed_over) {
   // the estimate is too uncertain the classifier's detections (keyframes with scans only:
   // alignment needs both).
   std::vector<Candidate> cands;
-  if (map_.keyframes()[current].hasScan()) cands = closer_.candidates(*map_.filter(), map_, current);
+  if (map_.keyframes()[current].hasScan()) cands = closer_.candidates(*map_.filter(), map_, current, !pending_.empty());
   std::vector<size_t> keyframes;
   for (const Candidate& c : cands) keyframes.push_back(c.keyframe);
   for (auto* o : observers_) o->onCandidates({current, &keyframes});

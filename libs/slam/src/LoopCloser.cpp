@@ -69,7 +69,7 @@ Eigen::Matrix3d LoopCloser::relativeCovariance(esdf::Esdf& filter, size_t i, siz
   return s;
 }
 
-std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const Map& map, size_t current) {
+std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const Map& map, size_t current, bool confirming) {
   const std::vector<Keyframe>& keyframes = map.keyframes();
   const KeyframeGrid& grid = map.index();
   const auto& cur = keyframes[current];
@@ -99,29 +99,36 @@ std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const Map& map
     const Eigen::Vector2d t = esdf::between(xi, xk).head<2>();
     return t.dot(st.inverse() * t);
   };
+  // Where the map is: the uncertainty of the current pose relative to the nearest earlier
+  // keyframe (its own marginal grows with the distance from the map's origin even where loops
+  // have tied it to the keyframes around). Beyond appearance_min_sigma_m, more than alignment
+  // from the estimate's guess reaches, the nearest keyframes are as likely wrong as any within
+  // reach.
+  const bool far = !initial.empty() &&
+                   largestPositionSigma(relativeCovariance(filter, initial.front().second, current)) > options_.appearance_min_sigma_m;
   // The keyframes nearest the estimate, nearest in Mahalanobis distance first (the 30 nearest
-  // tested: bounded covariance work per keyframe).
+  // tested: bounded covariance work per keyframe). Far from the map they are searched at every
+  // n-th keyframe only: the next keyframe's nearest are the same wrong guesses shifted by a
+  // keyframe, and CRF-match + ICP on each costs several milliseconds (in the 1 km² city, 7 of
+  // the 1616 searches with a relative sigma beyond 3 m found a closure). While a hypothesis
+  // waits for its confirmation every keyframe searches.
   constexpr size_t kMahalanobisTests = 30;
   std::vector<std::pair<double, size_t>> near_set;
-  for (size_t n = 0; n < initial.size() && n < kMahalanobisTests; ++n)
+  const bool search_near = !far || confirming || current % static_cast<size_t>(options_.far_every_n_keyframes) == 0;
+  for (size_t n = 0; search_near && n < initial.size() && n < kMahalanobisTests; ++n)
     if (const double d2 = mahalanobis2(initial[n].second); d2 <= chi2_2dof_) near_set.emplace_back(d2, initial[n].second);
   std::sort(near_set.begin(), near_set.end());
   const size_t per_source = static_cast<size_t>(options_.max_candidates);
   std::vector<Candidate> out;
   for (size_t n = 0; n < near_set.size() && n < per_source; ++n) out.push_back({near_set[n].second, std::nullopt});
-  // Where the map is: the uncertainty of the current pose relative to the nearest earlier
-  // keyframe (its own marginal grows with the distance from the map's origin even where loops
-  // have tied it to the keyframes around). Beyond appearance_min_sigma_m, more than alignment
-  // from the estimate's guess reaches, the nearest keyframes are as likely wrong as any within
-  // reach: the classifier's detections among all of them follow, best first and one per place,
-  // so that an aliased place cannot take every slot.
-  if (!scorer_ || initial.empty() || !cur.hasScan()) return out;
-  // (The nearest keyframe's relative covariance is the one its Mahalanobis test computed.)
-  if (largestPositionSigma(relativeCovariance(filter, initial.front().second, current)) <= options_.appearance_min_sigma_m) return out;
+  // There the classifier's detections among all of them follow, best first and one per place, so
+  // that an aliased place cannot take every slot.
+  if (!scorer_ || !far || !cur.hasScan()) return out;
   std::vector<std::pair<double, size_t>> scored;
   for (const auto& [d, i] : initial)
     if (const double score = scorer_(i, current); score >= options_.laser_threshold) scored.emplace_back(score, i);
-  std::sort(scored.begin(), scored.end(), [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second < b.second); });
+  std::sort(scored.begin(), scored.end(),
+            [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second < b.second); });
   const size_t first_detection = out.size();
   for (const auto& [score, detected] : scored) {
     if (out.size() - first_detection == per_source) break;
@@ -140,15 +147,15 @@ std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const Map& map
 // axis by ambiguity_offset_m, then twice, four and eight times that, as far as the innovation
 // gate could admit such a shift (3 sigma of the relative position): if one converges elsewhere
 // and matches clearly more points, the alignment is not the best explanation of the two scans.
-bool LoopCloser::ambiguous(esdf::Esdf& filter, const io::LaserScan& earlier_scan, const io::LaserScan& current_scan, size_t earlier,
-                           size_t current, const alignment::AlignmentResult& a, alignment::AlignerOptions ao) {
+bool LoopCloser::ambiguous(esdf::Esdf& filter, const alignment::IndexedReference& earlier_points, const alignment::PointSet& current_points,
+                           size_t earlier, size_t current, const alignment::AlignmentResult& a, alignment::AlignerOptions ao) {
   const double reach = 3 * largestPositionSigma(relativeCovariance(filter, earlier, current));
   ao.method = alignment::Method::PlIcp;
   const auto& t = a.transform;
   for (double d = options_.ambiguity_offset_m; d <= 8 * options_.ambiguity_offset_m && 0.5 * d <= reach; d *= 2) {
     for (const common::Pose2& g : {common::Pose2{t.x + d, t.y, t.phi}, common::Pose2{t.x - d, t.y, t.phi},
                                    common::Pose2{t.x, t.y + d, t.phi}, common::Pose2{t.x, t.y - d, t.phi}}) {
-      const auto b = alignment::align(earlier_scan, current_scan, g, ao);
+      const auto b = alignment::alignPointSets(earlier_points, current_points, g, ao);
       if (!b.converged || b.rms_residual_m > options_.max_rms_m) continue;
       const common::Pose2 e = common::between(t, b.transform);
       if (std::hypot(e.x, e.y) < 0.25 * options_.ambiguity_offset_m) continue;  // back to the same minimum
@@ -158,8 +165,8 @@ bool LoopCloser::ambiguous(esdf::Esdf& filter, const io::LaserScan& earlier_scan
   return false;
 }
 
-LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current,
-                                       bool commit, const Detection* detection) {
+LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current, bool commit,
+                                       const Detection* detection) {
   const std::vector<Keyframe>& keyframes = map.keyframes();
   LoopClosureRecord r;
   r.from = earlier;
@@ -194,10 +201,13 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_
   };
   // (Trying PL-ICP first on an uncertain guess was measured worse: it lands in wrong local
   // minima that pass the residual test — ATE 2.96 m vs 0.26 m on Intel.)
-  // The map keeps its scans compact (and maybe on disk): expanded once for this candidate's
-  // alignments.
+  // The map keeps its scans compact (and maybe on disk): expanded once for this candidate, and
+  // its point sets, kd-tree and line normals built once for every alignment below (the
+  // ambiguity test restarts PL-ICP up to 16 times).
   const io::LaserScan earlier_scan = map.scan(earlier), current_scan = map.scan(current);
-  const alignment::AlignmentResult a = alignment::align(earlier_scan, current_scan, guess, ao);
+  const alignment::IndexedReference earlier_points(alignment::pointSetFromScan(earlier_scan, ao.scan, ao.in_vehicle_frame));
+  const alignment::PointSet current_points = alignment::pointSetFromScan(current_scan, ao.scan, ao.in_vehicle_frame);
+  const alignment::AlignmentResult a = alignment::alignPointSets(earlier_points, current_points, guess, ao);
   r.measurement = a.transform;
   r.rms_m = a.rms_residual_m;
   const double matched = a.matchedFraction();
@@ -206,7 +216,7 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_
     r.reason = ClosureReason::Alignment;
     return r;
   }
-  if (options_.ambiguity_offset_m > 0 && ambiguous(filter, earlier_scan, current_scan, earlier, current, a, ao)) {
+  if (options_.ambiguity_offset_m > 0 && ambiguous(filter, earlier_points, current_points, earlier, current, a, ao)) {
     r.reason = ClosureReason::Ambiguous;
     return r;
   }
@@ -234,9 +244,8 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_
   return r;
 }
 
-LoopClosureRecord LoopCloser::tryCloseMeasured(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current,
-                                               const esdf::Vec3& z, const Eigen::Matrix3d& information, bool commit,
-                                               const Detection& detection) {
+LoopClosureRecord LoopCloser::tryCloseMeasured(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current, const esdf::Vec3& z,
+                                               const Eigen::Matrix3d& information, bool commit, const Detection& detection) {
   const std::vector<Keyframe>& keyframes = map.keyframes();
   LoopClosureRecord r;
   r.from = earlier;

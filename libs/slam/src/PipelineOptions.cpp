@@ -69,13 +69,16 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
 
   s.section("loop_closure", "Global SLAM: loop-closure candidates, detection, alignment, gating");
   s.add("enabled", o.loop_closure.enabled, "search for loop closures");
-  s.add<LoopClosureOptions::Detector>("detector", o.loop_closure.detector,
-                                      {{"none", LoopClosureOptions::Detector::None}, {"laser", LoopClosureOptions::Detector::Laser}},
-                                      "where the pose is too uncertain to pick the candidates (appearance_min_sigma_m); none: the nearest to the estimate only; laser: the AdaBoost classifier's detections among every keyframe within reach as well");
+  s.add<LoopClosureOptions::Detector>(
+      "detector", o.loop_closure.detector, {{"none", LoopClosureOptions::Detector::None}, {"laser", LoopClosureOptions::Detector::Laser}},
+      "where the pose is too uncertain to pick the candidates (appearance_min_sigma_m); none: the nearest to the estimate only; laser: the "
+      "AdaBoost classifier's detections among every keyframe within reach as well");
   s.add("laser_model", o.loop_closure.laser_model, {}, "laser classifier model; empty: share/laser_loop/default.model");
   s.add("appearance_min_sigma_m", o.loop_closure.appearance_min_sigma_m, 0.0, 1000.0, "m",
-        "detector = laser: the classifier adds candidates once the pose relative to the nearest keyframe is this uncertain (1 sigma; from the estimate's guess, alignment reaches a few metres)");
-  s.add("laser_threshold", o.loop_closure.laser_threshold, -100.0, 100.0, "", "classifier decision offset (higher: fewer false alarms): a keyframe scoring below is not a candidate");
+        "detector = laser: the classifier adds candidates once the pose relative to the nearest keyframe is this uncertain (1 sigma; from "
+        "the estimate's guess, alignment reaches a few metres)");
+  s.add("laser_threshold", o.loop_closure.laser_threshold, -100.0, 100.0, "",
+        "classifier decision offset (higher: fewer false alarms): a keyframe scoring below is not a candidate");
   s.add<LoopClosureOptions::ImageDetector>(
       "image_detector", o.loop_closure.image_detector,
       {{"none", LoopClosureOptions::ImageDetector::None}, {"tree_of_words", LoopClosureOptions::ImageDetector::TreeOfWords}},
@@ -89,6 +92,9 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
         "final candidate set: chi2 (2 dof) probability");
   s.add("max_candidates", o.loop_closure.max_candidates, 1, 1000, "", "candidates aligned per keyframe");
   s.add("every_n_keyframes", o.loop_closure.every_n_keyframes, 1, 1000, "keyframes", "search at every n-th keyframe");
+  s.add("far_every_n_keyframes", o.loop_closure.far_every_n_keyframes, 1, 1000, "keyframes",
+        "beyond appearance_min_sigma_m, the keyframes nearest the estimate are candidates at every n-th keyframe only (as likely wrong at "
+        "the next keyframe; detections are searched at every one)");
   s.add<LoopClosureOptions::Method>(
       "method", o.loop_closure.method,
       {{"auto", LoopClosureOptions::Method::Auto},
@@ -142,7 +148,8 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("grid_tile_cells", o.map.grid_tile_cells, 100, 10000, "cells", "side of a tile of grid_tiles/");
   s.add("point_decimation", o.map.point_decimation, 1, 1000, "", "keep every n-th point in the point clouds");
   s.add("scan_cache_mb", o.map.scan_cache_mb, 0, 1e6, "MB", "keyframe scans held in memory at most; the rest wait in a spill file");
-  s.add("scan_spill_dir", o.map.scan_spill_dir, {}, "folder of the spill file (deleted with the run); empty: the system's temporary folder");
+  s.add("scan_spill_dir", o.map.scan_spill_dir, {},
+        "folder of the spill file (deleted with the run); empty: the system's temporary folder");
 
   s.section("output", "Which files a run writes besides the trajectory, stats.json and config.ini");
   s.add("write_ply_binary", o.output.write_ply_binary, "map.ply (binary little-endian PLY)");

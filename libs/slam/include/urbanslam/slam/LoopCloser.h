@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "urbanslam/alignment/Aligner.h"
+#include "urbanslam/alignment/IndexedReference.h"
 #include "urbanslam/common/BinaryStream.h"
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/io/LaserScan.h"
@@ -78,20 +79,23 @@ class LoopCloser {
   // With a scorer, appearance adds candidates when the estimate is too uncertain to pick them.
   void setScorer(CandidateScorer scorer);
 
-  // The final candidate set for keyframe `current` of `map` (its spatial index and estimates). First the max_candidates keyframes nearest the estimate (Mahalanobis). When the
-  // pose relative to the nearest keyframe is uncertain beyond appearance_min_sigma_m, many
-  // keyframes lie within reach and the nearest ones are as likely wrong as any: with a scorer,
-  // up to max_candidates of the classifier's detections follow, best first and one per place
-  // (search_radius_m apart).
-  std::vector<Candidate> candidates(esdf::Esdf& filter, const Map& map, size_t current);
+  // The final candidate set for keyframe `current` of `map` (its spatial index and estimates).
+  // First the max_candidates keyframes nearest the estimate (Mahalanobis). When the pose relative
+  // to the nearest keyframe is uncertain beyond appearance_min_sigma_m, many keyframes lie within
+  // reach and the nearest ones are as likely wrong as any: they are searched at every
+  // far_every_n_keyframes-th keyframe only, and with a scorer up to max_candidates of the
+  // classifier's detections follow, best first and one per place (search_radius_m apart).
+  // `confirming`: a closure hypothesis waits for its confirmation, which only the next
+  // keyframes' searches can bring, so they search at every keyframe.
+  std::vector<Candidate> candidates(esdf::Esdf& filter, const Map& map, size_t current, bool confirming = false);
   // Alignment and gating of one candidate. With `commit`, a closure that passes is
   // added to the filter; without, it is only tested (accepted = passed) for later confirmation.
   LoopClosureRecord tryClose(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current, bool commit = true,
                              const Detection* detection = nullptr);
   // Gating (and with `commit` the update) of a relative-pose factor measured by another sensor
   // (the camera: CameraClosure.h) in place of a scan alignment.
-  LoopClosureRecord tryCloseMeasured(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current,
-                                     const esdf::Vec3& z, const Eigen::Matrix3d& information, bool commit, const Detection& detection);
+  LoopClosureRecord tryCloseMeasured(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current, const esdf::Vec3& z,
+                                     const Eigen::Matrix3d& information, bool commit, const Detection& detection);
 
   // The relative covariances kept for the current keyframe (a later image proposal for it
   // reuses them). The scorer is code: whoever set it sets it again.
@@ -100,8 +104,8 @@ class LoopCloser {
 
  private:
   Eigen::Matrix3d relativeCovariance(esdf::Esdf& filter, size_t i, size_t k);
-  bool ambiguous(esdf::Esdf& filter, const io::LaserScan& earlier_scan, const io::LaserScan& current_scan, size_t earlier, size_t current,
-                 const alignment::AlignmentResult& a, alignment::AlignerOptions ao);
+  bool ambiguous(esdf::Esdf& filter, const alignment::IndexedReference& earlier_points, const alignment::PointSet& current_points,
+                 size_t earlier, size_t current, const alignment::AlignmentResult& a, alignment::AlignerOptions ao);
 
   LoopClosureOptions options_;
   CandidateScorer scorer_;

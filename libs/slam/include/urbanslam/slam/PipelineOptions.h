@@ -74,9 +74,9 @@ struct LoopClosureOptions {
   // Candidates besides the nearest to the estimate where the pose is too uncertain to pick them
   // (appearance_min_sigma_m): none, or laser (the AdaBoost classifier's detections).
   enum class Detector { None, Laser } detector = Detector::None;
-  std::string laser_model;       // classifier model file; empty = share/laser_loop/default.model
+  std::string laser_model;              // classifier model file; empty = share/laser_loop/default.model
   double appearance_min_sigma_m = 3.0;  // detector = laser: the classifier adds candidates beyond this pose uncertainty
-  double laser_threshold = 0.0;  // strong-classifier margin offset (higher: fewer false alarms)
+  double laser_threshold = 0.0;         // strong-classifier margin offset (higher: fewer false alarms)
   // Image proposals (Tree of Words, [image_loop]) go through the same alignment, gating and
   // confirmation as the laser candidates; without scans they are only recorded.
   enum class ImageDetector { None, TreeOfWords } image_detector = ImageDetector::TreeOfWords;
@@ -86,6 +86,10 @@ struct LoopClosureOptions {
   double mahalanobis_probability = 0.99;  // final set: chi2 (2 dof) gate on the relative position
   int max_candidates = 3;                 // aligned per keyframe, nearest (Mahalanobis) first
   int every_n_keyframes = 1;              // search at every n-th keyframe
+  // Where the pose relative to the nearest keyframe is uncertain beyond appearance_min_sigma_m,
+  // the keyframes nearest the estimate are searched at every n-th keyframe only (detections still
+  // at every one): from one keyframe to the next they are the same guesses about as wrong.
+  int far_every_n_keyframes = 4;
   // Alignment of a candidate pair: auto (PL-ICP when the relative pose is well known, else
   // CRF-match + ICP) or one of the aligner's methods.
   enum class Method { Auto, Icp, PlIcp, Crf, CrfIcp } method = Method::Auto;
