@@ -61,7 +61,7 @@ void expectSamePoses(const std::vector<io::StampedPose>& a, const std::vector<io
 
 void expectResumeEqualsWholeRun(const Case& c) {
   slam::PipelineOptions o = slam::loadPipelineOptions(c.ini.empty() ? "" : test::repoPath(c.ini));
-  if (c.laser_classifier) o.loop_closure.detector = slam::LoopClosureOptions::Detector::Laser;
+  o.loop_closure.detector = c.laser_classifier ? slam::LoopClosureOptions::Detector::Laser : slam::LoopClosureOptions::Detector::None;
   slam::resolveDefaultPaths(o, URBANSLAM_SOURCE_DIR);
   std::string whole_map, resumed_map;
   const auto whole = runWhole(c, o, &whole_map);

@@ -73,7 +73,7 @@ struct LoopClosureOptions {
   bool enabled = true;
   // Candidates besides the nearest to the estimate where the pose is too uncertain to pick them
   // (appearance_min_sigma_m): none, or laser (the AdaBoost classifier's detections).
-  enum class Detector { None, Laser } detector = Detector::None;
+  enum class Detector { None, Laser } detector = Detector::Laser;
   std::string laser_model;              // classifier model file; empty = share/laser_loop/default.model
   double appearance_min_sigma_m = 3.0;  // detector = laser: the classifier adds candidates beyond this pose uncertainty
   double laser_threshold = 0.0;         // strong-classifier margin offset (higher: fewer false alarms)
