@@ -1,0 +1,76 @@
+// Global SLAM's candidate schedule far from the map, through GlobalSlam itself: the pose-gated
+// candidates are searched at every far_every_n_keyframes-th keyframe only, except while a closure
+// hypothesis waits for its confirmation, which only the next keyframes' searches can bring.
+#include <gtest/gtest.h>
+
+#include <map>
+#include <memory>
+#include <vector>
+
+#include "ConstantScan.h"
+#include "urbanslam/esdf/Esdf.h"
+#include "urbanslam/slam/GlobalSlam.h"
+#include "urbanslam/slam/Map.h"
+#include "urbanslam/slam/Observer.h"
+#include "urbanslam/slam/PipelineOptions.h"
+
+using namespace urbanslam;
+
+namespace {
+
+struct CandidateLog : slam::PipelineObserver {
+  std::map<size_t, std::vector<size_t>> by_keyframe;  // the candidates of each search
+  void onCandidates(const slam::CandidatesEvent& e) override { by_keyframe[e.keyframe] = *e.candidates; }
+};
+
+struct Run {
+  slam::PipelineOptions options;
+  slam::PipelineStats stats;
+  CandidateLog log;
+  std::vector<slam::PipelineObserver*> observers{&log};
+  slam::Map map{std::make_unique<esdf::Esdf>(), 2.0};
+  std::unique_ptr<slam::GlobalSlam> global;
+};
+
+// Keyframes 0-199 one metre apart along x, each odometry link 0.5 m uncertain; keyframe 200 back
+// at x = 100 (5 m uncertain relative to keyframe 100: far from the map) and on from there.
+// `late_range_m`: the range of the scans from keyframe 200 on (the earlier ones see 10 m).
+std::unique_ptr<Run> drive(double late_range_m) {
+  auto r = std::make_unique<Run>();
+  r->options.loop_closure.detector = slam::LoopClosureOptions::Detector::None;
+  r->options.loop_closure.appearance_min_sigma_m = 3;
+  r->options.loop_closure.far_every_n_keyframes = 4;
+  r->global = std::make_unique<slam::GlobalSlam>(r->options, r->map, r->stats, r->observers);
+  slam::KeyframeConstraint c;
+  c.cov = Eigen::Vector3d(0.25, 0.25, 1e-6).asDiagonal();
+  for (size_t k = 0; k <= 203; ++k) {
+    const double x = k < 200 ? static_cast<double>(k) : 100.0 + static_cast<double>(k - 200);
+    c.z = {k == 200 ? x - 199.0 : 1.0, 0, 0};
+    const float range = static_cast<float>(k < 200 ? 10.0 : late_range_m);
+    r->global->addKeyframe({k, static_cast<double>(k), {}, true, false, {}}, io::CompactScan(test::constantScan(k, range, 80)), c);
+    if (k >= 200) r->global->closeLoops(k, std::chrono::steady_clock::now());
+  }
+  return r;
+}
+
+}  // namespace
+
+TEST(GlobalSlam, AClosureAwaitingConfirmationMakesTheNextKeyframesSearchFarFromTheMap) {
+  // The same scans before and after: keyframe 200 (a 4th) aligns with its nearest keyframes and
+  // waits for a confirmation; keyframe 201 searches too, confirms it, and the closure is in.
+  const auto same = drive(10.0);
+  const auto& seen = same->log.by_keyframe;
+  ASSERT_TRUE(seen.count(200) && seen.count(201));
+  EXPECT_FALSE(seen.at(200).empty());
+  EXPECT_FALSE(seen.at(201).empty());
+  EXPECT_GE(same->stats.closures_accepted, 2u);
+
+  // Scans that cannot align: no hypothesis waits after keyframe 200, so keyframes 201-203 (not
+  // 4ths) search no keyframe near the estimate.
+  const auto other = drive(3.0);
+  const auto& none = other->log.by_keyframe;
+  ASSERT_TRUE(none.count(200));
+  EXPECT_FALSE(none.at(200).empty());
+  for (size_t k : {201, 202, 203}) EXPECT_TRUE(!none.count(k) || none.at(k).empty()) << k;
+  EXPECT_EQ(other->stats.closures_accepted, 0u);
+}
