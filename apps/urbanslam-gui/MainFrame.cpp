@@ -211,9 +211,11 @@ void MainFrame::buildMenus() {
   Bind(
       wxEVT_MENU,
       [this](wxCommandEvent&) {
-        wxFileDialog map(this, "Open map", "", "map.usmap", "urbanslam maps (*.usmap)|*.usmap|All files|*", wxFD_OPEN | wxFD_FILE_MUST_EXIST);
+        wxFileDialog map(this, "Open map", "", "map.usmap", "urbanslam maps (*.usmap)|*.usmap|All files|*",
+                         wxFD_OPEN | wxFD_FILE_MUST_EXIST);
         if (map.ShowModal() != wxID_OK) return;
-        wxFileDialog log(this, "Log to localize", "", "", "Logs (*.rawlog;*.log;*.gz;*.clf;*.zip)|*.rawlog;*.log;*.gz;*.clf;*.zip|All files|*",
+        wxFileDialog log(this, "Log to localize", "", "",
+                         "Logs (*.rawlog;*.log;*.gz;*.clf;*.zip)|*.rawlog;*.log;*.gz;*.clf;*.zip|All files|*",
                          wxFD_OPEN | wxFD_FILE_MUST_EXIST);
         if (log.ShowModal() == wxID_OK) localizeLog(map.GetPath().ToStdString(), log.GetPath().ToStdString());
       },
@@ -381,7 +383,8 @@ void MainFrame::buildMenus() {
         const std::string dir = dlg.GetPath().ToStdString();
         try {
           worker_->withPipeline([&](const slam::Pipeline& p) {
-            slam::writeRunOutputs(p, dir, {worker_->logPath(), worker_->inputFormat(), worker_->iniPath(), worker_->resolvedIni(), {}, {}});
+            slam::writeRunOutputs(p, dir,
+                                  {worker_->logPath(), worker_->inputFormat(), worker_->iniPath(), worker_->resolvedIni(), {}, {}, {}});
           });
           SetStatusText("exported to " + dir, 0);
         } catch (const std::exception& e) {
@@ -531,11 +534,11 @@ void MainFrame::refreshView(bool force) {
     notebook_->SetSelection(2);
   }
   if (last_snapshot_.localizing)
-    SetStatusText(wxString::Format("localizing in %zu keyframes: %zu scans, %zu lost, %zu relocalisations, %.0f %%%s",
-                                   last_snapshot_.keyframes.size(), last_snapshot_.stats.scans, last_snapshot_.lost_scans,
-                                   last_snapshot_.relocalisations, 100 * last_snapshot_.stats.progress,
-                                   last_snapshot_.finished ? " - finished" : ""),
-                  0);
+    SetStatusText(
+        wxString::Format("localizing in %zu keyframes: %zu scans, %zu lost, %zu relocalisations, %.0f %%%s",
+                         last_snapshot_.keyframes.size(), last_snapshot_.stats.scans, last_snapshot_.lost_scans,
+                         last_snapshot_.relocalisations, 100 * last_snapshot_.stats.progress, last_snapshot_.finished ? " - finished" : ""),
+        0);
   else
     SetStatusText(wxString::Format("%zu keyframes, %.0f %%%s", last_snapshot_.stats.keyframes, 100 * last_snapshot_.stats.progress,
                                    last_snapshot_.finished ? " - finished" : ""),

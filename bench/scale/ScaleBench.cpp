@@ -89,7 +89,8 @@ int main(int argc, char** argv) {
     pipeline.run(*source);
     const double cpu_s = cpuSeconds() - cpu0;
     std::filesystem::create_directories(out);
-    const common::Json stats = slam::writeRunOutputs(pipeline, out, {city.empty() ? log : city, source->format(), ini, resolved, {}, {}});
+    const common::Json stats =
+        slam::writeRunOutputs(pipeline, out, {city.empty() ? log : city, source->format(), ini, resolved, {}, {}, {}});
 
     std::ofstream csv(out + "/steps.csv");
     csv << "keyframes,step_ms\n";

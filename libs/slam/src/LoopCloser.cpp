@@ -7,6 +7,7 @@
 
 #include "urbanslam/alignment/Aligner.h"
 #include "urbanslam/alignment/FreeSpace.h"
+#include "urbanslam/alignment/IndexedReference.h"
 #include "urbanslam/esdf/Gating.h"
 #include "urbanslam/esdf/PoseOps.h"
 #include "urbanslam/slam/Map.h"

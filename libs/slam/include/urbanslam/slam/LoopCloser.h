@@ -12,12 +12,15 @@
 #include <vector>
 
 #include "urbanslam/alignment/Aligner.h"
-#include "urbanslam/alignment/IndexedReference.h"
 #include "urbanslam/common/BinaryStream.h"
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/io/LaserScan.h"
 #include "urbanslam/slam/KeyframeGrid.h"
 #include "urbanslam/slam/PipelineOptions.h"
+
+namespace urbanslam::alignment {
+class IndexedReference;
+}  // namespace urbanslam::alignment
 
 namespace urbanslam::slam {
 
