@@ -22,6 +22,9 @@ void PacedRunner::play() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     running_ = true;
+    // Play overrides a pending single step: otherwise a play arriving while that step runs is
+    // undone when the step reports its unit done, and the runner pauses for good.
+    unit_request_ = false;
   }
   wake_.notify_all();
 }
