@@ -384,7 +384,7 @@ void MainFrame::buildMenus() {
         try {
           worker_->withPipeline([&](const slam::Pipeline& p) {
             slam::writeRunOutputs(p, dir,
-                                  {worker_->logPath(), worker_->inputFormat(), worker_->iniPath(), worker_->resolvedIni(), {}, {}, {}});
+                                  {worker_->logPath(), worker_->inputFormat(), worker_->iniPath(), worker_->resolvedIni(), {}, {}, {}, {}});
           });
           SetStatusText("exported to " + dir, 0);
         } catch (const std::exception& e) {

@@ -36,7 +36,8 @@ int localizeCommand(const Argv& args) {
                "folder), which is not changed: every scan is predicted by the odometry and matched against the\n"
                "map's scans near that pose. Without --initial, and whenever the matches stop supporting the pose\n"
                "(lost), the map is searched for the scan's place until one place clearly wins: the whole map,\n"
-               "or, once matches have confirmed the pose, only where the odometry from it can have gone.");
+               "or, once matches have confirmed the pose, only where the odometry from it can have gone.\n"
+               "A map file that holds separate maps (`merge`): the vehicle is localized in the first.");
   ap.addPositional("LOG", "the log to localize (any format `run` reads)");
   ap.addOption("map", "MAP", "the map: a map.usmap file or the run folder holding one (required)");
   ap.addOption("initial", "x,y,phi", "the vehicle's pose at the first scan in the map frame (m, m, rad); default: searched");
@@ -83,8 +84,8 @@ int localizeCommand(const Argv& args) {
   if (ap.flag("json")) std::cout << stats.dump() << "\n";
   if (!quiet) {
     const auto& s = localizer.stats();
-    std::cerr << "urbanslam localize: " << s.scans_used << " scans, " << s.tracking << " tracked, " << s.lost << " lost ("
-              << s.lost_s << " s), " << s.relocalisations << " relocalisations in " << info.wall_s << " s ("
+    std::cerr << "urbanslam localize: " << s.scans_used << " scans, " << s.tracking << " tracked, " << s.lost << " lost (" << s.lost_s
+              << " s), " << s.relocalisations << " relocalisations in " << info.wall_s << " s ("
               << stats.at("timing").at("real_time_factor").asNumber() << "x real time)\n"
               << "outputs in " << std::filesystem::absolute(out).string() << "/ (trajectory_scans.tum, localization.csv, stats.json)\n";
   }

@@ -1,7 +1,8 @@
 // map.usmap (slam/MapFile.h). A mutation almost always breaks the payload's length or checksum,
 // so the input is loaded twice: as it is, and with the header's length and checksum made right,
 // which lets the fuzzer reach the sections behind them. A map that loads must encode again, and
-// that encoding must load.
+// that encoding must load. The file's separate maps are read too.
+#include <memory>
 #include <vector>
 
 #include "FuzzSupport.h"
@@ -15,10 +16,13 @@ constexpr size_t kHeaderBytes = 28;  // signature 8, version 4, payload length 8
 void load(const std::string& path) {
   using namespace urbanslam;
   fuzz::expectCleanOutcome(path, [&] {
-    const auto pipeline = slam::loadMap(path);
-    const std::string again = fuzz::writeInput("again.usmap", slam::encodeMap(*pipeline));
+    std::vector<std::unique_ptr<slam::Pipeline>> separate;
+    const auto pipeline = slam::loadMap(path, nullptr, &separate);
+    std::vector<const slam::Pipeline*> others;
+    for (const auto& p : separate) others.push_back(p.get());
+    const std::string again = fuzz::writeInput("again.usmap", slam::encodeMap(*pipeline, others));
     try {
-      slam::loadMap(again);
+      slam::loadMap(again, nullptr, &separate);
     } catch (const common::InputError& e) {
       fuzz::fail("a loaded map does not load again once encoded", e.what());
     }

@@ -1,6 +1,6 @@
 // `urbanslam merge` and `urbanslam run --map`: the two halves of a log, each mapped in its own
-// frame, joined into one map; a map of another building is not joined; bad input is one line
-// and exit 2.
+// frame, joined into one map; a map of another building is not joined but kept as a separate
+// map; bad input is one line and exit 2.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -69,16 +69,29 @@ TEST(MergeCommand, JoinsTheMapsOfTwoHalvesOfALog) {
   EXPECT_EQ(loc.code, 0) << loc.err;
   EXPECT_GT(jsonNumber(loc.out, "tracking"), 40);
 
-  // A map of another building is not found in it: exit 1, its reason, nothing written.
+  // A map of another building is not found in it: it stays a separate map in the merged file,
+  // and the outputs are the first map's.
   ASSERT_EQ(runCli("run --quiet --out " + (dir / "intel").string() + " --ini " + repoPath("ini/fr079.ini") + " " +
                    repoPath("rawlogs/intel-corrected-excerpt.log.gz"))
                 .code,
             0);
   const CliResult other =
-      runCli("merge --quiet " + (dir / "a").string() + " " + (dir / "intel").string() + " --out " + (dir / "x").string());
-  EXPECT_EQ(other.code, 1) << other.err;
-  EXPECT_NE(other.err.find("was not found"), std::string::npos) << other.err;
-  EXPECT_FALSE(fs::exists(dir / "x"));
+      runCli("merge --json " + (dir / "a").string() + " " + (dir / "intel").string() + " --out " + (dir / "x").string());
+  ASSERT_EQ(other.code, 0) << other.err;
+  EXPECT_NE(other.err.find("was not found in the other maps: kept as separate map 1"), std::string::npos) << other.err;
+  EXPECT_NE(other.out.find("\"separate_map\":1"), std::string::npos) << other.out;
+  EXPECT_NE(other.out.find("\"separate_maps\":[{\"keyframes\":"), std::string::npos) << other.out;
+  // A log mapped into a map it is not found in: its own map comes first (a resumed run continues
+  // it), the map it was not found in is kept as a separate one.
+  const CliResult unjoined = runCli("run --json --map " + (dir / "intel").string() + " --out " + (dir / "u").string() + " " + few);
+  ASSERT_EQ(unjoined.code, 0) << unjoined.err;
+  EXPECT_NE(unjoined.err.find("its map is its own"), std::string::npos) << unjoined.err;
+  EXPECT_NE(unjoined.out.find("\"separate_maps\":[{\"keyframes\":"), std::string::npos) << unjoined.out;
+  EXPECT_NE(unjoined.out.find("\"sessions\":[\"" + (dir / "intel").string()), std::string::npos) << unjoined.out;
+  // Resumed, the separate map is carried along.
+  const CliResult resumed = runCli("run --quiet --json --resume " + (dir / "x").string() + " --out " + (dir / "xr").string() + " " + few);
+  ASSERT_EQ(resumed.code, 0) << resumed.err;
+  EXPECT_NE(resumed.out.find("\"separate_maps\":[{\"keyframes\":"), std::string::npos) << resumed.out;
 }
 
 TEST(MergeCommand, BadInputIsOneLineAndExitTwo) {

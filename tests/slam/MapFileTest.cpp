@@ -4,7 +4,10 @@
 
 #include <fstream>
 #include <iterator>
+#include <memory>
+#include <vector>
 
+#include "MapFileSections.h"
 #include "TestPaths.h"
 #include "urbanslam/common/BinaryStream.h"
 #include "urbanslam/common/Error.h"
@@ -168,4 +171,27 @@ TEST(MapFile, MapWithAnImageDatabaseIsRefused) {
   ASSERT_GT(p.keyframes().size(), 0u);
   const std::string e = loadError("images", slam::encodeMap(p));
   EXPECT_NE(e.find("image_detector = tree_of_words"), std::string::npos) << e;
+}
+
+// A file of the format before separate maps (version 3, written by that version: the fuzzing
+// seed) is read as a map without any; written again, every section is as it was (the options
+// aside: they list the keys added since) and the empty separate-maps section follows.
+TEST(MapFile, AVersion3FileIsReadAsAMapWithoutSeparateMaps) {
+  const std::string path = test::repoPath("fuzz/corpus/map_file/three-scans-24-beams.usmap");
+  const std::string old = readBytes(path);
+  ASSERT_EQ(old[8], 3);
+  std::vector<std::unique_ptr<slam::Pipeline>> separate(1);
+  const auto loaded = slam::loadMap(path, nullptr, &separate);
+  EXPECT_TRUE(separate.empty());
+  EXPECT_GT(loaded->keyframes().size(), 0u);
+  const std::string now = slam::encodeMap(*loaded);
+  EXPECT_EQ(now[8], static_cast<char>(slam::kMapFormatVersion));
+  const auto a = test::mapFileSections(old), b = test::mapFileSections(now);
+  EXPECT_EQ(a.size(), 7u);
+  for (const char* tag : {"STAT", "MAP ", "ESDF", "LOCL", "GLOB", "IMGS"}) {
+    ASSERT_TRUE(a.count(tag) && b.count(tag)) << tag;
+    EXPECT_TRUE(a.at(tag) == b.at(tag)) << "section " << tag << " differs";
+  }
+  ASSERT_TRUE(b.count("SEPM"));
+  EXPECT_EQ(b.at("SEPM"), std::string(8, '\0'));  // a count of 0
 }

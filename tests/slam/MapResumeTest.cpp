@@ -104,8 +104,8 @@ void expectResumeEqualsWholeRun(const Case& c) {
   // map, the filter (down to its last factorisation), local and global SLAM. Only the statistics
   // differ (they hold processing times).
   const auto a = test::mapFileSections(whole_map), b = test::mapFileSections(resumed_map);
-  EXPECT_EQ(a.size(), 7u);
-  for (const char* tag : {"OPTS", "MAP ", "ESDF", "LOCL", "GLOB", "IMGS"}) {
+  EXPECT_EQ(a.size(), 8u);
+  for (const char* tag : {"OPTS", "MAP ", "ESDF", "LOCL", "GLOB", "IMGS", "SEPM"}) {
     ASSERT_TRUE(a.count(tag) && b.count(tag)) << tag;
     EXPECT_TRUE(a.at(tag) == b.at(tag)) << "section " << tag << " differs";
   }

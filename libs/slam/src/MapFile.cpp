@@ -22,6 +22,7 @@ constexpr char kMagic[8] = {'U', 'S', 'M', 'A', 'P', '\r', '\n', '\x1a'};
 constexpr size_t kHeaderBytes = 8 + 4 + 8 + 8;  // magic, version, payload length, checksum
 constexpr size_t kLengthOffset = 8 + 4;         // where the payload length and checksum go
 constexpr std::uint32_t kOptionsTag = common::sectionTag("OPTS");
+constexpr std::uint32_t kSeparateTag = common::sectionTag("SEPM");
 
 // Sections whose keys only change what is written, not what is computed.
 bool outputOnly(const std::string& section) { return section == "map" || section == "output"; }
@@ -60,7 +61,7 @@ std::uint64_t readU64(const std::string& bytes, size_t at) {
 
 }  // namespace
 
-void writeMap(const Pipeline& pipeline, std::iostream& out, const std::string& name) {
+void writeMap(const Pipeline& pipeline, std::iostream& out, const std::string& name, const std::vector<const Pipeline*>& separate) {
   // The header with a zero length and checksum, the payload straight to the stream a megabyte at
   // a time, then the payload read back for its checksum and the header completed: no copy of
   // the map in memory, however large.
@@ -73,6 +74,10 @@ void writeMap(const Pipeline& pipeline, std::iostream& out, const std::string& n
   w.string(optionsToIni(pipeline.options()));
   w.endSection();
   pipeline.writeState(w);
+  w.beginSection(kSeparateTag);
+  w.size(separate.size());
+  for (const auto& p : separate) p->writeState(w);
+  w.endSection();
   w.flush();
   const std::uint64_t length = w.position() - kHeaderBytes;
   out.flush();
@@ -96,22 +101,22 @@ void writeMap(const Pipeline& pipeline, std::iostream& out, const std::string& n
   if (!out) throw common::InputError(name + ": cannot write the map file (disk full?)");
 }
 
-std::string encodeMap(const Pipeline& pipeline) {
+std::string encodeMap(const Pipeline& pipeline, const std::vector<const Pipeline*>& separate) {
   std::stringstream s(std::ios::in | std::ios::out | std::ios::binary);
-  writeMap(pipeline, s, "map");
+  writeMap(pipeline, s, "map", separate);
   return s.str();
 }
 
-void writeMapFile(const Pipeline& pipeline, const std::string& path) {
+void writeMapFile(const Pipeline& pipeline, const std::string& path, const std::vector<const Pipeline*>& separate) {
   std::fstream f(path, std::ios::in | std::ios::out | std::ios::trunc | std::ios::binary);
   if (!f) throw common::InputError(path + ": cannot create the map file (is its folder writable?)");
-  writeMap(pipeline, f, path);
+  writeMap(pipeline, f, path, separate);
   f.close();
   if (f.fail()) throw common::InputError(path + ": cannot write the map file (disk full?)");
 }
 
-void saveMap(const Pipeline& pipeline, const std::string& path) {
-  common::writeAtomically(path, [&](const std::string& tmp) { writeMapFile(pipeline, tmp); });
+void saveMap(const Pipeline& pipeline, const std::string& path, const std::vector<const Pipeline*>& separate) {
+  common::writeAtomically(path, [&](const std::string& tmp) { writeMapFile(pipeline, tmp, separate); });
 }
 
 std::string mapFilePath(const std::string& file_or_run_folder) {
@@ -125,7 +130,8 @@ std::string mapFilePath(const std::string& file_or_run_folder) {
   return file_or_run_folder;
 }
 
-std::unique_ptr<Pipeline> loadMap(const std::string& path, const PipelineOptions* options) {
+std::unique_ptr<Pipeline> loadMap(const std::string& path, const PipelineOptions* options,
+                                  std::vector<std::unique_ptr<Pipeline>>* separate) {
   const std::string bytes = readWholeFile(path);
   // The signature first: a file that is not a map is told so, even a short one.
   const size_t sig = std::min(bytes.size(), sizeof kMagic);
@@ -135,9 +141,9 @@ std::unique_ptr<Pipeline> loadMap(const std::string& path, const PipelineOptions
     throw common::InputError(path + ": truncated map: " + std::to_string(bytes.size()) + " bytes, shorter than the header");
   common::BinaryReader header(bytes.data() + sizeof kMagic, kHeaderBytes - sizeof kMagic, path, "corrupt map");
   const std::uint32_t version = header.u32();
-  if (version != kMapFormatVersion)
-    throw common::InputError(path + ": map format version " + std::to_string(version) + ", but this urbanslam reads version " +
-                             std::to_string(kMapFormatVersion) + " only");
+  if (version < kOldestMapFormatVersion || version > kMapFormatVersion)
+    throw common::InputError(path + ": map format version " + std::to_string(version) + ", but this urbanslam reads versions " +
+                             std::to_string(kOldestMapFormatVersion) + " to " + std::to_string(kMapFormatVersion) + " only");
   const std::uint64_t length = readU64(bytes, kLengthOffset), checksum = readU64(bytes, kLengthOffset + 8);
   const size_t available = bytes.size() - kHeaderBytes;
   if (length > available)
@@ -154,8 +160,22 @@ std::unique_ptr<Pipeline> loadMap(const std::string& path, const PipelineOptions
   const PipelineOptions saved = parsePipelineOptions(opts.string(), path + " (its saved options)");
   opts.expectEnd();
   if (options) checkSameAlgorithmOptions(saved, *options, path);
-  auto pipeline = std::make_unique<Pipeline>(options ? *options : saved);
+  const PipelineOptions& used = options ? *options : saved;
+  auto pipeline = std::make_unique<Pipeline>(used);
   pipeline->readState(r);
+  if (separate) separate->clear();
+  if (version >= 4) {
+    common::BinaryReader maps = r.section(kSeparateTag);
+    if (separate) {
+      const size_t n = maps.count(6 * 12);  // a map is at least its six sections' tags and lengths
+      for (size_t i = 0; i < n; ++i) {
+        separate->push_back(std::make_unique<Pipeline>(used));
+        separate->back()->readState(maps);
+      }
+      maps.expectEnd();
+    }
+  }
+  r.expectEnd();
   return pipeline;
 }
 

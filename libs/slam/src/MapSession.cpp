@@ -47,6 +47,7 @@ SessionRun runSessionInMap(std::unique_ptr<Pipeline> map, io::DataSource& source
   if (!out.join.joined) {
     session->waitForGlobalSlam(source);
     out.pipeline = std::move(session);
+    out.map = std::move(map);
     return out;
   }
   for (auto* o : observers) map->addObserver(o);

@@ -34,10 +34,12 @@ void Pipeline::appendSession(const Pipeline& session, const SessionJoin& join) {
     return found;
   };
 
-  // The session's odometry constraints, by the keyframe they lead to.
+  // The session's odometry constraints, by the keyframe they lead to. A session that is itself
+  // a merge (a map kept separate in a file, then linked) has its later sessions' first
+  // keyframes hang from an earlier keyframe by their join: that constraint is kept as it is.
   std::vector<const GraphEdge*> chain(other.size(), nullptr);
   for (const GraphEdge& e : other.edges())
-    if (!e.loop_closure && e.to == e.from + 1 && e.to < chain.size()) chain[e.to] = &e;
+    if (!e.loop_closure && e.from < e.to && e.to < chain.size() && (!chain[e.to] || e.from > chain[e.to]->from)) chain[e.to] = &e;
 
   const auto now = std::chrono::steady_clock::now();
   for (const Keyframe& k : other.keyframes()) {
@@ -58,8 +60,11 @@ void Pipeline::appendSession(const Pipeline& session, const SessionJoin& join) {
         throw common::InputError("the session's keyframe " + std::to_string(k.index) + " has no odometry constraint from the one before");
       c.z = e->measurement;
       c.cov = e->information.inverse();
-      global_.addKeyframe(Keyframe{n0 + k.index, k.timestamp, {}, false, k.has_image, k.image_words}, io::CompactScan(other.scan(k.index)),
-                          c);
+      Keyframe kf{n0 + k.index, k.timestamp, {}, false, k.has_image, k.image_words};
+      if (e->from + 1 == k.index)
+        global_.addKeyframe(std::move(kf), io::CompactScan(other.scan(k.index)), c);
+      else
+        global_.addKeyframeFrom(n0 + e->from, std::move(kf), io::CompactScan(other.scan(k.index)), c);
     }
     // The places the join recognised, tied to this map's keyframe nearest to each.
     for (size_t i : join.agreeing) {

@@ -166,9 +166,25 @@ LoopClosureRecord readRecord(BinaryReader& r, size_t keyframes) {
 }
 
 void writeStats(BinaryWriter& w, const PipelineStats& s) {
-  for (size_t v : {s.measurements, s.scans, s.scans_used, s.odometry, s.drive, s.images, s.gps, s.reference, s.keyframes,
-                   s.scan_matches_used, s.scan_matches_rejected, s.scans_anchored, s.closures_tried, s.closures_accepted,
-                   s.closures_rejected, s.image_keyframes, s.image_proposals, s.camera_motions_used, s.camera_motions_rejected,
+  for (size_t v : {s.measurements,
+                   s.scans,
+                   s.scans_used,
+                   s.odometry,
+                   s.drive,
+                   s.images,
+                   s.gps,
+                   s.reference,
+                   s.keyframes,
+                   s.scan_matches_used,
+                   s.scan_matches_rejected,
+                   s.scans_anchored,
+                   s.closures_tried,
+                   s.closures_accepted,
+                   s.closures_rejected,
+                   s.image_keyframes,
+                   s.image_proposals,
+                   s.camera_motions_used,
+                   s.camera_motions_rejected,
                    s.global_backlog_max})
     w.size(v);
   w.f64(s.first_timestamp);
@@ -184,10 +200,26 @@ void writeStats(BinaryWriter& w, const PipelineStats& s) {
 }
 
 void readStats(BinaryReader& r, PipelineStats& s) {
-  for (size_t* v : {&s.measurements, &s.scans, &s.scans_used, &s.odometry, &s.drive, &s.images, &s.gps, &s.reference, &s.keyframes,
-                    &s.scan_matches_used, &s.scan_matches_rejected, &s.scans_anchored, &s.closures_tried, &s.closures_accepted,
-                    &s.closures_rejected, &s.image_keyframes, &s.image_proposals, &s.camera_motions_used,
-                    &s.camera_motions_rejected, &s.global_backlog_max})
+  for (size_t* v : {&s.measurements,
+                    &s.scans,
+                    &s.scans_used,
+                    &s.odometry,
+                    &s.drive,
+                    &s.images,
+                    &s.gps,
+                    &s.reference,
+                    &s.keyframes,
+                    &s.scan_matches_used,
+                    &s.scan_matches_rejected,
+                    &s.scans_anchored,
+                    &s.closures_tried,
+                    &s.closures_accepted,
+                    &s.closures_rejected,
+                    &s.image_keyframes,
+                    &s.image_proposals,
+                    &s.camera_motions_used,
+                    &s.camera_motions_rejected,
+                    &s.global_backlog_max})
     *v = r.size();
   s.first_timestamp = r.f64();
   s.last_timestamp = r.f64();
@@ -633,7 +665,6 @@ void Pipeline::readState(BinaryReader& r) {
                                "not hold the image database, so this map cannot be continued");
     s.expectEnd();
   }
-  r.expectEnd();
 }
 
 }  // namespace urbanslam::slam

@@ -17,7 +17,7 @@ namespace urbanslam::slam {
 
 namespace fs = std::filesystem;
 
-StagedMapFile::StagedMapFile(const std::string& dir, const Pipeline& pipeline) {
+StagedMapFile::StagedMapFile(const std::string& dir, const Pipeline& pipeline, const std::vector<const Pipeline*>& separate) {
   const std::string target = dir + ".usmap";
   common::removeStaleTemporaries(target);
   if (pipeline.keyframes().empty()) return;
@@ -27,7 +27,7 @@ StagedMapFile::StagedMapFile(const std::string& dir, const Pipeline& pipeline) {
     throw common::InputError(dir + ": cannot create the output folder (is its parent writable?)");
   path_ = common::temporaryPathFor(target);
   try {
-    writeMapFile(pipeline, path_);
+    writeMapFile(pipeline, path_, separate);
   } catch (...) {
     // A constructor that throws runs no destructor: the half-written temporary goes now.
     fs::remove(path_, ec);
@@ -166,6 +166,7 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   j["ini"] = info.ini_path;
   if (!info.resumed_map.empty()) j["resumed_map"] = info.resumed_map;
   if (info.sessions.type() != Json::Type::Null) j["sessions"] = info.sessions;
+  if (info.separate_maps.type() != Json::Type::Null) j["separate_maps"] = info.separate_maps;
   j["estimator"] = p.estimatorName();
   Json& c = j["counts"];
   c["measurements"] = s.measurements;

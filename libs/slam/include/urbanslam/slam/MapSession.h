@@ -21,6 +21,8 @@ struct SessionRun {
   // The map with the session in it, or the session alone when it was never joined; its input
   // read to the end, global SLAM caught up, not finished (the map can still be saved).
   std::unique_ptr<Pipeline> pipeline;
+  // The map, when the session was never joined to it (then it stays a map of its own).
+  std::unique_ptr<Pipeline> map;
   SessionJoin join;
   double joined_at_s = 0;       // log time of the keyframe at which the join was found
   size_t keyframes_before = 0;  // the map's keyframes before the session's

@@ -7,6 +7,7 @@
 // (MapFile.h), is written before finish() to a temporary file, which RunInfo names and which is
 // moved into the folder.
 #include <string>
+#include <vector>
 
 #include "urbanslam/common/Json.h"
 #include "urbanslam/slam/Pipeline.h"
@@ -20,6 +21,9 @@ struct RunInfo {
   // Sessions joined to the map (`run --map`, `merge`): stats.json's "sessions" (sessionJson);
   // null for none.
   common::Json sessions;
+  // The maps map.usmap holds besides this one, each in its own frame (MapMerge.h's
+  // separateMapsJson): stats.json's "separate_maps"; null for none.
+  common::Json separate_maps;
 };
 
 // map.usmap for the run folder `dir`, staged: the pipeline's state saved now, before finish()
@@ -30,7 +34,8 @@ struct RunInfo {
 // is then empty. Throws InputError when dir's parent cannot be created.
 class StagedMapFile {
  public:
-  StagedMapFile(const std::string& dir, const Pipeline& pipeline);
+  // `separate`: the file's maps besides the pipeline's (MapFile.h), written with it.
+  StagedMapFile(const std::string& dir, const Pipeline& pipeline, const std::vector<const Pipeline*>& separate = {});
   ~StagedMapFile();
   StagedMapFile(const StagedMapFile&) = delete;
   StagedMapFile& operator=(const StagedMapFile&) = delete;
