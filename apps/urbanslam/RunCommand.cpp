@@ -47,13 +47,16 @@ int runCommand(const Argv& args) {
   ap.addOption("resume", "MAP",
                "continue the map of an earlier run (its map.usmap, or its output folder) with LOG, which\n"
                "must start where that run's log ended (e.g. the rest of a split log); the result is that of\n"
-               "one run over both. An --ini may change only [map] and [output] keys");
+               "one run over both (separate maps in MAP are carried along). An --ini may change only [map]\n"
+               "and [output] keys");
   ap.addOption("map", "MAP",
                "map LOG as a new session of the map of an earlier run (its map.usmap, or its output folder),\n"
                "starting anywhere: LOG is mapped on its own until place recognition finds it in the map\n"
                "(a few agreeing places), then joined to the map and continued inside it; a LOG that never\n"
-               "meets the map ends as a map of its own (stats.json: sessions). An --ini may change only\n"
-               "[map] and [output] keys");
+               "meets the map ends as a map of its own, with MAP kept beside it as a separate map in the\n"
+               "output's map.usmap (stats.json: sessions, separate_maps). MAP's own separate maps are\n"
+               "searched for again: the new session may link them. An --ini may change only [map] and\n"
+               "[output] keys");
   ap.addOption("out", "DIR", "output folder (created if needed)", "out");
   ap.addFlag("quiet", "no progress bar and no summary on stderr");
   ap.addFlag("json", "print stats.json as one JSON object on stdout");
