@@ -3,7 +3,10 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "ArgParser.h"
 #include "Commands.h"
@@ -28,18 +31,33 @@ common::Pose2 parsePose(const std::string& text) {
   return {v[0], v[1], common::wrapToPi(v[2])};
 }
 
+size_t parseSeparateMap(const std::string& text) {
+  size_t used = 0;
+  unsigned long long k = 0;
+  try {
+    k = std::stoull(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || text[0] == '-' || k > 1000000)
+    throw common::InputError("localize --separate-map: expected a whole number (0: the first map), got '" + text + "'");
+  return static_cast<size_t>(k);
+}
+
 }  // namespace
 
 int localizeCommand(const Argv& args) {
-  ArgParser ap("urbanslam localize --map MAP LOG [--initial x,y,phi] [--out DIR] [--quiet] [--json]",
+  ArgParser ap("urbanslam localize --map MAP LOG [--initial x,y,phi] [--separate-map K] [--out DIR] [--quiet] [--json]",
                "Tracks the vehicle of LOG in the map of an earlier `urbanslam run` (its map.usmap, or its output\n"
                "folder), which is not changed: every scan is predicted by the odometry and matched against the\n"
                "map's scans near that pose. Without --initial, and whenever the matches stop supporting the pose\n"
                "(lost), the map is searched for the scan's place until one place clearly wins: the whole map,\n"
                "or, once matches have confirmed the pose, only where the odometry from it can have gone.\n"
-               "A map file that holds separate maps (`merge`): the vehicle is localized in the first.");
+               "A map file that holds separate maps (`merge`, `run --map`; stats.json's separate_maps lists\n"
+               "them): the vehicle is localized in the first, or in the one --separate-map names.");
   ap.addPositional("LOG", "the log to localize (any format `run` reads)");
   ap.addOption("map", "MAP", "the map: a map.usmap file or the run folder holding one (required)");
+  ap.addOption("separate-map", "K", "localize in the map file's K-th separate map (in that map's own frame); default: the first map", "0");
   ap.addOption("initial", "x,y,phi", "the vehicle's pose at the first scan in the map frame (m, m, rad); default: searched");
   ap.addOption("out", "DIR", "output folder (created if needed)", "out_localize");
   ap.addFlag("quiet", "no progress bar and no summary on stderr");
@@ -61,7 +79,13 @@ int localizeCommand(const Argv& args) {
     info.initial_pose = parsePose(ap.option("initial"));
     info.initial_pose_given = true;
   }
-  std::unique_ptr<slam::Pipeline> pipeline = slam::loadMap(info.map_path);
+  info.separate_map = parseSeparateMap(ap.option("separate-map"));
+  std::vector<std::unique_ptr<slam::Pipeline>> separate;
+  std::unique_ptr<slam::Pipeline> pipeline = slam::loadMap(info.map_path, nullptr, info.separate_map > 0 ? &separate : nullptr);
+  if (info.separate_map > separate.size() && info.separate_map > 0)
+    throw common::InputError("localize --separate-map " + std::to_string(info.separate_map) + ": " + info.map_path + " holds " +
+                             std::to_string(separate.size()) + " separate map" + (separate.size() == 1 ? "" : "s"));
+  if (info.separate_map > 0) pipeline = std::move(separate[info.separate_map - 1]);
   // The final estimates of the map's keyframes (what `run` wrote out); nothing is added after.
   pipeline->finish();
   if (pipeline->keyframes().empty()) throw common::InputError(info.map_path + ": the map has no keyframes");

@@ -81,6 +81,22 @@ TEST(MergeCommand, JoinsTheMapsOfTwoHalvesOfALog) {
   EXPECT_NE(other.err.find("was not found in the other maps: kept as separate map 1"), std::string::npos) << other.err;
   EXPECT_NE(other.out.find("\"separate_map\":1"), std::string::npos) << other.out;
   EXPECT_NE(other.out.find("\"separate_maps\":[{\"keyframes\":"), std::string::npos) << other.out;
+  // The separate map is a map to localize in, in its own frame: the Intel excerpt tracks in it
+  // with no initial pose; the first map does not hold it; there is no second separate map.
+  const std::string intel = repoPath("rawlogs/intel-corrected-excerpt.log.gz");
+  const CliResult in_separate =
+      runCli("localize --quiet --json --map " + (dir / "x").string() + " --separate-map 1 --out " + (dir / "lx").string() + " " + intel);
+  ASSERT_EQ(in_separate.code, 0) << in_separate.err;
+  EXPECT_NE(in_separate.out.find("\"separate_map\":1"), std::string::npos) << in_separate.out;
+  EXPECT_GT(jsonNumber(in_separate.out, "tracking_fraction"), 0.8) << in_separate.out;
+  const CliResult in_first =
+      runCli("localize --quiet --json --map " + (dir / "x").string() + " --out " + (dir / "l0").string() + " " + intel);
+  ASSERT_EQ(in_first.code, 0) << in_first.err;
+  EXPECT_LT(jsonNumber(in_first.out, "tracking_fraction"), 0.2) << in_first.out;
+  const CliResult no_such = runCli("localize --map " + (dir / "x").string() + " --separate-map 2 " + intel);
+  EXPECT_EQ(no_such.code, 2);
+  EXPECT_NE(no_such.err.find("--separate-map 2: " + (dir / "x" / "map.usmap").string() + " holds 1 separate map"), std::string::npos)
+      << no_such.err;
   // A log mapped into a map it is not found in: its own map comes first (a resumed run continues
   // it), the map it was not found in is kept as a separate one.
   const CliResult unjoined = runCli("run --json --map " + (dir / "intel").string() + " --out " + (dir / "u").string() + " " + few);

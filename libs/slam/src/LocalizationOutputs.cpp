@@ -30,6 +30,7 @@ common::Json localizationStats(const std::vector<LocalizedScan>& scans, const Lo
   using common::Json;
   Json j = Json::object();
   j["map"] = info.map_path;
+  if (info.separate_map > 0) j["separate_map"] = info.separate_map;
   j["input"] = info.input_path;
   j["input_format"] = info.input_format;
   if (info.initial_pose_given) {
