@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <array>
+#include <stdexcept>
 #include <cctype>
 #include <cstdio>
 #include <cstring>
@@ -49,15 +50,18 @@ class GzMrptStream : public mrpt::io::CStream {
     head_len_ = std::max<size_t>(head_len_, static_cast<size_t>(pos_ - entry_start_) + keep);
     if (keep > 0) std::memcpy(head_.data() + (pos_ - entry_start_), buf, keep);
     pos_ += got;
-    if (got == n) movement_.check(static_cast<const unsigned char*>(buf), n);
+    if (got == n) {
+      movement_.check(static_cast<const unsigned char*>(buf), n);
+      checkNesting(static_cast<const unsigned char*>(buf), n);
+    }
     return got;
   }
   size_t Write(const void*, size_t) override { throw std::logic_error("read-only stream"); }
   uint64_t Seek(int64_t, TSeekOrigin) override { throw std::logic_error("stream cannot seek"); }
   uint64_t getTotalBytesCount() const override { return 0; }
   uint64_t getPosition() const override { return pos_; }
-  // Why the last Read refused a field (MovementGuard), or "".
-  const std::string& refusal() const { return movement_.failure(); }
+  // Why the last Read refused a field (MovementGuard, or a container nested in the entry), or "".
+  const std::string& refusal() const { return nesting_failure_.empty() ? movement_.failure() : nesting_failure_; }
   double progress() const { return in_->progress(); }
 
   // The class name of the object header that comes next (MRPT's: length | 0x80, then the
@@ -74,6 +78,9 @@ class GzMrptStream : public mrpt::io::CStream {
   void startEntry() {
     entry_start_ = pos_;
     head_len_ = 0;
+    containers_ = 0;
+    name_length_ = 0;
+    nesting_failure_.clear();
   }
   // Class name of the entry's object as MRPT writes it (length | 0x80, then the name), or "".
   std::string entryClass() const {
@@ -111,8 +118,34 @@ class GzMrptStream : public mrpt::io::CStream {
     return got;
   }
 
+  // A sensory frame or an action collection is an entry of the rawlog, never part of another
+  // object: MRPT would read one nested in another all the same (and fail only afterwards, on its
+  // type), so a file of frames nested in frames recurses as deep as it is long, and every level
+  // rethrows the error with a backtrace of the levels below (seconds, hundreds of megabytes; an
+  // allocation refused inside MRPT's what() ends the process). The second such class name read
+  // in one entry stops the read there. MRPT reads a class name as one byte (its length | 0x80)
+  // and then the name in one read.
+  void checkNesting(const unsigned char* data, size_t n) {
+    if (n == 1 && (data[0] & 0x80)) {
+      name_length_ = data[0] & 0x7f;
+      return;
+    }
+    const size_t expected = name_length_;
+    name_length_ = 0;
+    if (expected == 0 || n != expected) return;
+    const std::string name(reinterpret_cast<const char*>(data), n);
+    static const std::array<const char*, 4> kContainers = {"CSensoryFrame", "mrpt::obs::CSensoryFrame", "CActionCollection",
+                                                           "mrpt::obs::CActionCollection"};
+    if (std::find(kContainers.begin(), kContainers.end(), name) == kContainers.end()) return;
+    if (++containers_ < 2) return;
+    nesting_failure_ = "a " + name + " inside another sensory frame or action collection";
+    throw std::runtime_error(nesting_failure_);
+  }
+
   std::unique_ptr<detail::ByteStream> in_;
   std::string pushback_;
+  size_t containers_ = 0, name_length_ = 0;
+  std::string nesting_failure_;
   uint64_t pos_ = 0, entry_start_ = 0;
   std::array<char, 130> head_{};
   size_t head_len_ = 0;
@@ -284,7 +317,8 @@ struct RawlogReader::Impl {
     };
     try {
       const std::string cls = stream.peekClassName();
-      obj = cls == "CActionCollection" || cls == "mrpt::obs::CActionCollection" ? detail::readActionCollection(arch, stream, where()) : arch.ReadObject();
+      obj = cls == "CActionCollection" || cls == "mrpt::obs::CActionCollection" ? detail::readActionCollection(arch, stream, where())
+                                                                                : arch.ReadObject();
     } catch (const mrpt::serialization::CExceptionEOF&) {
       ended = true;
       if (stream.getPosition() != before) throw InputError(where() + ": truncated rawlog (file ends inside an entry)");
