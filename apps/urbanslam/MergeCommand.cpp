@@ -50,9 +50,9 @@ int mergeCommand(const Argv& args) {
   std::vector<slam::NamedMap> maps;
   for (size_t i = 0; i < paths.size(); ++i) {
     std::vector<std::unique_ptr<slam::Pipeline>> separate;
-    maps.push_back({slam::loadMap(paths[i], i == 0 ? nullptr : &maps.front().map->options(), &separate), {paths[i]}});
-    for (size_t k = 0; k < separate.size(); ++k)
-      maps.push_back({std::move(separate[k]), {paths[i] + " (separate map " + std::to_string(k + 1) + ")"}});
+    const int group = static_cast<int>(i);  // one file's maps were kept apart by the run that wrote it
+    maps.push_back({slam::loadMap(paths[i], i == 0 ? nullptr : &maps.front().map->options(), &separate), {paths[i]}, group});
+    for (auto& m : slam::namedSeparateMaps(std::move(separate), paths[i], group)) maps.push_back(std::move(m));
   }
   common::ProgressBar bar("merge", 1000, !quiet);
   slam::MergedMaps merged =

@@ -95,23 +95,30 @@ int runCommand(const Argv& args) {
   // error from reading the log unwinds this function.
   common::ProgressBar bar("run", 1000, !quiet);
   ProgressObserver progress(bar);
-  // A map file's separate maps (MapFile.h) are carried to the output's.
-  std::vector<std::unique_ptr<slam::Pipeline>> separate;
-  std::unique_ptr<slam::Pipeline> pipeline =
-      map.empty() ? std::make_unique<slam::Pipeline>(options) : slam::loadMap(map, ini.empty() ? nullptr : &options, &separate);
+  // The maps of the output's map.usmap: [0] the one this run builds, then a map file's separate
+  // maps (MapFile.h), carried along.
+  std::vector<slam::NamedMap> maps;
+  {
+    std::vector<std::unique_ptr<slam::Pipeline>> separate;
+    maps.push_back(
+        {map.empty() ? std::make_unique<slam::Pipeline>(options) : slam::loadMap(map, ini.empty() ? nullptr : &options, &separate),
+         {map.empty() ? log : map},
+         0});
+    for (auto& m : slam::namedSeparateMaps(std::move(separate), map, 0)) maps.push_back(std::move(m));
+  }
   if (ini.empty()) {
-    resolved = slam::optionsToIni(pipeline->options());
+    resolved = slam::optionsToIni(maps.front().map->options());
     ini = map + " (its saved options)";
   }
 
   // The simulator is a data source like a file reader: a drive of any length streams through.
   std::unique_ptr<io::DataSource> source =
       ap.has("simulate") ? std::make_unique<sim::SimulatedSource>(sim::loadSimOptions(log)) : io::openDataSource(log);
-  common::Json sessions, separate_maps;
+  common::Json sessions;
   bool joined = false;
   if (ap.has("map")) {
     // A new session of the map: on its own until it is found in the map, then inside it.
-    slam::SessionRun s = slam::runSessionInMap(std::move(pipeline), *source, {&progress});
+    slam::SessionRun s = slam::runSessionInMap(std::move(maps.front().map), *source, {&progress});
     joined = s.join.joined;
     sessions = common::Json::array();
     sessions.push(slam::sessionJson(log, s.join, s.keyframes_before, s.joined_at_s));
@@ -119,41 +126,24 @@ int runCommand(const Argv& args) {
       std::cerr << "urbanslam run: " << log << " was not found in " << map << " (" << s.join.reason << "): its map is its own\n";
     // The map that holds the session first (the one a resumed run continues), then the maps it
     // was not joined to: the session may link them now.
-    std::vector<slam::NamedMap> maps;
-    maps.push_back({std::move(s.pipeline), {joined ? map : log}});
-    if (joined) maps.front().sessions.push_back(log);
-    if (s.map) maps.push_back({std::move(s.map), {map}});
-    for (size_t k = 0; k < separate.size(); ++k)
-      maps.push_back({std::move(separate[k]), {map + " (separate map " + std::to_string(k + 1) + ")"}});
-    separate.clear();
+    maps.front() = joined ? slam::NamedMap{std::move(s.pipeline), {map, log}} : slam::NamedMap{std::move(s.pipeline), {log}};
+    if (s.map) maps.insert(maps.begin() + 1, slam::NamedMap{std::move(s.map), {map}, 0});
     if (maps.size() > 1) {
       slam::MergedMaps merged = slam::mergeMaps(std::move(maps));
       for (const auto& j : merged.sessions) sessions.push(j);
-      separate_maps = slam::separateMapsJson(merged.maps);
       maps = std::move(merged.maps);
       if (!quiet && maps.size() > 1)
         std::cerr << "urbanslam run: " << maps.size() - 1 << " separate map" << (maps.size() > 2 ? "s" : "") << " kept in map.usmap\n";
     }
-    pipeline = std::move(maps.front().map);
-    for (size_t k = 1; k < maps.size(); ++k) separate.push_back(std::move(maps[k].map));
   } else {
-    pipeline->addObserver(&progress);
-    pipeline->runInput(*source);
+    maps.front().map->addObserver(&progress);
+    maps.front().map->runInput(*source);
   }
+  slam::Pipeline* const pipeline = maps.front().map.get();
   // The map is saved before finish() (StagedMapFile).
   std::string out = ap.option("out");
   while (out.size() > 1 && out.back() == '/') out.pop_back();
-  std::vector<const slam::Pipeline*> separate_ptrs;
-  for (const auto& p : separate) separate_ptrs.push_back(p.get());
-  if (!separate.empty() && separate_maps.type() == common::Json::Type::Null) {
-    separate_maps = common::Json::array();  // resumed: the map's separate maps as they were
-    for (const auto& p : separate) {
-      common::Json j = common::Json::object();
-      j["keyframes"] = p->keyframes().size();
-      separate_maps.push(std::move(j));
-    }
-  }
-  const slam::StagedMapFile map_file(out, *pipeline, separate_ptrs);
+  const slam::StagedMapFile map_file(out, *pipeline, slam::separateMaps(maps));
   pipeline->finish(*source);
   bar.finish();
   // A log without a single keyframe has nothing to map: outputs would only look like a run.
@@ -163,8 +153,8 @@ int runCommand(const Argv& args) {
                                                : ": none of its " + std::to_string(scans) + " laser scans could be used: nothing to map"));
   }
 
-  const slam::RunInfo info{log,      source->format(), ini, resolved, map_file.path(), ap.has("map") && !joined ? "" : map,
-                           sessions, separate_maps};
+  const slam::RunInfo info{
+      log, source->format(), ini, resolved, map_file.path(), ap.has("map") && !joined ? "" : map, sessions, slam::separateMapsJson(maps)};
   const common::Json stats = slam::writeRunOutputs(*pipeline, out, info);
   if (ap.flag("json")) std::cout << stats.dump() << "\n";
   if (!quiet) {

@@ -97,6 +97,21 @@ TEST(SeparateMaps, KeptInOneFileUntilASessionLinksThem) {
   EXPECT_EQ(slam::encodeMap(*first, {separate[0].get()}), slam::encodeMap(*apart.maps[0].map, slam::separateMaps(apart.maps)));
   EXPECT_EQ(slam::loadMap(path)->keyframes().size(), na);
 
+  {
+    // The maps of one file were searched for in each other when it was written: merged again
+    // with nothing new, they are not searched again.
+    std::vector<std::unique_ptr<slam::Pipeline>> sep;
+    std::vector<slam::NamedMap> same;
+    same.push_back({slam::loadMap(path, nullptr, &sep), {path}, 0});
+    for (auto& m : slam::namedSeparateMaps(std::move(sep), path, 0)) same.push_back(std::move(m));
+    ASSERT_EQ(same.size(), 2u);
+    EXPECT_EQ(same[1].sessions.front(), path + " (separate map 1)");
+    const slam::MergedMaps again = slam::mergeMaps(std::move(same));
+    ASSERT_EQ(again.maps.size(), 2u);
+    ASSERT_EQ(again.sessions.size(), 1u);
+    EXPECT_FALSE(again.sessions[0].contains("place_searches")) << again.sessions[0].dump();
+  }
+
   // B drives from A's part to C's: merged after them, it joins A, and then C joins the two.
   std::vector<slam::NamedMap> three;
   three.push_back({std::move(first), {"A"}});

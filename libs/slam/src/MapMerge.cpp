@@ -13,6 +13,7 @@ namespace {
 bool tryJoin(std::vector<NamedMap>& maps, size_t a, size_t b, const SessionJoinOptions& options,
              const std::function<void(const std::string&, double)>& progress, std::vector<common::Json>& log,
              std::map<std::string, common::Json>& misses) {
+  if (maps[a].apart_group >= 0 && maps[a].apart_group == maps[b].apart_group) return false;  // searched before, as they are
   Pipeline& into = *maps[a].map;
   const NamedMap& other = maps[b];
   const std::string name = other.sessions.front();
@@ -33,6 +34,7 @@ bool tryJoin(std::vector<NamedMap>& maps, size_t a, size_t b, const SessionJoinO
   log.push_back(std::move(j));
   into.appendSession(*other.map, join);
   maps[a].sessions.insert(maps[a].sessions.end(), other.sessions.begin(), other.sessions.end());
+  maps[a].apart_group = -1;  // it grew: worth searching against everything again
   maps.erase(maps.begin() + static_cast<std::ptrdiff_t>(b));
   return true;
 }
@@ -77,6 +79,13 @@ MergedMaps mergeMaps(std::vector<NamedMap> maps, const SessionJoinOptions& optio
     j["separate_map"] = i;
     out.sessions.push_back(std::move(j));
   }
+  return out;
+}
+
+std::vector<NamedMap> namedSeparateMaps(std::vector<std::unique_ptr<Pipeline>> separate, const std::string& file, int apart_group) {
+  std::vector<NamedMap> out;
+  for (size_t k = 0; k < separate.size(); ++k)
+    out.push_back({std::move(separate[k]), {file + " (separate map " + std::to_string(k + 1) + ")"}, apart_group});
   return out;
 }
 

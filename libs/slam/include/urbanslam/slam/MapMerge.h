@@ -23,7 +23,14 @@ struct NamedMap {
   std::unique_ptr<Pipeline> map;  // loaded, not finished; all with the same options
   // Its sessions' names (a map file's, or the log that made it); a map made by merging has several.
   std::vector<std::string> sessions;
+  // Maps with the same group (>= 0) were searched for in each other as they are and not linked:
+  // the maps of one file. They are not searched again until one of them grows (group -1 then).
+  int apart_group = -1;
 };
+
+// A map file's separate maps (loadMap), named after the file ("FILE (separate map K)"), in the
+// file's group.
+std::vector<NamedMap> namedSeparateMaps(std::vector<std::unique_ptr<Pipeline>> separate, const std::string& file, int apart_group);
 
 struct MergedMaps {
   std::vector<NamedMap> maps;  // [0]: the first map's frame, with everything joined to it; then the separate maps
