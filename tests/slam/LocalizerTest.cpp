@@ -87,8 +87,8 @@ double percentileOf(std::vector<double> v, double q) {
 
 }  // namespace
 
-// Started where the map ended: the relations between the tracked scans are met about as well as
-// by the mapping run over the whole excerpt, and the poses are those of that run (whose frame is
+// Started where the map ended: the relations between the tracked scans are met as well as by the
+// mapping run over the whole excerpt, and the poses are those of that run (whose frame is
 // the map's: both start at the same first scan).
 TEST(Localizer, TracksTheRestOfTheExcerptAsWellAsTheFullRunMapsIt) {
   const common::Pose2 start = maps().first->scanTrajectory().back().pose;
@@ -105,8 +105,10 @@ TEST(Localizer, TracksTheRestOfTheExcerptAsWellAsTheFullRunMapsIt) {
   const auto localized = evaluation::relationMetrics(traj, inside, 0.0, 0.5);
   const auto mapped = evaluation::relationMetrics(maps().full->scanTrajectory(), inside, 0.0, 0.5);
   EXPECT_EQ(localized.used, inside.size());
-  EXPECT_LT(localized.abs_trans_m.mean, 1.5 * mapped.abs_trans_m.mean + 0.01);
-  EXPECT_LT(localized.abs_rot_deg.mean, 1.5 * mapped.abs_rot_deg.mean + 0.2);
+  // Within 10 % of the mapping run (the localization goal). With a match's covariance taken alone
+  // instead of fused with the prediction's, the rotations are 23 % worse (0.453° against 0.363°).
+  EXPECT_LT(localized.abs_trans_m.mean, 1.1 * mapped.abs_trans_m.mean);
+  EXPECT_LT(localized.abs_rot_deg.mean, 1.1 * mapped.abs_rot_deg.mean);
 
   std::vector<double> errors;
   for (const auto& p : traj) errors.push_back(distance(p.pose, reference(p.timestamp)));

@@ -158,10 +158,16 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
     if (reference && r.valid && out.matched_fraction >= options_.min_matched_fraction) {
       out.matched = true;
       if (++consecutive_matches_ >= options_.confirm_matches) confirmed_ = true;
+      // The match's covariance: its posterior times the scale, floored, plus the spread where
+      // the search and the refinement part (in doubt by that much, as in local SLAM's posterior,
+      // LocalSlam.cpp: added after the floors and not scaled). Fused with the prediction's: a
+      // match adds information, it cannot leave the pose less certain than the prediction was.
+      // Taken alone, the spread along a direction the map hardly constrains (the far end of a
+      // corridor) grew the covariance scan after scan, 2 cm to 46 cm in a second on Intel, until
+      // a match jumped 0.4 m to a look-alike and back.
       setPose(r.pose, options_.covariance_scale * r.cov);
-      // Where the search and the refinement part, the pose is in doubt by that much, as in local
-      // SLAM's posterior (LocalSlam.cpp): added after the floors and not scaled.
-      cov_ += r.spread;
+      const Eigen::Matrix3d match_cov = cov_ + r.spread;
+      setPose(r.pose, (predicted_cov.inverse() + match_cov.inverse()).inverse());
       // The correction is the difference of two estimates of the pose, each with its own error:
       // the prediction's, and the match's against the map, which is at least the map's own
       // disagreement (the floors). Tested against the prediction's covariance alone, corrections
