@@ -14,6 +14,7 @@
 #include "urbanslam/common/Progress.h"
 #include "urbanslam/common/Timing.h"
 #include "urbanslam/slam/LocalizationOutputs.h"
+#include "urbanslam/slam/LocalizeInMaps.h"
 #include "urbanslam/slam/Localizer.h"
 #include "urbanslam/slam/MapFile.h"
 
@@ -54,10 +55,14 @@ int localizeCommand(const Argv& args) {
                "(lost), the map is searched for the scan's place until one place clearly wins: the whole map,\n"
                "or, once matches have confirmed the pose, only where the odometry from it can have gone.\n"
                "A map file that holds separate maps (`merge`, `run --map`; stats.json's separate_maps lists\n"
-               "them): the vehicle is localized in the first, or in the one --separate-map names.");
+               "them): the vehicle is localized in the one --separate-map names, in the first with --initial,\n"
+               "and otherwise searched for in all of them, side by side, until one finds its place; that map\n"
+               "goes on alone (stats.json: separate_map, maps_searched).");
   ap.addPositional("LOG", "the log to localize (any format `run` reads)");
   ap.addOption("map", "MAP", "the map: a map.usmap file or the run folder holding one (required)");
-  ap.addOption("separate-map", "K", "localize in the map file's K-th separate map (in that map's own frame); default: the first map", "0");
+  ap.addOption("separate-map", "K",
+               "localize in the map file's K-th separate map (in that map's own frame; 0: the first map); default: searched "
+               "in every map of the file (the first with --initial)");
   ap.addOption("initial", "x,y,phi", "the vehicle's pose at the first scan in the map frame (m, m, rad); default: searched");
   ap.addOption("out", "DIR", "output folder (created if needed)", "out_localize");
   ap.addFlag("quiet", "no progress bar and no summary on stderr");
@@ -79,28 +84,54 @@ int localizeCommand(const Argv& args) {
     info.initial_pose = parsePose(ap.option("initial"));
     info.initial_pose_given = true;
   }
-  info.separate_map = parseSeparateMap(ap.option("separate-map"));
+  if (ap.has("separate-map")) info.separate_map = parseSeparateMap(ap.option("separate-map"));
+  // Without a named map or an initial pose (which is in the first map's frame), every map of the
+  // file is searched.
+  const bool search_maps = !ap.has("separate-map") && !info.initial_pose_given;
   std::vector<std::unique_ptr<slam::Pipeline>> separate;
-  std::unique_ptr<slam::Pipeline> pipeline = slam::loadMap(info.map_path, nullptr, info.separate_map > 0 ? &separate : nullptr);
+  std::vector<std::unique_ptr<slam::Pipeline>> maps;
+  maps.push_back(slam::loadMap(info.map_path, nullptr, info.separate_map > 0 || search_maps ? &separate : nullptr));
   if (info.separate_map > separate.size() && info.separate_map > 0)
     throw common::InputError("localize --separate-map " + std::to_string(info.separate_map) + ": " + info.map_path + " holds " +
                              std::to_string(separate.size()) + " separate map" + (separate.size() == 1 ? "" : "s"));
-  if (info.separate_map > 0) pipeline = std::move(separate[info.separate_map - 1]);
-  // The final estimates of the map's keyframes (what `run` wrote out); nothing is added after.
-  pipeline->finish();
-  if (pipeline->keyframes().empty()) throw common::InputError(info.map_path + ": the map has no keyframes");
+  if (info.separate_map > 0) {
+    maps[0] = std::move(separate[info.separate_map - 1]);
+  } else if (search_maps) {
+    for (auto& p : separate) maps.push_back(std::move(p));
+  }
+  separate.clear();
+  for (size_t k = 0; k < maps.size(); ++k) {
+    // The final estimates of the map's keyframes (what `run` wrote out); nothing is added after.
+    maps[k]->finish();
+    if (maps[k]->keyframes().empty())
+      throw common::InputError(info.map_path + ": " + (k == 0 && info.separate_map == 0 ? "the map" : "a separate map") +
+                               " has no keyframes");
+  }
   std::unique_ptr<io::DataSource> source = io::openDataSource(info.input_path);
   info.input_format = source->format();
 
-  slam::Localizer localizer(pipeline->map(), pipeline->options(), slam::localizerOptions(pipeline->options()));
-  if (info.initial_pose_given) localizer.setInitialPose(info.initial_pose);
+  std::vector<std::unique_ptr<slam::Localizer>> localizers;
+  std::vector<slam::Localizer*> running;
+  for (const auto& p : maps) {
+    localizers.push_back(std::make_unique<slam::Localizer>(p->map(), p->options(), slam::localizerOptions(p->options())));
+    running.push_back(localizers.back().get());
+  }
+  if (info.initial_pose_given) localizers[0]->setInitialPose(info.initial_pose);
   common::ProgressBar bar("localize", 1000, !quiet);
-  const auto scans = slam::localize(localizer, *source, [&](const slam::LocalizedScan& r, double progress) {
-    const auto& s = localizer.stats();
-    bar.update(static_cast<uint64_t>(progress * 1000), std::to_string(s.scans_used) + " scans, " + slam::stateName(r.state) + ", " +
-                                                           std::to_string(s.relocalisations) + " relocalisations");
+  size_t shown_scans = 0, shown_fixes = 0;
+  slam::MapsLocalization result = slam::localizeInMaps(running, *source, [&](const slam::LocalizedScan& r, double progress) {
+    ++shown_scans;
+    shown_fixes += r.relocalised;
+    bar.update(static_cast<uint64_t>(progress * 1000), std::to_string(shown_scans) + " scans, " + slam::stateName(r.state) + ", " +
+                                                           std::to_string(shown_fixes) + " relocalisations");
   });
   bar.finish();
+  const slam::Localizer& localizer = *localizers[result.map];
+  const std::vector<slam::LocalizedScan>& scans = result.scans;
+  if (search_maps) {
+    info.separate_map = result.map;
+    info.maps_searched = maps.size();
+  }
   if (scans.empty()) throw common::InputError(info.input_path + ": no laser scans the map's [input] options accept: nothing to localize");
   info.wall_s = wall.seconds();
   const std::string out = ap.option("out");
@@ -110,7 +141,11 @@ int localizeCommand(const Argv& args) {
     const auto& s = localizer.stats();
     std::cerr << "urbanslam localize: " << s.scans_used << " scans, " << s.tracking << " tracked, " << s.lost << " lost (" << s.lost_s
               << " s), " << s.relocalisations << " relocalisations in " << info.wall_s << " s ("
-              << stats.at("timing").at("real_time_factor").asNumber() << "x real time)\n"
+              << stats.at("timing").at("real_time_factor").asNumber() << "x real time)";
+    if (info.maps_searched > 1)
+      std::cerr << "; searched in the file's " << info.maps_searched << " maps, "
+                << (info.separate_map == 0 ? std::string("the first") : "separate map " + std::to_string(info.separate_map)) << " went on";
+    std::cerr << "\n"
               << "outputs in " << std::filesystem::absolute(out).string() << "/ (trajectory_scans.tum, localization.csv, stats.json)\n";
   }
   return 0;

@@ -90,9 +90,18 @@ TEST(MergeCommand, JoinsTheMapsOfTwoHalvesOfALog) {
   EXPECT_NE(in_separate.out.find("\"separate_map\":1"), std::string::npos) << in_separate.out;
   EXPECT_GT(jsonNumber(in_separate.out, "tracking_fraction"), 0.8) << in_separate.out;
   const CliResult in_first =
-      runCli("localize --quiet --json --map " + (dir / "x").string() + " --out " + (dir / "l0").string() + " " + intel);
+      runCli("localize --quiet --json --map " + (dir / "x").string() + " --separate-map 0 --out " + (dir / "l0").string() + " " + intel);
   ASSERT_EQ(in_first.code, 0) << in_first.err;
   EXPECT_LT(jsonNumber(in_first.out, "tracking_fraction"), 0.2) << in_first.out;
+  // With no map named, the log is searched for in both: the separate map holds it, and tracks it
+  // as when named (the same scans: the first map never found its place to take them).
+  const CliResult searched = runCli("localize --json --map " + (dir / "x").string() + " --out " + (dir / "la").string() + " " + intel);
+  ASSERT_EQ(searched.code, 0) << searched.err;
+  EXPECT_NE(searched.out.find("\"separate_map\":1"), std::string::npos) << searched.out;
+  EXPECT_NE(searched.out.find("\"maps_searched\":2"), std::string::npos) << searched.out;
+  EXPECT_EQ(jsonNumber(searched.out, "tracking"), jsonNumber(in_separate.out, "tracking")) << searched.out;
+  EXPECT_EQ(slurp(dir / "la" / "trajectory_scans.tum"), slurp(dir / "lx" / "trajectory_scans.tum"));
+  EXPECT_NE(searched.err.find("searched in the file's 2 maps, separate map 1 went on"), std::string::npos) << searched.err;
   const CliResult no_such = runCli("localize --map " + (dir / "x").string() + " --separate-map 2 " + intel);
   EXPECT_EQ(no_such.code, 2);
   EXPECT_NE(no_such.err.find("--separate-map 2: " + (dir / "x" / "map.usmap").string() + " holds 1 separate map"), std::string::npos)

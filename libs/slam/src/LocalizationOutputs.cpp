@@ -31,6 +31,7 @@ common::Json localizationStats(const std::vector<LocalizedScan>& scans, const Lo
   Json j = Json::object();
   j["map"] = info.map_path;
   if (info.separate_map > 0) j["separate_map"] = info.separate_map;
+  if (info.maps_searched > 1) j["maps_searched"] = info.maps_searched;
   j["input"] = info.input_path;
   j["input_format"] = info.input_format;
   if (info.initial_pose_given) {

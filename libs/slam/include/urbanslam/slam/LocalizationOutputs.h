@@ -20,7 +20,8 @@ extern const char* const kLocalizationCsvHeader;
 
 struct LocalizationInfo {
   std::string map_path, input_path, input_format;
-  size_t separate_map = 0;  // which of the file's maps: 0 the first, k its k-th separate map (MapFile.h)
+  size_t separate_map = 0;   // which of the file's maps: 0 the first, k its k-th separate map (MapFile.h)
+  size_t maps_searched = 1;  // the file's maps the log was searched in (LocalizeInMaps.h) when none was named
   bool initial_pose_given = false;
   common::Pose2 initial_pose;
   double wall_s = 0;  // the whole run: reading the map and the log included
