@@ -14,7 +14,7 @@
 #include "model/LocalizationWorker.h"
 #include "urbanslam/common/Error.h"
 #include "urbanslam/io/DataSource.h"
-#include "urbanslam/slam/Localizer.h"
+#include "urbanslam/slam/LocalizeInMaps.h"
 #include "urbanslam/slam/MapFile.h"
 
 using namespace urbanslam;
@@ -46,7 +46,7 @@ TEST(LocalizationWorker, LocalizesLikeTheBatchLocalizerAndDrawsTheMapAndThePath)
   loaded->finish();
   slam::Localizer batch(loaded->map(), loaded->options(), slam::localizerOptions(loaded->options()));
   auto src = io::openDataSource(kLog);
-  const auto expected = slam::localize(batch, *src);
+  const auto expected = slam::localizeInMaps({&batch}, *src).scans;
   ASSERT_GT(expected.size(), 50u);
   size_t expected_poses = 0, expected_lost = 0;
   for (const auto& r : expected) {

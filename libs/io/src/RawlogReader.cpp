@@ -16,7 +16,6 @@
 
 #include <algorithm>
 #include <array>
-#include <stdexcept>
 #include <cctype>
 #include <cstdio>
 #include <cstring>
@@ -24,6 +23,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 
 #include "ActionCollection.h"
 #include "AllocationLimit.h"

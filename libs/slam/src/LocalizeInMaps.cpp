@@ -21,19 +21,18 @@ MapsLocalization localizeInMaps(const std::vector<Localizer*>& localizers, io::D
       continue;
     }
     // Every localizer takes the measurement (their maps' input options may differ: each keeps
-    // the scans it used).
+    // the scans it used). Shown: the first localizer's result until one finds its place.
     std::optional<size_t> found;
-    bool any = false;
+    std::optional<LocalizedScan> first;
     for (size_t k = 0; k < localizers.size(); ++k) {
       if (auto r = localizers[k]->add(m)) {
-        scans[k].push_back(*r);
-        any = true;
         if (!found && r->state == LocalizationState::Tracking) found = k;
+        if (k == 0) first = *r;
+        scans[k].push_back(std::move(*r));
       }
     }
-    if (found) chosen = found;
-    const size_t shown = found.value_or(0);
-    if (any && on_scan && !scans[shown].empty()) on_scan(scans[shown].back(), source.progress());
+    chosen = found;
+    if (on_scan && (found || first)) on_scan(found ? scans[*found].back() : *first, source.progress());
   }
   const size_t k = chosen.value_or(0);
   return {k, std::move(scans[k])};

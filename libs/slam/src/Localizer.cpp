@@ -57,15 +57,20 @@ void Localizer::setInitialPose(const common::Pose2& pose) {
   confirmed_ = false;
 }
 
-void Localizer::setPose(const common::Pose2& pose, const Eigen::Matrix3d& cov) {
-  pose_ = pose;
-  cov_ = 0.5 * (cov + cov.transpose());
+Eigen::Matrix3d Localizer::withFloors(const Eigen::Matrix3d& cov) const {
   // The matcher's posterior alone would shrink without bound over many matches against the same
   // map, which has errors of its own.
+  Eigen::Matrix3d out = 0.5 * (cov + cov.transpose());
   const double sxy = options_.min_sigma_xy_m, sphi = options_.min_sigma_deg * kDeg;
-  cov_(0, 0) = std::max(cov_(0, 0), sxy * sxy);
-  cov_(1, 1) = std::max(cov_(1, 1), sxy * sxy);
-  cov_(2, 2) = std::max(cov_(2, 2), sphi * sphi);
+  out(0, 0) = std::max(out(0, 0), sxy * sxy);
+  out(1, 1) = std::max(out(1, 1), sxy * sxy);
+  out(2, 2) = std::max(out(2, 2), sphi * sphi);
+  return out;
+}
+
+void Localizer::setPose(const common::Pose2& pose, const Eigen::Matrix3d& cov) {
+  pose_ = pose;
+  cov_ = withFloors(cov);
   have_pose_ = true;
 }
 
@@ -165,8 +170,7 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
       // Taken alone, the spread along a direction the map hardly constrains (the far end of a
       // corridor) grew the covariance scan after scan, 2 cm to 46 cm in a second on Intel, until
       // a match jumped 0.4 m to a look-alike and back.
-      setPose(r.pose, options_.covariance_scale * r.cov);
-      const Eigen::Matrix3d match_cov = cov_ + r.spread;
+      const Eigen::Matrix3d match_cov = withFloors(options_.covariance_scale * r.cov) + r.spread;
       setPose(r.pose, (predicted_cov.inverse() + match_cov.inverse()).inverse());
       // The correction is the difference of two estimates of the pose, each with its own error:
       // the prediction's, and the match's against the map, which is at least the map's own
@@ -261,19 +265,6 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
   }
   have_scan_ = true;
   last_scan_time_ = t;
-  return out;
-}
-
-std::vector<LocalizedScan> localize(Localizer& localizer, io::DataSource& source,
-                                    const std::function<void(const LocalizedScan&, double progress)>& on_scan) {
-  std::vector<LocalizedScan> out;
-  io::Measurement m;
-  while (source.next(m)) {
-    if (auto r = localizer.add(m)) {
-      if (on_scan) on_scan(*r, source.progress());
-      out.push_back(*r);
-    }
-  }
   return out;
 }
 

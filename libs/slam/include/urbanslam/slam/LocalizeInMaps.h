@@ -18,9 +18,10 @@ struct MapsLocalization {
   std::vector<LocalizedScan> scans;  // its results, from the first scan
 };
 
-// `localizers`: one per map, none given an initial pose (at least one). on_scan (optional) sees
-// each result of the first localizer until one is chosen, then the chosen one's, with the
-// source's progress.
+// `localizers`: one per map, none given an initial pose when there are several; a single one
+// simply localizes the whole log (it may have an initial pose). on_scan (optional) sees each
+// result of the first localizer until one is chosen, then the chosen one's, with the source's
+// progress.
 MapsLocalization localizeInMaps(const std::vector<Localizer*>& localizers, io::DataSource& source,
                                 const std::function<void(const LocalizedScan&, double progress)>& on_scan = {});
 

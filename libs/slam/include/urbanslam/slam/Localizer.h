@@ -20,7 +20,6 @@
 // may lie (and where no mapped place is within reach, nothing is searched at all). A fix found
 // that way inherits the confirmation; a pose the map never confirmed (a given initial pose, a fix
 // from the whole map not yet tracked) vetoes nothing.
-#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -28,7 +27,6 @@
 #include <Eigen/Core>
 
 #include "urbanslam/alignment/SeenThroughRate.h"
-#include "urbanslam/io/DataSource.h"
 #include "urbanslam/io/Measurements.h"
 #include "urbanslam/slam/InputFilter.h"
 #include "urbanslam/slam/Map.h"
@@ -128,7 +126,9 @@ class Localizer {
  private:
   LocalizedScan onScan(io::LaserScan scan);
   bool placeSearchDue(double t) const;
+  // The pose and its covariance, floored (withFloors).
   void setPose(const common::Pose2& pose, const Eigen::Matrix3d& cov);
+  Eigen::Matrix3d withFloors(const Eigen::Matrix3d& cov) const;
 
   const Map& map_;
   LocalizerOptions options_;
@@ -167,10 +167,5 @@ class Localizer {
   common::Pose2 last_search_odometry_;
   LocalizerStats stats_;
 };
-
-// Localizes every measurement of `source`; on_scan (optional) sees each result with the
-// source's progress.
-std::vector<LocalizedScan> localize(Localizer& localizer, io::DataSource& source,
-                                    const std::function<void(const LocalizedScan&, double progress)>& on_scan = {});
 
 }  // namespace urbanslam::slam
