@@ -145,15 +145,15 @@ std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const Map& map
 
 // A wrong closure is usually a wrong local minimum (aliasing along a corridor or a facade) that
 // the drifted estimate happened to start PL-ICP in. Restarts from the result shifted along each
-// axis by ambiguity_offset_m, then twice, four and eight times that, as far as the innovation
-// gate could admit such a shift (3 sigma of the relative position): if one converges elsewhere
-// and matches clearly more points, the alignment is not the best explanation of the two scans.
-bool LoopCloser::ambiguous(esdf::Esdf& filter, const alignment::IndexedReference& earlier_points, const alignment::PointSet& current_points,
-                           size_t earlier, size_t current, const alignment::AlignmentResult& a, alignment::AlignerOptions ao) {
-  const double reach = 3 * largestPositionSigma(relativeCovariance(filter, earlier, current));
+// axis by ambiguity_offset_m, then twice, four and eight times that, as far as reach_m (for a
+// closure, 3 sigma of the relative position: what the innovation gate could admit): if one
+// converges elsewhere and matches clearly more points, the alignment is not the best
+// explanation of the two scans.
+bool LoopCloser::ambiguous(const alignment::IndexedReference& earlier_points, const alignment::PointSet& current_points,
+                           const alignment::AlignmentResult& a, alignment::AlignerOptions ao, double reach_m) const {
   ao.method = alignment::Method::PlIcp;
   const auto& t = a.transform;
-  for (double d = options_.ambiguity_offset_m; d <= 8 * options_.ambiguity_offset_m && 0.5 * d <= reach; d *= 2) {
+  for (double d = options_.ambiguity_offset_m; d <= 8 * options_.ambiguity_offset_m && 0.5 * d <= reach_m; d *= 2) {
     for (const common::Pose2& g : {common::Pose2{t.x + d, t.y, t.phi}, common::Pose2{t.x - d, t.y, t.phi},
                                    common::Pose2{t.x, t.y + d, t.phi}, common::Pose2{t.x, t.y - d, t.phi}}) {
       const auto b = alignment::alignPointSets(earlier_points, current_points, g, ao);
@@ -164,6 +164,35 @@ bool LoopCloser::ambiguous(esdf::Esdf& filter, const alignment::IndexedReference
     }
   }
   return false;
+}
+
+alignment::AlignmentResult LoopCloser::verifyAlignment(const io::LaserScan& earlier_scan, const io::LaserScan& current_scan,
+                                                       const common::Pose2& guess, alignment::Method method, double reach_m,
+                                                       LoopClosureRecord& r) const {
+  alignment::AlignerOptions ao;
+  ao.min_constraint_ratio = options_.min_constraint_ratio;
+  ao.method = method;
+  // The point sets, kd-tree and line normals built once for every alignment below (the
+  // ambiguity test restarts PL-ICP up to 16 times).
+  const alignment::IndexedReference earlier_points(alignment::pointSetFromScan(earlier_scan, ao.scan, ao.in_vehicle_frame));
+  const alignment::PointSet current_points = alignment::pointSetFromScan(current_scan, ao.scan, ao.in_vehicle_frame);
+  const alignment::AlignmentResult a = alignment::alignPointSets(earlier_points, current_points, guess, ao);
+  r.measurement = a.transform;
+  r.rms_m = a.rms_residual_m;
+  if (!a.converged || a.rms_residual_m > options_.max_rms_m || a.matchedFraction() < options_.min_matched_fraction) {
+    r.reason = ClosureReason::Alignment;
+    return a;
+  }
+  if (options_.ambiguity_offset_m > 0 && ambiguous(earlier_points, current_points, a, ao, reach_m)) {
+    r.reason = ClosureReason::Ambiguous;
+    return a;
+  }
+  alignment::FreeSpaceOptions fo;
+  fo.margin_m = options_.free_space_margin_m;
+  fo.no_return_free_m = options_.free_space_no_return_m;
+  r.free_space_conflict = alignment::mutualFreeSpaceConflict(earlier_scan, current_scan, a.transform, fo);
+  if (r.free_space_conflict > options_.max_free_space_conflict) r.reason = ClosureReason::FreeSpace;
+  return a;
 }
 
 LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current, bool commit,
@@ -178,57 +207,30 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_
   if (detection) r.score = detection->score;
   // Alignment from the current estimate of the relative pose.
   const esdf::Vec3 xi = filter.mean(static_cast<int>(earlier)), xk = filter.mean(static_cast<int>(current));
-  r.prior_sigma_m = largestPositionSigma(relativeCovariance(filter, earlier, current));
-  alignment::AlignerOptions ao;
-  ao.min_constraint_ratio = options_.min_constraint_ratio;
+  const Eigen::Matrix3d s = relativeCovariance(filter, earlier, current);
+  r.prior_sigma_m = largestPositionSigma(s);
+  alignment::Method method = alignment::Method::CrfIcp;
   if (options_.method == LoopClosureOptions::Method::Auto) {
     // A well-known relative pose needs only the fast local refinement (PL-ICP); a poorly known
     // one the global coarse alignment first (CRF-match, then ICP), as in the thesis.
-    const Eigen::Matrix3d s = relativeCovariance(filter, earlier, current);
     const double sxy = std::sqrt(std::max(s(0, 0), s(1, 1))), sphi = std::sqrt(s(2, 2));
-    ao.method = 3 * sxy < options_.auto_local_max_m && 3 * sphi < options_.auto_local_max_deg * M_PI / 180 ? alignment::Method::PlIcp
-                                                                                                           : alignment::Method::CrfIcp;
+    method = 3 * sxy < options_.auto_local_max_m && 3 * sphi < options_.auto_local_max_deg * M_PI / 180 ? alignment::Method::PlIcp
+                                                                                                        : alignment::Method::CrfIcp;
   } else {
     using M = LoopClosureOptions::Method;
     const M m = options_.method;
-    ao.method = m == M::Icp     ? alignment::Method::Icp
-                : m == M::PlIcp ? alignment::Method::PlIcp
-                : m == M::Crf   ? alignment::Method::Crf
-                                : alignment::Method::CrfIcp;
+    method = m == M::Icp     ? alignment::Method::Icp
+             : m == M::PlIcp ? alignment::Method::PlIcp
+             : m == M::Crf   ? alignment::Method::Crf
+                             : alignment::Method::CrfIcp;
   }
-  const common::Pose2 guess = esdf::toPose(esdf::between(xi, xk));
-  const auto good = [&](const alignment::AlignmentResult& a) {
-    return a.converged && a.rms_residual_m <= options_.max_rms_m && a.matchedFraction() >= options_.min_matched_fraction;
-  };
   // (Trying PL-ICP first on an uncertain guess was measured worse: it lands in wrong local
   // minima that pass the residual test — ATE 2.96 m vs 0.26 m on Intel.)
-  // The map keeps its scans compact (and maybe on disk): expanded once for this candidate, and
-  // its point sets, kd-tree and line normals built once for every alignment below (the
-  // ambiguity test restarts PL-ICP up to 16 times).
-  const io::LaserScan earlier_scan = map.scan(earlier), current_scan = map.scan(current);
-  const alignment::IndexedReference earlier_points(alignment::pointSetFromScan(earlier_scan, ao.scan, ao.in_vehicle_frame));
-  const alignment::PointSet current_points = alignment::pointSetFromScan(current_scan, ao.scan, ao.in_vehicle_frame);
-  const alignment::AlignmentResult a = alignment::alignPointSets(earlier_points, current_points, guess, ao);
-  r.measurement = a.transform;
-  r.rms_m = a.rms_residual_m;
-  const double matched = a.matchedFraction();
-  if (!detection) r.score = matched;
-  if (!good(a)) {
-    r.reason = ClosureReason::Alignment;
-    return r;
-  }
-  if (options_.ambiguity_offset_m > 0 && ambiguous(filter, earlier_points, current_points, earlier, current, a, ao)) {
-    r.reason = ClosureReason::Ambiguous;
-    return r;
-  }
-  alignment::FreeSpaceOptions fo;
-  fo.margin_m = options_.free_space_margin_m;
-  fo.no_return_free_m = options_.free_space_no_return_m;
-  r.free_space_conflict = alignment::mutualFreeSpaceConflict(earlier_scan, current_scan, a.transform, fo);
-  if (r.free_space_conflict > options_.max_free_space_conflict) {
-    r.reason = ClosureReason::FreeSpace;
-    return r;
-  }
+  // The map keeps its scans compact (and maybe on disk): expanded once for this candidate.
+  const common::Pose2 guess = esdf::toPose(esdf::between(xi, xk));
+  const alignment::AlignmentResult a = verifyAlignment(map.scan(earlier), map.scan(current), guess, method, 3 * r.prior_sigma_m, r);
+  if (!detection) r.score = a.matchedFraction();
+  if (r.reason != ClosureReason::None) return r;
   // Innovation gate, then the information-form update.
   const esdf::Mat3 cov = options_.covariance_scale * a.cov;
   r.information = cov.inverse();

@@ -100,6 +100,13 @@ class LoopCloser {
   LoopClosureRecord tryCloseMeasured(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current, const esdf::Vec3& z,
                                      const Eigen::Matrix3d& information, bool commit, const Detection& detection);
 
+  // The checks of a closure that need no estimate, for two scans aligned from `guess` by
+  // `method`: the alignment's residual and matched share, the ambiguity restarts as far as
+  // reach_m, the free-space test. Fills r's measurement, rms_m, free_space_conflict and (when it
+  // fails) reason; returns the alignment, its covariance not scaled yet. A place found with no
+  // estimate at all (another session's scan) is checked by this alone.
+  alignment::AlignmentResult verifyAlignment(const io::LaserScan& earlier, const io::LaserScan& current, const common::Pose2& guess,
+                                             alignment::Method method, double reach_m, LoopClosureRecord& r) const;
   // The relative covariances kept for the current keyframe (a later image proposal for it
   // reuses them). The scorer is code: whoever set it sets it again.
   void writeState(common::BinaryWriter& w) const;
@@ -107,8 +114,8 @@ class LoopCloser {
 
  private:
   Eigen::Matrix3d relativeCovariance(esdf::Esdf& filter, size_t i, size_t k);
-  bool ambiguous(esdf::Esdf& filter, const alignment::IndexedReference& earlier_points, const alignment::PointSet& current_points,
-                 size_t earlier, size_t current, const alignment::AlignmentResult& a, alignment::AlignerOptions ao);
+  bool ambiguous(const alignment::IndexedReference& earlier_points, const alignment::PointSet& current_points,
+                 const alignment::AlignmentResult& a, alignment::AlignerOptions ao, double reach_m) const;
 
   LoopClosureOptions options_;
   CandidateScorer scorer_;
