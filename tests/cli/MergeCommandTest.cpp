@@ -38,7 +38,7 @@ TEST(MergeCommand, JoinsTheMapsOfTwoHalvesOfALog) {
   ASSERT_EQ(merged.code, 0) << merged.err;
   EXPECT_NE(merged.out.find("\"sessions\":[{"), std::string::npos);
   EXPECT_NE(merged.out.find("\"joined\":true"), std::string::npos);
-  EXPECT_GE(jsonNumber(merged.out, "fixes_agreeing"), 4);
+  EXPECT_GE(jsonNumber(merged.out, "scans_agreeing"), 4);
   for (const char* f : {"map.usmap", "trajectory_scans.tum", "grid.png", "pose_graph.g2o", "stats.json"})
     EXPECT_TRUE(fs::exists(dir / "m" / f)) << f;
 

@@ -88,7 +88,7 @@ void twoMapsAreJoinedWhereTheFullRunHasThemAndKeepEachSessionsAccuracy(Sessions&
   const auto first_alone = byPart(*s.first, split), second_alone = byPart(*s.second, split);
   const slam::SessionJoin join = slam::findSessionJoin(s.first->map(), s.first->options(), s.second->map());
   ASSERT_TRUE(join.joined) << join.reason;
-  EXPECT_GE(join.agreeing.size(), 4u);
+  EXPECT_GE(join.agreeing_scans, 4u);
   double worst_m = 0, worst_deg = 0;
   for (size_t i : join.agreeing) {
     const slam::Keyframe& k = s.second->keyframes()[join.fixes[i].keyframe];
@@ -135,7 +135,7 @@ void aLogMappedIntoAMapMeetsTheRelationsAsTheFullRunDoes(Sessions& s) {
     slam::Pipeline intel(slam::PipelineOptions{});
     intel.runInput(*io::openDataSource(test::repoPath("rawlogs/intel-corrected-excerpt.log.gz")));
     const slam::SessionJoin other = slam::findSessionJoin(s.first->map(), s.first->options(), intel.map());
-    EXPECT_FALSE(other.joined) << other.agreeing.size() << " agreeing fixes of " << other.fixes.size();
+    EXPECT_FALSE(other.joined) << other.agreeing_scans << " scans support a join (" << other.fixes.size() << " fixes)";
     EXPECT_GT(other.probes, 10u);
   }
   test::SkippingSource rest(io::openDataSource(excerpt()), s.first->stats().measurements);

@@ -209,10 +209,11 @@ void GlobalSlam::closeLoops(size_t current, SteadyTime handed_over) {
   stats_.closure_ms.push_back(sw.milliseconds());
 }
 
-void GlobalSlam::addPlaceFix(size_t earlier, size_t current, const common::Pose2& z, const Eigen::Matrix3d& information, double score) {
+void GlobalSlam::addPlaceFix(size_t earlier, size_t current, const common::Pose2& z, const Eigen::Matrix3d& information, double score,
+                             const std::string& detector) {
   if (!map_.filter()) return;
   ++stats_.closures_tried;
-  const Detection detection{"place", score};
+  const Detection detection{detector, score};
   LoopClosureRecord r = closer_.tryCloseMeasured(*map_.filter(), map_, earlier, current, esdf::toVec(z), information, true, detection);
   if (r.accepted) map_.addEdge({earlier, current, r.measurement, r.information, true});
   reportClosure(r);

@@ -10,6 +10,10 @@ common::Json sessionJson(const std::string& name, const SessionJoin& join, size_
   j["place_searches"] = join.probes;
   j["fixes"] = join.fixes.size();
   j["fixes_agreeing"] = join.agreeing.size();
+  j["scans_agreeing"] = join.agreeing_scans;
+  size_t by_classifier = 0;
+  for (const SessionFix& f : join.fixes) by_classifier += f.detector == "laser" ? 1 : 0;
+  j["fixes_laser"] = by_classifier;
   j["fixes_rival"] = join.rival;
   if (join.joined) {
     common::Json t = common::Json::object();

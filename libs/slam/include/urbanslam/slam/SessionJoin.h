@@ -1,15 +1,32 @@
 #pragma once
 // Where another session's map lies in this one, with no prior: the other session's keyframe
 // scans, one every probe_spacing_m of its path, are each searched for in the whole map by place
-// recognition (PlaceRecognizer, as `localize` does at its start). Every fix gives a transform
-// from the session's frame to the map's. One fix can be a look-alike place (a repeated facade,
-// a corridor of identical doors); the session's own trajectory is what tells: fixes of the right
-// place agree on the transform, wrong ones scatter. The join is the largest set of fixes that
-// agree, accepted only when it has at least min_agreeing fixes spread over min_span_m of the
-// session's path, holds at least min_agreeing_share of all fixes, and no other set of
-// min_agreeing fixes disagrees with it (two places that both explain the session: no join
-// rather than a wrong one). The search stops at the first fix that makes the join: a log being
-// mapped is joined as early as it can be, and a finished session is searched coarse to fine.
+// recognition (PlaceRecognizer, as `localize` does at its start) in a map small enough for that
+// exhaustive search (a building). In a larger one (a city, where a street's scan also matches
+// all along the street within the search's range) and when the map uses the laser classifier,
+// the classifier's best detections among the map's keyframes are aligned with the scan from no
+// prior instead (CRF-match + ICP, then the loop closer's checks: residual, ambiguity, free
+// space), and each that passes is a fix. Every fix gives a transform from the session's frame
+// to the map's. One fix can be a look-alike place (a repeated facade, a corridor of identical
+// doors, a street like another); the session's own trajectory is what tells, in two ways, and
+// either joins:
+//  - agreement: fixes of the right place agree on the transform, wrong ones scatter. The set of
+//    agreeing fixes from the most scans joins when they are at least min_agreeing scans spread
+//    over min_span_m of the session's path and at least min_agreeing_share of the scans that
+//    gave a fix;
+//  - confirmation: each fix is checked where it predicts the session's other scans to be: the
+//    scans every check_spacing_m of the session's path within check_reach_m of it, placed by its
+//    transform, are aligned locally with the map's keyframe there (PL-ICP from the prediction);
+//    each lands where the fix puts it (it confirms the fix), elsewhere (it contradicts it) or
+//    does not align. Under a wrong fix the scans around come to places that look otherwise: a
+//    street's intersections and gaps fall elsewhere. The set of agreeing fixes that the most
+//    scans support (its fixes' own and their confirmations) joins when those are at least
+//    min_agreeing scans over min_span_m, at least min_agreeing_share of the scans that confirmed
+//    or contradicted it, and one of its fixes has min_confirmations, most of its checks.
+// In both, no other set of fixes that disagrees with the join may have min_agreeing scans (two
+// places that both explain the session: no join rather than a wrong one). The search stops at
+// the first fix that makes the join: a log being mapped is joined as early as it can be (the
+// checks of its fixes go on as it grows), and a finished session is searched coarse to fine.
 #include <functional>
 #include <memory>
 #include <string>
@@ -18,6 +35,7 @@
 #include <Eigen/Core>
 
 #include "urbanslam/common/Pose2.h"
+#include "urbanslam/io/LaserScan.h"
 #include "urbanslam/slam/Map.h"
 #include "urbanslam/slam/PipelineOptions.h"
 
@@ -34,14 +52,40 @@ struct SessionJoinOptions {
   int min_agreeing = 4;
   double min_span_m = 6.0;  // of the session's path between the first and last agreeing fix
   double min_agreeing_share = 0.5;
+  // The exhaustive place search only in maps of at most this many search windows (PlaceRecognizer:
+  // one per 2 m cell the map's keyframes visited): its time grows faster than the map.
+  int place_search_max_windows = 150;
+  // Beyond that: the laser classifier's best detections aligned per scan, one per place (the
+  // map's [loop_closure] search_radius_m apart); 0: none. Used when the map's [loop_closure]
+  // detector is laser.
+  int appearance_candidates = 3;
+  // The checks of each fix along the session's path: a scan every check_spacing_m within
+  // check_reach_m before and after it, aligned with the map's keyframe nearest to where the fix
+  // puts it (within the map's [loop_closure] search_radius_m and facing within check_max_deg:
+  // one that sees the same side).
+  double check_spacing_m = 5.0;
+  double check_reach_m = 50.0;
+  double check_max_deg = 45.0;
+  // A join by confirmation needs a fix that this many of the session's scans confirm, and at
+  // least min_agreeing_share of the scans checked against it (those that did not align
+  // included). In a city of look-alike streets a wrong fix can have 3 or 4 confirmations, but of
+  // 16 or more scans checked (the rest do not align there); a right one has 10 to 18 of 12 to 20.
+  int min_confirmations = 3;
 };
 
 struct SessionFix {
   size_t keyframe = 0;                                // the session's keyframe
   common::Pose2 pose;                                 // where it was found, map frame
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Identity();  // as the localizer takes a place search's answer
-  double margin_per_point = 0;
-  common::Pose2 transform;  // session frame -> map frame, from this fix
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Identity();  // place: as the localizer takes a match; laser: as a loop closure an alignment
+  std::string detector = "place";                     // who found it: the place search ("place") or the classifier and alignment ("laser")
+  double margin_per_point = 0;                        // place: the search's margin; laser: the classifier's
+  common::Pose2 transform;                            // session frame -> map frame, from this fix
+  std::vector<size_t> confirmed;                      // the session's keyframes whose scans landed where this fix puts them
+  std::vector<size_t> contradicted;                   // ... and those that did not, where the map has a keyframe to tell
+  std::vector<size_t> unaligned;                      // ... and those that did not align with the map's scan there
+  bool checked_back = false;                          // the earlier scans checked (by the fix's first check)
+  size_t checked_to = 0;                              // the last of the later keyframes looked at
+  double next_check_m = 0;                            // the session's path at which the next later scan is checked
 };
 
 struct SessionJoin {
@@ -51,10 +95,12 @@ struct SessionJoin {
   // Its uncertainty at the session's first keyframe: the agreement's tolerance, grown by the
   // drift allowance over the session's path from there to that fix.
   Eigen::Matrix3d transform_cov = Eigen::Matrix3d::Identity();
-  size_t probes = 0;              // place searches made
-  std::vector<SessionFix> fixes;  // every fix found
-  std::vector<size_t> agreeing;   // indices into fixes: the join's
-  size_t rival = 0;               // the largest set of fixes that disagrees with the join
+  size_t probes = 0;               // place searches made
+  std::vector<SessionFix> fixes;   // every fix found
+  std::vector<size_t> agreeing;    // indices into fixes: the join's
+  size_t agreeing_scans = 0;       // the session's scans that support them (their own and their confirmations)
+  size_t contradicting_scans = 0;  // the session's scans checked against them that did not land where they say
+  size_t rival = 0;                // the session's scans of the largest set of fixes that disagrees with the join
 };
 
 // The search kept up to date while the session grows (a run that joins a map as it goes):
@@ -74,7 +120,10 @@ class SessionJoiner {
  private:
   void decide(const Map& session);
   void extendPath(const Map& session);
-  bool probe(const Map& session, size_t keyframe);  // true: joined now
+  bool probe(const Map& session, size_t keyframe);                   // true: joined now
+  void appearanceFixes(size_t keyframe, const io::LaserScan& scan);  // the classifier's, where the place search found none
+  void check(const Map& session, SessionFix& fix);                   // its confirmations and contradictions
+  bool addFixes(const Map& session, size_t first);                   // checks fixes[first..] and decides; true: joined now
 
   struct Search;
   std::unique_ptr<Search> search_;
