@@ -92,3 +92,51 @@ TEST(LocalizationWorker, BadInputGivesTheCliMessage) {
   EXPECT_THROW(gui::LocalizationWorker(not_a_map, kLog), common::InputError);
   EXPECT_THROW(gui::LocalizationWorker(excerptMap(d), (d / "missing.rawlog").string()), common::InputError);
 }
+
+// A file of two maps, the FR079 excerpt's first and the Intel excerpt's as a separate map (both
+// with FR079's ini, as one file's maps share their options): the Intel log is found in its own
+// map, which is drawn from then on, and the poses drawn are those the Intel map's localizer gives
+// alone from the scan at which it found its place.
+TEST(LocalizationWorker, SearchesEveryMapOfTheFileAndDrawsTheOneThatHoldsTheLog) {
+  const auto dir = test::scratchDir("gui_localization_maps");
+  const slam::PipelineOptions o = slam::loadPipelineOptions(test::repoPath("ini/fr079.ini"));
+  const auto mapOf = [&](const std::string& log, size_t scans) {
+    auto p = std::make_unique<slam::Pipeline>(o);
+    auto src = io::openDataSource(log);
+    while (p->stats().scans < scans && p->step(*src)) {
+    }
+    p->waitForGlobalSlam(*src);
+    return p;
+  };
+  const auto fr079 = mapOf(test::repoPath("rawlogs/fr079-raw-excerpt.clf.gz"), 300), intel = mapOf(kLog, 100000);
+  const std::string file = (dir / "map.usmap").string();
+  slam::saveMap(*fr079, file, {intel.get()});
+
+  // The reference: the Intel map's localizer alone, on the map as saved and loaded.
+  std::vector<std::unique_ptr<slam::Pipeline>> separate;
+  auto loaded = slam::loadMap(file, nullptr, &separate);
+  ASSERT_EQ(separate.size(), 1u);
+  separate[0]->finish();
+  slam::Localizer alone(separate[0]->map(), separate[0]->options(), slam::localizerOptions(separate[0]->options()));
+  auto src = io::openDataSource(kLog);
+  const auto expected = slam::localizeInMaps({&alone}, *src).scans;
+  size_t found = 0;
+  while (found < expected.size() && expected[found].state != slam::LocalizationState::Tracking) ++found;
+  ASSERT_LT(found, expected.size() / 2);
+  size_t expected_poses = 0;
+  for (size_t i = found; i < expected.size(); ++i) expected_poses += expected[i].has_pose;
+
+  gui::LocalizationWorker w(file, kLog);
+  EXPECT_EQ(w.snapshot().keyframes.size(), fr079->keyframes().size());  // the first map until the log is found
+  w.play();
+  ASSERT_TRUE(waitFor([&] { return w.finished(); }, 240s));
+  EXPECT_EQ(w.error(), "");
+  const gui::MapSnapshot s = w.snapshot();
+  EXPECT_EQ(s.keyframes.size(), intel->keyframes().size());
+  EXPECT_EQ(s.stats.scans, expected.size());
+  ASSERT_EQ(s.localized.size(), expected_poses);
+  ASSERT_FALSE(s.localized.empty());
+  EXPECT_NEAR(s.localized.front().pose.x, expected[found].pose.x, 1e-9);
+  EXPECT_NEAR(s.localized.back().pose.x, expected.back().pose.x, 1e-9);
+  EXPECT_NEAR(s.localized.back().pose.y, expected.back().pose.y, 1e-9);
+}

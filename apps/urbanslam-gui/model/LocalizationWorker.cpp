@@ -8,17 +8,37 @@ namespace urbanslam::gui {
 
 LocalizationWorker::LocalizationWorker(const std::string& map_path, const std::string& log_path)
     : map_path_(slam::mapFilePath(map_path)), log_path_(log_path) {
-  map_ = slam::loadMap(map_path_);
-  map_->finish();  // the final estimates of the map's keyframes, as `localize` uses them
-  if (map_->keyframes().empty()) throw common::InputError(map_path_ + ": the map has no keyframes");
+  std::vector<std::unique_ptr<slam::Pipeline>> separate;
+  maps_.push_back(slam::loadMap(map_path_, nullptr, &separate));
+  for (auto& p : separate) maps_.push_back(std::move(p));
+  for (size_t k = 0; k < maps_.size(); ++k) {
+    maps_[k]->finish();  // the final estimates of the map's keyframes, as `localize` uses them
+    if (maps_[k]->keyframes().empty())
+      throw common::InputError(map_path_ + ": " + (k == 0 ? "the map" : "a separate map") + " has no keyframes");
+  }
   source_ = io::openDataSource(log_path);
-  localizer_ = std::make_unique<slam::Localizer>(map_->map(), map_->options(), slam::localizerOptions(map_->options()));
+  std::vector<slam::Localizer*> running;
+  for (const auto& p : maps_) {
+    localizers_.push_back(std::make_unique<slam::Localizer>(p->map(), p->options(), slam::localizerOptions(p->options())));
+    running.push_back(localizers_.back().get());
+  }
+  localizer_ = std::make_unique<slam::MapsLocalizer>(running);
   state_.localizing = true;
-  for (const auto& k : map_->keyframes()) {
-    auto pts = std::make_shared<const std::vector<io::Point2>>(k.hasScan() ? io::scanToPoints(map_->map().scan(k.index), true) : std::vector<io::Point2>{});
-    state_.keyframes.push_back({k.index, k.timestamp, k.pose, std::move(pts), nullptr});
+  drawMap(0);
+}
+
+void LocalizationWorker::drawMap(size_t k) {
+  const slam::Pipeline& map = *maps_[k];
+  state_.keyframes.clear();
+  for (const auto& kf : map.keyframes()) {
+    auto pts = std::make_shared<const std::vector<io::Point2>>(kf.hasScan() ? io::scanToPoints(map.map().scan(kf.index), true)
+                                                                            : std::vector<io::Point2>{});
+    state_.keyframes.push_back({kf.index, kf.timestamp, kf.pose, std::move(pts), nullptr});
   }
   state_.stats.keyframes = state_.keyframes.size();
+  // The poses shown so far were in the map drawn before, lost: they mean nothing in this one.
+  state_.localized.clear();
+  drawn_ = k;
   ++state_.version;
 }
 
@@ -64,6 +84,7 @@ PacedRunner::Step LocalizationWorker::step() {
     return s;
   }
   if (!r) return s;  // odometry: nothing to show, no pause
+  if (localizer_->shown() != drawn_) drawMap(localizer_->shown());
   record(*r, step_ms);
   s.unit_done = true;
   s.paced = true;

@@ -2,13 +2,18 @@
 // Localizes a log in a saved map (map.usmap) on its own thread, with the same play / pause /
 // step / speed controls as PipelineWorker: the map's keyframes are drawn as they were saved, and
 // the vehicle's pose in them scan by scan, tracked or lost (what `urbanslam localize` computes).
+// A file that holds separate maps is searched as `localize` searches it when no map is named:
+// every map side by side until one finds the log's place; the first map is drawn until then,
+// the one that found it from then on.
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "MapSnapshot.h"
 #include "PacedRunner.h"
 #include "urbanslam/io/DataSource.h"
+#include "urbanslam/slam/LocalizeInMaps.h"
 #include "urbanslam/slam/Localizer.h"
 #include "urbanslam/slam/Pipeline.h"
 
@@ -38,11 +43,14 @@ class LocalizationWorker {
  private:
   PacedRunner::Step step();
   void record(const slam::LocalizedScan& r, double step_ms);  // under mutex_
+  void drawMap(size_t k);                                     // under mutex_: map k's keyframes
 
   std::string map_path_, log_path_;
-  std::unique_ptr<slam::Pipeline> map_;  // the loaded map; read only
+  std::vector<std::unique_ptr<slam::Pipeline>> maps_;  // the file's maps, the first first; read only
   std::unique_ptr<io::DataSource> source_;
-  std::unique_ptr<slam::Localizer> localizer_;
+  std::vector<std::unique_ptr<slam::Localizer>> localizers_;  // one per map
+  std::unique_ptr<slam::MapsLocalizer> localizer_;
+  size_t drawn_ = 0;  // the map drawn
 
   mutable std::mutex mutex_;  // guards error_ and state_
   std::string error_;

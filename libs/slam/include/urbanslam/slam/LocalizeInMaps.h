@@ -6,6 +6,7 @@
 // Until then the others cost their place searches (while lost, each searches at most every few
 // seconds of log time). A log found in none of the maps stays with the first, lost throughout.
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "urbanslam/io/DataSource.h"
@@ -13,15 +14,35 @@
 
 namespace urbanslam::slam {
 
+// One measurement at a time (a viewer steps it).
+class MapsLocalizer {
+ public:
+  // `localizers`: one per map, none given an initial pose when there are several; a single one
+  // simply localizes the whole log (it may have an initial pose). They must outlive this.
+  explicit MapsLocalizer(std::vector<Localizer*> localizers);
+  // The measurement to every localizer until one is chosen, then to that one. Returns the result
+  // to show for it: the chosen localizer's (from the measurement at which it found its place),
+  // before that the first localizer's; none for a measurement that is not a scan.
+  std::optional<LocalizedScan> add(const io::Measurement& m);
+  // The localizer that went on, or the first while none has found its place.
+  size_t shown() const { return chosen_.value_or(0); }
+  bool chosen() const { return chosen_.has_value(); }
+  // Every result of localizer k so far, from the log's first scan.
+  std::vector<LocalizedScan>& scans(size_t k) { return scans_.at(k); }
+
+ private:
+  std::vector<Localizer*> localizers_;
+  std::vector<std::vector<LocalizedScan>> scans_;
+  std::optional<size_t> chosen_;
+};
+
 struct MapsLocalization {
   size_t map = 0;                    // the localizer that went on (an index into the localizers)
   std::vector<LocalizedScan> scans;  // its results, from the first scan
 };
 
-// `localizers`: one per map, none given an initial pose when there are several; a single one
-// simply localizes the whole log (it may have an initial pose). on_scan (optional) sees each
-// result of the first localizer until one is chosen, then the chosen one's, with the source's
-// progress.
+// The whole log through a MapsLocalizer. on_scan (optional) sees each result it shows, with the
+// source's progress.
 MapsLocalization localizeInMaps(const std::vector<Localizer*>& localizers, io::DataSource& source,
                                 const std::function<void(const LocalizedScan&, double progress)>& on_scan = {});
 
