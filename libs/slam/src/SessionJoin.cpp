@@ -295,31 +295,39 @@ void SessionJoiner::decide(const Map& session) {
     bool joined = false;
     std::string reason;
   };
+  // A fix most of whose checks landed where it puts them, min_confirmations at least.
+  const auto confirmedFix = [&](size_t j) {
+    const SessionFix& f = out.fixes[j];
+    const size_t yes = f.confirmed.size(), tried = yes + f.contradicted.size() + f.unaligned.size();
+    return static_cast<int>(yes) >= o.min_confirmations && static_cast<double>(yes) >= o.min_agreeing_share * static_cast<double>(tried);
+  };
   const auto judge = [&](const auto& count, bool need_confirmed) {
     Verdict v;
     std::vector<size_t> supported(n);
     for (size_t i = 0; i < n; ++i) supported[i] = count(agreeing[i]).support.size();
-    // The best set: the most scans, then the clearer fix.
+    // The best set: by confirmation, one around a confirmed fix if there is one (wrong fixes
+    // that agree loosely can gather more scans while the right one is young); the most scans,
+    // then the clearer fix.
+    const auto eligible = [&](size_t i) { return !need_confirmed || confirmedFix(i); };
+    const auto better = [&](size_t i, size_t b) {
+      if (eligible(i) != eligible(b)) return eligible(i);
+      return supported[i] > supported[b] || (supported[i] == supported[b] && out.fixes[i].margin_per_point > out.fixes[b].margin_per_point);
+    };
     for (size_t i = 1; i < n; ++i)
-      if (supported[i] > supported[v.best] ||
-          (supported[i] == supported[v.best] && out.fixes[i].margin_per_point > out.fixes[v.best].margin_per_point))
-        v.best = i;
+      if (better(i, v.best)) v.best = i;
     const std::vector<size_t>& set = agreeing[v.best];
     v.tally = count(set);
-    // The largest set among the fixes that disagree with the best one.
+    // The largest set among the fixes that disagree with the best one (by confirmation, only
+    // sets around a confirmed fix rival it: look-alike streets give unconfirmed ones anywhere).
     const auto inBest = [&](size_t i) { return std::find(set.begin(), set.end(), i) != set.end(); };
     for (size_t i = 0; i < n; ++i) {
-      if (inBest(i)) continue;
+      if (inBest(i) || !eligible(i)) continue;
       std::vector<size_t> outside;
       for (size_t j : agreeing[i])
         if (!inBest(j)) outside.push_back(j);
       v.rival = std::max(v.rival, count(outside).support.size());
     }
-    const bool confirmed = std::any_of(set.begin(), set.end(), [&](size_t j) {
-      const SessionFix& f = out.fixes[j];
-      const size_t yes = f.confirmed.size(), tried = yes + f.contradicted.size() + f.unaligned.size();
-      return static_cast<int>(yes) >= o.min_confirmations && static_cast<double>(yes) >= o.min_agreeing_share * static_cast<double>(tried);
-    });
+    const bool confirmed = eligible(v.best) && std::any_of(set.begin(), set.end(), confirmedFix);
     const size_t m = v.tally.support.size(), checked = m + v.tally.against.size();
     const double span = path_[*v.tally.support.rbegin()] - path_[*v.tally.support.begin()];
     if (static_cast<int>(m) < o.min_agreeing)
