@@ -57,11 +57,9 @@ void Localizer::setInitialPose(const common::Pose2& pose) {
   confirmed_ = false;
 }
 
-Eigen::Matrix3d Localizer::withFloors(const Eigen::Matrix3d& cov) const {
-  // The matcher's posterior alone would shrink without bound over many matches against the same
-  // map, which has errors of its own.
+Eigen::Matrix3d withFloors(const Eigen::Matrix3d& cov, const LocalizerOptions& options) {
   Eigen::Matrix3d out = 0.5 * (cov + cov.transpose());
-  const double sxy = options_.min_sigma_xy_m, sphi = options_.min_sigma_deg * kDeg;
+  const double sxy = options.min_sigma_xy_m, sphi = options.min_sigma_deg * kDeg;
   out(0, 0) = std::max(out(0, 0), sxy * sxy);
   out(1, 1) = std::max(out(1, 1), sxy * sxy);
   out(2, 2) = std::max(out(2, 2), sphi * sphi);
@@ -70,7 +68,7 @@ Eigen::Matrix3d Localizer::withFloors(const Eigen::Matrix3d& cov) const {
 
 void Localizer::setPose(const common::Pose2& pose, const Eigen::Matrix3d& cov) {
   pose_ = pose;
-  cov_ = withFloors(cov);
+  cov_ = withFloors(cov, options_);
   have_pose_ = true;
 }
 
@@ -170,7 +168,7 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
       // Taken alone, the spread along a direction the map hardly constrains (the far end of a
       // corridor) grew the covariance scan after scan, 2 cm to 46 cm in a second on Intel, until
       // a match jumped 0.4 m to a look-alike and back.
-      const Eigen::Matrix3d match_cov = withFloors(options_.covariance_scale * r.cov) + r.spread;
+      const Eigen::Matrix3d match_cov = withFloors(options_.covariance_scale * r.cov, options_) + r.spread;
       setPose(r.pose, (predicted_cov.inverse() + match_cov.inverse()).inverse());
       // The correction is the difference of two estimates of the pose, each with its own error:
       // the prediction's, and the match's against the map, which is at least the map's own
@@ -246,7 +244,8 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
       ++stats_.relocalisations;
       searched_ = false;
     } else {
-      search_interval_s_ = searched_ ? std::min(options_.relocalise_max_interval_s, 2 * search_interval_s_) : options_.relocalise_interval_s;
+      search_interval_s_ =
+          searched_ ? std::min(options_.relocalise_max_interval_s, 2 * search_interval_s_) : options_.relocalise_interval_s;
       searched_ = true;
       last_search_time_ = t;
       last_search_odometry_ = motion_.odometryPose();

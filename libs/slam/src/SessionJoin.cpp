@@ -119,14 +119,9 @@ bool SessionJoiner::probe(const Map& session, size_t k) {
     SessionFix f;
     f.keyframe = k;
     f.pose = h.pose;
-    // As the localizer takes a match (LocalizerOptions): scaled for the correlated errors of
-    // matches against the same map points, with floors for the map's own disagreements.
-    const LocalizerOptions& lo = search_->localizer;
-    f.cov = lo.covariance_scale * h.cov;
-    const double sxy = lo.min_sigma_xy_m, sphi = lo.min_sigma_deg * kDeg;
-    f.cov(0, 0) = std::max(f.cov(0, 0), sxy * sxy);
-    f.cov(1, 1) = std::max(f.cov(1, 1), sxy * sxy);
-    f.cov(2, 2) = std::max(f.cov(2, 2), sphi * sphi);
+    // As the localizer takes a match: scaled for the correlated errors of matches against the
+    // same map points, with floors for the map's own disagreements.
+    f.cov = withFloors(search_->localizer.covariance_scale * h.cov, search_->localizer);
     f.margin_per_point = h.margin_per_point;
     join_.fixes.push_back(f);
   }
@@ -140,7 +135,7 @@ bool SessionJoiner::addFixes(const Map& session, size_t first) {
   return join_.joined;
 }
 
-void SessionJoiner::check(const Map& session, SessionFix& f) {
+size_t SessionJoiner::check(const Map& session, SessionFix& f) {
   const Search& s = *search_;
   const Map& map = s.map;
   const auto& kf = session.keyframes();
@@ -178,6 +173,8 @@ void SessionJoiner::check(const Map& session, SessionFix& f) {
                        std::abs(wrap(landed.phi - predicted.phi)) <= o.agree_deg * kDeg;
     (lands ? f.confirmed : f.contradicted).push_back(j);
   };
+  const size_t before = f.confirmed.size() + f.contradicted.size() + f.unaligned.size();
+  const auto made = [&] { return f.confirmed.size() + f.contradicted.size() + f.unaligned.size() - before; };
   // The later scans as far as the session goes: a growing session's come in later calls, so the
   // checks of a fix found early go on as the session grows (checked_to, next_check_m).
   if (!f.checked_back) f.checked_to = f.keyframe, f.next_check_m = s0 + o.check_spacing_m;
@@ -185,11 +182,12 @@ void SessionJoiner::check(const Map& session, SessionFix& f) {
     f.checked_to = j;
     if (kf[j].hasScan() && path_[j] >= f.next_check_m) checkOne(j), f.next_check_m = path_[j] + o.check_spacing_m;
   }
-  if (f.checked_back) return;
+  if (f.checked_back) return made();
   f.checked_back = true;
   double next = s0 - o.check_spacing_m;
   for (size_t j = f.keyframe; j-- > 0 && s0 - path_[j] <= o.check_reach_m;)
     if (kf[j].hasScan() && path_[j] <= next) checkOne(j), next = path_[j] - o.check_spacing_m;
+  return made();
 }
 
 const SessionJoin& SessionJoiner::update(const Map& session, const std::function<void(double)>& progress) {
@@ -198,11 +196,7 @@ const SessionJoin& SessionJoiner::update(const Map& session, const std::function
   extendPath(session);
   // The fixes found so far, checked on the scans that came since.
   size_t checks = 0;
-  for (SessionFix& f : join_.fixes) {
-    const size_t before = f.confirmed.size() + f.contradicted.size();
-    check(session, f);
-    checks += f.confirmed.size() + f.contradicted.size() - before;
-  }
+  for (SessionFix& f : join_.fixes) checks += check(session, f);
   if (checks > 0) decide(session);
   // The session's scans searched for in the whole map, one every probe_spacing_m of its path,
   // until the join is found.

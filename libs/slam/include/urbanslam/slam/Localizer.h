@@ -82,6 +82,11 @@ struct LocalizerOptions {
 // The defaults, with the matcher, scan model and floors of the map's own [local] options.
 LocalizerOptions localizerOptions(const PipelineOptions& map_options);
 
+// A match's covariance with the options' floors (min_sigma_xy_m, min_sigma_deg): the matcher's
+// posterior alone would shrink without bound over many matches against the same map, which has
+// errors of its own. Symmetrised first.
+Eigen::Matrix3d withFloors(const Eigen::Matrix3d& cov, const LocalizerOptions& options);
+
 enum class LocalizationState { Tracking, Lost };
 const char* stateName(LocalizationState state);
 
@@ -128,7 +133,6 @@ class Localizer {
   bool placeSearchDue(double t) const;
   // The pose and its covariance, floored (withFloors).
   void setPose(const common::Pose2& pose, const Eigen::Matrix3d& cov);
-  Eigen::Matrix3d withFloors(const Eigen::Matrix3d& cov) const;
 
   const Map& map_;
   LocalizerOptions options_;

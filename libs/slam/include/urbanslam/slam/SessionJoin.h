@@ -69,7 +69,7 @@ struct SessionJoinOptions {
   // A join by confirmation needs a fix that this many of the session's scans confirm, and at
   // least min_agreeing_share of the scans checked against it (those that did not align
   // included). In a city of look-alike streets a wrong fix can have 3 or 4 confirmations, but of
-  // 16 or more scans checked (the rest do not align there); a right one has 10 to 18 of 12 to 20.
+  // 14 to 17 scans checked (the rest do not align there); a right one has 10 to 18 of 12 to 18.
   int min_confirmations = 3;
 };
 
@@ -122,7 +122,7 @@ class SessionJoiner {
   void extendPath(const Map& session);
   bool probe(const Map& session, size_t keyframe);                   // true: joined now
   void appearanceFixes(size_t keyframe, const io::LaserScan& scan);  // the classifier's, where the place search found none
-  void check(const Map& session, SessionFix& fix);                   // its confirmations and contradictions
+  size_t check(const Map& session, SessionFix& fix);                 // its checks on the scans not looked at yet; how many
   bool addFixes(const Map& session, size_t first);                   // checks fixes[first..] and decides; true: joined now
 
   struct Search;
