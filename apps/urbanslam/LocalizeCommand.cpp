@@ -65,12 +65,17 @@ int localizeCommand(const Argv& args) {
                "in every map of the file (the first with --initial)");
   ap.addOption("initial", "x,y,phi", "the vehicle's pose at the first scan in the map frame (m, m, rad); default: searched");
   ap.addOption("out", "DIR", "output folder (created if needed)", "out_localize");
+  ap.addFlag("no-smoothing",
+             "write the tracked poses as they were at each scan into trajectory_scans.tum too, and skip local SLAM's\n"
+             "trajectory of the log (faster; trajectory_online.tum holds those poses either way)");
   ap.addFlag("quiet", "no progress bar and no summary on stderr");
   ap.addFlag("json", "print stats.json as one JSON object on stdout");
   ap.addEpilog(
-      "outputs in DIR: trajectory_scans.tum (the tracked scans; `urbanslam eval DIR --relations F`\n"
-      "scores it), localization.csv (every scan: time, x, y, phi, covariance upper triangle xx xy xphi\n"
-      "yy yphi phiphi, state tracking|lost), stats.json (counts, time lost, relocalisations, wall time,\n"
+      "outputs in DIR: trajectory_scans.tum (the tracked scans, smoothed given the whole log: local SLAM's\n"
+      "motion between scans weighed against the map's matches; `urbanslam eval DIR --relations F` scores\n"
+      "it), trajectory_online.tum (the same scans as tracked at each scan), localization.csv (every\n"
+      "scan as tracked then: time, x, y, phi, covariance upper triangle xx xy xphi yy yphi phiphi, state\n"
+      "tracking|lost), stats.json (counts, time lost, relocalisations, wall time,\n"
       "real-time factor). DIR appears complete at the end; it is replaced only when it is empty or\n"
       "holds an earlier localization.");
   if (!ap.parse(args)) return 0;
@@ -85,6 +90,7 @@ int localizeCommand(const Argv& args) {
     info.initial_pose_given = true;
   }
   if (ap.has("separate-map")) info.separate_map = parseSeparateMap(ap.option("separate-map"));
+  info.smoothed = !ap.flag("no-smoothing");
   // Without a named map or an initial pose (which is in the first map's frame), every map of the
   // file is searched.
   const bool search_maps = !ap.has("separate-map") && !info.initial_pose_given;
@@ -119,12 +125,15 @@ int localizeCommand(const Argv& args) {
   if (info.initial_pose_given) localizers[0]->setInitialPose(info.initial_pose);
   common::ProgressBar bar("localize", 1000, !quiet);
   size_t shown_scans = 0, shown_fixes = 0;
-  slam::MapsLocalization result = slam::localizeInMaps(running, *source, [&](const slam::LocalizedScan& r, double progress) {
-    ++shown_scans;
-    shown_fixes += r.relocalised;
-    bar.update(static_cast<uint64_t>(progress * 1000), std::to_string(shown_scans) + " scans, " + slam::stateName(r.state) + ", " +
-                                                           std::to_string(shown_fixes) + " relocalisations");
-  });
+  slam::MapsLocalization result = slam::localizeInMaps(
+      running, *source,
+      [&](const slam::LocalizedScan& r, double progress) {
+        ++shown_scans;
+        shown_fixes += r.relocalised;
+        bar.update(static_cast<uint64_t>(progress * 1000), std::to_string(shown_scans) + " scans, " + slam::stateName(r.state) + ", " +
+                                                               std::to_string(shown_fixes) + " relocalisations");
+      },
+      info.smoothed ? &maps[0]->options() : nullptr);
   bar.finish();
   const slam::Localizer& localizer = *localizers[result.map];
   const std::vector<slam::LocalizedScan>& scans = result.scans;
@@ -135,7 +144,8 @@ int localizeCommand(const Argv& args) {
   if (scans.empty()) throw common::InputError(info.input_path + ": no laser scans the map's [input] options accept: nothing to localize");
   info.wall_s = wall.seconds();
   const std::string out = ap.option("out");
-  const common::Json stats = slam::writeLocalizationOutputs(scans, localizer.stats(), info, out);
+  info.smoothed = !result.smoothed.empty();
+  const common::Json stats = slam::writeLocalizationOutputs(scans, result.smoothed, localizer.stats(), info, out);
   if (ap.flag("json")) std::cout << stats.dump() << "\n";
   if (!quiet) {
     const auto& s = localizer.stats();

@@ -35,7 +35,14 @@ TEST(LocalizeCommand, LocalizesTheRestOfALogInTheMapOfItsFirstPart) {
   ASSERT_EQ(run.code, 0) << run.err;
   const CliResult loc = runCli("localize --quiet --json --map " + (dir / "map").string() + " --out " + (dir / "loc").string() + " " + rest);
   ASSERT_EQ(loc.code, 0) << loc.err;
-  for (const char* f : {"trajectory_scans.tum", "localization.csv", "stats.json"}) EXPECT_TRUE(fs::exists(dir / "loc" / f)) << f;
+  for (const char* f : {"trajectory_scans.tum", "trajectory_online.tum", "localization.csv", "stats.json"})
+    EXPECT_TRUE(fs::exists(dir / "loc" / f)) << f;
+  // The smoothed trajectory and the online one hold the same scans at different poses.
+  EXPECT_NE(loc.out.find("\"smoothed\":true"), std::string::npos);
+  const std::string smoothed = slurp((dir / "loc" / "trajectory_scans.tum").string());
+  const std::string online = slurp((dir / "loc" / "trajectory_online.tum").string());
+  EXPECT_EQ(std::count(smoothed.begin(), smoothed.end(), '\n'), std::count(online.begin(), online.end(), '\n'));
+  EXPECT_NE(smoothed, online);
   EXPECT_EQ(jsonNumber(loc.out, "scans_used"), 600);
   EXPECT_GT(jsonNumber(loc.out, "tracking"), 200);
   EXPECT_GE(jsonNumber(loc.out, "first_fix_s"), 0);
@@ -46,14 +53,17 @@ TEST(LocalizeCommand, LocalizesTheRestOfALogInTheMapOfItsFirstPart) {
   EXPECT_EQ(csv.rfind("time,x,y,phi,cov_xx,cov_xy,cov_xphi,cov_yy,cov_yphi,cov_phiphi,state", 0), 0u);
 
   // eval scores the folder as it scores a run: the tracked scans against the relations.
-  const CliResult eval =
-      runCli("eval " + (dir / "loc").string() + " --json --time-offset 0 --max-gap 1 --relations " + repoPath("rawlogs/fr079-raw-excerpt.relations"));
+  const CliResult eval = runCli("eval " + (dir / "loc").string() + " --json --time-offset 0 --max-gap 1 --relations " +
+                                repoPath("rawlogs/fr079-raw-excerpt.relations"));
   ASSERT_EQ(eval.code, 0) << eval.err;
   EXPECT_GT(jsonNumber(eval.out, "used"), 40);
   EXPECT_LT(jsonNumber(eval.out, "abs_trans_mean_m"), 0.06);
 
   // A second localization may replace the first's folder; a user's folder is never replaced.
-  EXPECT_EQ(runCli("localize --quiet --map " + (dir / "map").string() + " --out " + (dir / "loc").string() + " " + rest).code, 0);
+  // --no-smoothing writes the online poses as the trajectory.
+  EXPECT_EQ(
+      runCli("localize --quiet --no-smoothing --map " + (dir / "map").string() + " --out " + (dir / "loc").string() + " " + rest).code, 0);
+  EXPECT_EQ(slurp((dir / "loc" / "trajectory_scans.tum").string()), slurp((dir / "loc" / "trajectory_online.tum").string()));
   fs::create_directories(dir / "mine");
   writeFile(dir / "mine" / "notes.txt", "keep");
   EXPECT_EQ(runCli("localize --quiet --map " + (dir / "map").string() + " --out " + (dir / "mine").string() + " " + rest).code, 2);

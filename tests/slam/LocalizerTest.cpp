@@ -11,6 +11,7 @@
 #include "SkippingSource.h"
 #include "TestPaths.h"
 #include "urbanslam/evaluation/Evaluation.h"
+#include "urbanslam/slam/LocalizationSmoothing.h"
 #include "urbanslam/slam/Localizer.h"
 #include "urbanslam/slam/Pipeline.h"
 
@@ -48,6 +49,7 @@ const Maps& maps() {
 struct Localized {
   std::vector<slam::LocalizedScan> scans;
   slam::LocalizerStats stats;
+  std::vector<common::Pose2> smoothed;  // each scan's, by local SLAM's trajectory and the map's fixes
 };
 
 Localized localizeRest(const std::optional<common::Pose2>& initial, const std::string& log = excerpt(), size_t skip = maps().skip,
@@ -56,11 +58,15 @@ Localized localizeRest(const std::optional<common::Pose2>& initial, const std::s
   slam::Localizer localizer(map.map(), map.options(), slam::localizerOptions(map.options()));
   if (initial) localizer.setInitialPose(*initial);
   test::SkippingSource src(io::openDataSource(log), skip);
+  slam::LocalTrajectory local(map.options());
   Localized out;
   io::Measurement m;
-  while (out.scans.size() < max_scans && src.next(m))
+  while (out.scans.size() < max_scans && src.next(m)) {
+    local.add(m);
     if (auto r = localizer.add(m)) out.scans.push_back(*r);
+  }
   out.stats = localizer.stats();
+  out.smoothed = slam::smoothLocalization(local, out.scans, map.options().local.covariance_scale);
   return out;
 }
 
@@ -109,6 +115,20 @@ TEST(Localizer, TracksTheRestOfTheExcerptAsWellAsTheFullRunMapsIt) {
   // instead of fused with the prediction's, the rotations are 23 % worse (0.453° against 0.363°).
   EXPECT_LT(localized.abs_trans_m.mean, 1.1 * mapped.abs_trans_m.mean);
   EXPECT_LT(localized.abs_rot_deg.mean, 1.1 * mapped.abs_rot_deg.mean);
+  // The smoothed trajectory, at the same scans.
+  ASSERT_EQ(loc.smoothed.size(), loc.scans.size());
+  std::vector<io::StampedPose> smoothed;
+  for (size_t i = 0; i < loc.scans.size(); ++i)
+    if (loc.scans[i].state == slam::LocalizationState::Tracking) smoothed.push_back({loc.scans[i].timestamp, loc.smoothed[i]});
+  const auto smooth = evaluation::relationMetrics(smoothed, inside, 0.0, 0.5);
+  // Measured: 0.024 m and 0.32° against the online poses' 0.028 m and 0.36° (the full run: 0.037 m,
+  // 0.37°): local SLAM's motion between scans, where the online poses follow each map match.
+  EXPECT_LT(smooth.abs_trans_m.mean, 0.95 * localized.abs_trans_m.mean);
+  EXPECT_LT(smooth.abs_rot_deg.mean, 0.95 * localized.abs_rot_deg.mean);
+  std::vector<double> smoothed_errors;
+  for (const auto& p : smoothed) smoothed_errors.push_back(distance(p.pose, reference(p.timestamp)));
+  EXPECT_LT(percentileOf(smoothed_errors, 0.5), 0.06);
+  EXPECT_LT(percentileOf(smoothed_errors, 0.95), 0.2);
 
   std::vector<double> errors;
   for (const auto& p : traj) errors.push_back(distance(p.pose, reference(p.timestamp)));

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
 
 #include "urbanslam/common/AtomicFile.h"
 #include "urbanslam/common/AtomicFolder.h"
@@ -67,6 +68,7 @@ common::Json localizationStats(const std::vector<LocalizedScan>& scans, const Lo
   l["position_sigma_m_p95"] = common::percentile(sigma, 95);
   Json& t = j["timing"];
   const double duration = s.last_timestamp - s.first_timestamp;
+  l["smoothed"] = info.smoothed;
   t["wall_s"] = info.wall_s;
   t["localizer_wall_s"] = s.wall_s;
   t["place_search_wall_s"] = s.place_search_wall_s;
@@ -76,14 +78,21 @@ common::Json localizationStats(const std::vector<LocalizedScan>& scans, const Lo
   return j;
 }
 
-common::Json writeLocalizationOutputs(const std::vector<LocalizedScan>& scans, const LocalizerStats& stats, const LocalizationInfo& info,
-                                      const std::string& dir) {
+common::Json writeLocalizationOutputs(const std::vector<LocalizedScan>& scans, const std::vector<common::Pose2>& smoothed,
+                                      const LocalizerStats& stats, const LocalizationInfo& info, const std::string& dir) {
+  if (!smoothed.empty() && smoothed.size() != scans.size())
+    throw std::logic_error("writeLocalizationOutputs: smoothed poses do not match the scans");
   common::AtomicFolder folder(dir, isLocalizationFolder);
   const auto path = [&](const std::string& name) { return (fs::path(folder.stagingPath()) / name).string(); };
-  std::vector<io::StampedPose> tracked;
-  for (const auto& r : scans)
-    if (r.state == LocalizationState::Tracking) tracked.push_back({r.timestamp, r.pose});
+  std::vector<io::StampedPose> tracked, online;
+  for (size_t i = 0; i < scans.size(); ++i) {
+    const LocalizedScan& r = scans[i];
+    if (r.state != LocalizationState::Tracking) continue;
+    online.push_back({r.timestamp, r.pose});
+    tracked.push_back({r.timestamp, smoothed.empty() ? r.pose : smoothed[i]});
+  }
   io::writeTum(path("trajectory_scans.tum"), tracked);
+  io::writeTum(path("trajectory_online.tum"), online);
   // `urbanslam eval` reads a run's trajectory at odometry times too; a localization has its
   // poses at the tracked scans only.
   io::writeTum(path("trajectory_odometry.tum"), tracked);

@@ -2,14 +2,27 @@
 
 #include <stdexcept>
 
+#include "urbanslam/slam/LocalizationSmoothing.h"
+
 namespace urbanslam::slam {
 
-MapsLocalizer::MapsLocalizer(std::vector<Localizer*> localizers) : localizers_(std::move(localizers)), scans_(localizers_.size()) {
+MapsLocalizer::MapsLocalizer(std::vector<Localizer*> localizers, const PipelineOptions* smoothing_options)
+    : localizers_(std::move(localizers)), scans_(localizers_.size()) {
   if (localizers_.empty()) throw std::invalid_argument("MapsLocalizer: no localizer");
   if (localizers_.size() == 1) chosen_ = 0;
+  if (smoothing_options) {
+    trajectory_.emplace(*smoothing_options);
+    fix_covariance_scale_ = smoothing_options->local.covariance_scale;
+  }
+}
+
+std::vector<common::Pose2> MapsLocalizer::smoothed(size_t k) const {
+  if (!trajectory_) return {};
+  return smoothLocalization(*trajectory_, scans_.at(k), fix_covariance_scale_);
 }
 
 std::optional<LocalizedScan> MapsLocalizer::add(const io::Measurement& m) {
+  if (trajectory_) trajectory_->add(m);
   if (chosen_) {
     auto r = localizers_[*chosen_]->add(m);
     if (r) scans_[*chosen_].push_back(*r);
@@ -32,13 +45,15 @@ std::optional<LocalizedScan> MapsLocalizer::add(const io::Measurement& m) {
 }
 
 MapsLocalization localizeInMaps(const std::vector<Localizer*>& localizers, io::DataSource& source,
-                                const std::function<void(const LocalizedScan&, double progress)>& on_scan) {
-  MapsLocalizer maps(localizers);
+                                const std::function<void(const LocalizedScan&, double progress)>& on_scan,
+                                const PipelineOptions* smoothing_options) {
+  MapsLocalizer maps(localizers, smoothing_options);
   io::Measurement m;
   while (source.next(m))
     if (auto r = maps.add(m); r && on_scan) on_scan(*r, source.progress());
   const size_t k = maps.shown();
-  return {k, std::move(maps.scans(k))};
+  std::vector<common::Pose2> smoothed = maps.smoothed(k);
+  return {k, std::move(maps.scans(k)), std::move(smoothed)};
 }
 
 }  // namespace urbanslam::slam

@@ -170,6 +170,9 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
       // a match jumped 0.4 m to a look-alike and back.
       const Eigen::Matrix3d match_cov = withFloors(options_.covariance_scale * r.cov, options_) + r.spread;
       setPose(r.pose, (predicted_cov.inverse() + match_cov.inverse()).inverse());
+      out.map_fix = true;
+      out.map_pose = r.pose;
+      out.map_cov = match_cov;
       // The correction is the difference of two estimates of the pose, each with its own error:
       // the prediction's, and the match's against the map, which is at least the map's own
       // disagreement (the floors). Tested against the prediction's covariance alone, corrections
@@ -232,6 +235,9 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
     }
     if (accepted) {
       setPose(h.pose, options_.covariance_scale * h.cov);
+      out.map_fix = true;
+      out.map_pose = pose_;
+      out.map_cov = cov_;
       consecutive_matches_ = 0;
       // A fix that the confirmed dead reckoning admitted carries its confirmation on; one from
       // the whole map has yet to earn it.

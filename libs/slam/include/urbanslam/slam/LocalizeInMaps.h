@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "urbanslam/io/DataSource.h"
+#include "urbanslam/slam/LocalTrajectory.h"
 #include "urbanslam/slam/Localizer.h"
 
 namespace urbanslam::slam {
@@ -19,7 +20,9 @@ class MapsLocalizer {
  public:
   // `localizers`: one per map, none given an initial pose when there are several; a single one
   // simply localizes the whole log (it may have an initial pose). They must outlive this.
-  explicit MapsLocalizer(std::vector<Localizer*> localizers);
+  // `smoothing_options` (optional): the maps' options, for local SLAM's trajectory of the log
+  // (LocalTrajectory; one for all maps: it does not depend on them), which smoothed() needs.
+  explicit MapsLocalizer(std::vector<Localizer*> localizers, const PipelineOptions* smoothing_options = nullptr);
   // The measurement to every localizer until one is chosen, then to that one. Returns the result
   // to show for it: the chosen localizer's (from the measurement at which it found its place),
   // before that the first localizer's; none for a measurement that is not a scan.
@@ -29,21 +32,28 @@ class MapsLocalizer {
   bool chosen() const { return chosen_.has_value(); }
   // Every result of localizer k so far, from the log's first scan.
   std::vector<LocalizedScan>& scans(size_t k) { return scans_.at(k); }
+  // The smoothed pose of each of scans(k) (smoothLocalization); empty without smoothing options
+  // or without any fix.
+  std::vector<common::Pose2> smoothed(size_t k) const;
 
  private:
   std::vector<Localizer*> localizers_;
+  std::optional<LocalTrajectory> trajectory_;
+  double fix_covariance_scale_ = 1;
   std::vector<std::vector<LocalizedScan>> scans_;
   std::optional<size_t> chosen_;
 };
 
 struct MapsLocalization {
-  size_t map = 0;                    // the localizer that went on (an index into the localizers)
-  std::vector<LocalizedScan> scans;  // its results, from the first scan
+  size_t map = 0;                       // the localizer that went on (an index into the localizers)
+  std::vector<LocalizedScan> scans;     // its results, from the first scan
+  std::vector<common::Pose2> smoothed;  // the smoothed pose of each (empty: not smoothed)
 };
 
 // The whole log through a MapsLocalizer. on_scan (optional) sees each result it shows, with the
-// source's progress.
+// source's progress. With `smoothing_options`, the trajectory is smoothed as well.
 MapsLocalization localizeInMaps(const std::vector<Localizer*>& localizers, io::DataSource& source,
-                                const std::function<void(const LocalizedScan&, double progress)>& on_scan = {});
+                                const std::function<void(const LocalizedScan&, double progress)>& on_scan = {},
+                                const PipelineOptions* smoothing_options = nullptr);
 
 }  // namespace urbanslam::slam

@@ -100,6 +100,12 @@ struct LocalizedScan {
   bool relocalised = false;  // a place search found the pose at this scan
   double matched_fraction = 0;
   double mahalanobis2 = 0;  // the match's correction of the prediction, d' P⁻¹ d (P: the prediction's covariance plus the floors)
+  // What the map said of this scan's pose, before it was fused with the prediction: the tracking
+  // match's pose and covariance, or the place search's fix (the smoothed trajectory's input,
+  // LocalizationSmoothing.h).
+  bool map_fix = false;
+  common::Pose2 map_pose;
+  Eigen::Matrix3d map_cov = Eigen::Matrix3d::Identity();
 };
 
 struct LocalizerStats {

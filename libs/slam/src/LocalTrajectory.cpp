@@ -1,0 +1,44 @@
+#include "urbanslam/slam/LocalTrajectory.h"
+
+#include "urbanslam/io/CompactScan.h"
+
+namespace urbanslam::slam {
+
+LocalTrajectory::LocalTrajectory(const PipelineOptions& options) : input_(options.input), local_(options) {}
+
+void LocalTrajectory::add(const io::Measurement& m) {
+  if (const auto* scan = std::get_if<io::LaserScan>(&m)) {
+    if (input_.accepts(scan->label)) onScan(*scan);
+  } else if (const auto* od = std::get_if<io::OdometryReading>(&m)) {
+    local_.addOdometry(*od);
+  } else if (const auto* dr = std::get_if<io::DriveReading>(&m)) {
+    local_.addDrive(*dr);
+  }
+}
+
+void LocalTrajectory::onScan(io::LaserScan scan) {
+  input_.limitRanges(scan);
+  const double t = scan.timestamp;
+  if (local_.isKeyframe()) {
+    // As Pipeline::addKeyframe: the submap holds the scan as a map keeps it (ranges to the
+    // millimetre), so that this chain is the mapping run's.
+    const KeyframeConstraint c = local_.keyframeConstraint(scan);
+    io::CompactScan(scan).expandInto(scan);
+    const size_t k = local_.keyframes();
+    keyframes_.push_back({c.z, c.cov});
+    scans_.push_back({t, k, {}});
+    last_anchor_ = {t, k, {}, local_.motion().odometryPose()};
+    local_.keyframeAdded(scan, c.z);
+    return;
+  }
+  if (keyframes_.empty()) return;  // isKeyframe() holds for the first scan: not reached
+  if (const auto anchor = local_.placeScan(scan, &last_anchor_)) {
+    last_anchor_ = *anchor;
+    scans_.push_back({t, anchor->keyframe, anchor->offset});
+  } else {
+    // Not matched: the odometry since the keyframe places it.
+    scans_.push_back({t, local_.keyframes() - 1, local_.motion().increment()});
+  }
+}
+
+}  // namespace urbanslam::slam
