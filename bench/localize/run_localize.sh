@@ -6,10 +6,12 @@
 #   bench/localize/run_localize.sh [BUILD_DIR] [OUT_DIR]
 #
 # Needs ../shared/data. Rows (RESULTS.md):
-#   rel_m loc / full   mean absolute translational relation error [m] of the localized second
-#                      half and of the full mapping run, on the relations whose two ends are both
-#                      tracked by the localizer (eval --max-gap 1 on a relations file restricted to
-#                      those, see relations_within.py); rel_deg likewise [deg];
+#   rel_m loc / onl / full
+#                      mean absolute translational relation error [m] of the localized second
+#                      half (trajectory_scans.tum: smoothed), of its poses as tracked at each scan
+#                      (trajectory_online.tum) and of the full mapping run, on the relations whose
+#                      two ends are both tracked by the localizer (eval --max-gap 1 on a relations
+#                      file restricted to those, see relations_within.py); rel_deg likewise [deg];
 #   tracked            share of the second half's scans tracked (the rest: lost, e.g. rooms the first
 #                      half never entered);
 #   reloc              relocalisations (place searches that found the pose) in the run with --initial;
@@ -18,7 +20,8 @@
 #   fix_err_m          that first fix against the full run's pose at the same scan (map frames agree:
 #                      both runs start at the same first scan);
 #   rtf                log duration / wall time of `urbanslam localize` with --initial (map loading
-#                      included), and of the kidnapped run.
+#                      included); rtf_onl the same with --no-smoothing (no local SLAM trajectory);
+#                      rtf_kidnap the kidnapped run's (smoothed).
 # Environment: DATASETS="intel fr079" (default: intel aces fr079 csail).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
@@ -30,7 +33,8 @@ HERE=bench/localize
 mkdir -p "$OUT"
 declare -A LOG=([intel]=intel [aces]=aces [fr079]=fr079 [csail]=mit-csail)
 declare -A REL=([intel]=intel [aces]=aces [fr079]=fr079 [csail]=mit-csail)
-printf "%-7s %6s %8s %8s %8s %8s %8s %6s %7s %9s %8s %8s\n" dataset rel_n rel_m_loc rel_m_full rel_deg_loc rel_deg_full tracked reloc fix_s fix_err_m rtf rtf_kidnap
+printf "%-7s %6s %8s %8s %8s %8s %8s %8s %8s %6s %7s %9s %8s %8s %8s\n" dataset rel_n rel_m_loc rel_m_onl rel_m_full rel_deg_loc \
+  rel_deg_onl rel_deg_full tracked reloc fix_s fix_err_m rtf rtf_onl rtf_kidnap
 for ds in ${DATASETS:-intel aces fr079 csail}; do
   W=$OUT/$ds
   mkdir -p "$W"
@@ -40,9 +44,16 @@ for ds in ${DATASETS:-intel aces fr079 csail}; do
   "$U" run --quiet --ini ini/$ds.ini --out "$W/map" "$W/first.clf"
   initial=$(python3 $HERE/last_pose.py "$W/map/trajectory_scans.tum")
   "$U" localize --quiet --map "$W/map" --initial "$initial" --out "$W/loc" "$W/second.clf"
+  "$U" localize --quiet --no-smoothing --map "$W/map" --initial "$initial" --out "$W/loc_fast" "$W/second.clf"
+  # The online poses as a folder eval reads.
+  rm -rf "$W/loc_online" && mkdir -p "$W/loc_online"
+  cp "$W/loc/stats.json" "$W/loc_online/"
+  cp "$W/loc/trajectory_online.tum" "$W/loc_online/trajectory_scans.tum"
+  cp "$W/loc/trajectory_online.tum" "$W/loc_online/trajectory_odometry.tum"
   "$U" localize --quiet --map "$W/map" --out "$W/kidnap" "$W/second.clf"
   python3 $HERE/relations_within.py "$D/relations/${REL[$ds]}.relations" "$W/loc/trajectory_scans.tum" 1.0 > "$W/relations_tracked"
   "$U" eval "$W/loc" --relations "$W/relations_tracked" --time-offset 0 --max-gap 1 --json > "$W/eval_loc.json"
+  "$U" eval "$W/loc_online" --relations "$W/relations_tracked" --time-offset 0 --max-gap 1 --json > "$W/eval_online.json"
   "$U" eval "$W/full" --relations "$W/relations_tracked" --time-offset 0 --max-gap 1 --json > "$W/eval_full.json"
   python3 $HERE/row.py "$ds" "$W"
 done
