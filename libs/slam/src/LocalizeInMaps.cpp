@@ -13,12 +13,13 @@ MapsLocalizer::MapsLocalizer(std::vector<Localizer*> localizers, const PipelineO
   if (smoothing_options) {
     trajectory_.emplace(*smoothing_options);
     fix_covariance_scale_ = smoothing_options->local.covariance_scale;
+    fix_spacing_m_ = smoothing_options->keyframes.min_translation_m;
   }
 }
 
 std::vector<common::Pose2> MapsLocalizer::smoothed(size_t k) const {
   if (!trajectory_) return {};
-  return smoothLocalization(*trajectory_, scans_.at(k), fix_covariance_scale_);
+  return smoothLocalization(*trajectory_, scans_.at(k), fix_covariance_scale_, fix_spacing_m_);
 }
 
 std::optional<LocalizedScan> MapsLocalizer::add(const io::Measurement& m) {

@@ -39,7 +39,7 @@ class MapsLocalizer {
  private:
   std::vector<Localizer*> localizers_;
   std::optional<LocalTrajectory> trajectory_;
-  double fix_covariance_scale_ = 1;
+  double fix_covariance_scale_ = 1, fix_spacing_m_ = 0;
   std::vector<std::vector<LocalizedScan>> scans_;
   std::optional<size_t> chosen_;
 };
