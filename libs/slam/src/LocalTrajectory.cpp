@@ -25,6 +25,7 @@ void LocalTrajectory::onScan(io::LaserScan scan) {
     const KeyframeConstraint c = local_.keyframeConstraint(scan);
     io::CompactScan(scan).expandInto(scan);
     const size_t k = local_.keyframes();
+    if (k > 0) keyframe_pose_ = common::compose(keyframe_pose_, c.z);
     keyframes_.push_back({c.z, c.cov});
     scans_.push_back({t, k, {}});
     last_anchor_ = {t, k, {}, local_.motion().odometryPose()};
@@ -39,6 +40,11 @@ void LocalTrajectory::onScan(io::LaserScan scan) {
     // Not matched: the odometry since the keyframe places it.
     scans_.push_back({t, local_.keyframes() - 1, local_.motion().increment()});
   }
+}
+
+std::optional<io::StampedPose> LocalTrajectory::newestScan() const {
+  if (scans_.empty()) return std::nullopt;
+  return io::StampedPose{scans_.back().timestamp, common::compose(keyframe_pose_, scans_.back().offset)};
 }
 
 }  // namespace urbanslam::slam

@@ -50,6 +50,7 @@ common::Json localizationStats(const std::vector<LocalizedScan>& scans, const Lo
   c["tracking"] = s.tracking;
   c["lost"] = s.lost;
   c["matches_failed"] = s.matches_failed;
+  c["matches_skipped"] = s.matches_skipped;
   c["lost_events"] = s.lost_events;
   c["place_searches"] = s.place_searches;
   c["relocalisations"] = s.relocalisations;

@@ -11,7 +11,8 @@ MapsLocalizer::MapsLocalizer(std::vector<Localizer*> localizers, const PipelineO
   if (localizers_.empty()) throw std::invalid_argument("MapsLocalizer: no localizer");
   if (localizers_.size() == 1) chosen_ = 0;
   if (smoothing_options) {
-    trajectory_.emplace(*smoothing_options);
+    trajectory_ = std::make_unique<LocalTrajectory>(*smoothing_options);
+    for (Localizer* l : localizers_) l->followLocalTrajectory(trajectory_.get());
     fix_covariance_scale_ = smoothing_options->local.covariance_scale;
     fix_spacing_m_ = smoothing_options->keyframes.min_translation_m;
   }

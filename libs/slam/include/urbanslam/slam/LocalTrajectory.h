@@ -6,10 +6,12 @@
 // between scans: matched against the vehicle's own recent scans, it is as smooth as a mapping
 // run's trajectory, where matches against a map may follow a look-alike for a while and snap
 // back (smoothLocalization, LocalizationSmoothing.h).
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "urbanslam/io/MapOutputs.h"
 #include "urbanslam/io/Measurements.h"
 #include "urbanslam/slam/InputFilter.h"
 #include "urbanslam/slam/LocalSlam.h"
@@ -37,6 +39,9 @@ class LocalTrajectory {
   const std::vector<Step>& keyframes() const { return keyframes_; }
   // Every scan [input] accepted, in order.
   const std::vector<PlacedScan>& scans() const { return scans_; }
+  // The newest scan's pose in local SLAM's frame (the chain of the keyframe constraints, then
+  // the scan's offset); none before the first scan.
+  std::optional<io::StampedPose> newestScan() const;
 
  private:
   void onScan(io::LaserScan scan);
@@ -45,7 +50,8 @@ class LocalTrajectory {
   LocalSlam local_;
   std::vector<Step> keyframes_;
   std::vector<PlacedScan> scans_;
-  ScanAnchor last_anchor_;  // the keyframe or matched scan the vehicle was last placed at
+  ScanAnchor last_anchor_;       // the keyframe or matched scan the vehicle was last placed at
+  common::Pose2 keyframe_pose_;  // the newest keyframe's, in local SLAM's frame
 };
 
 }  // namespace urbanslam::slam

@@ -6,6 +6,7 @@
 // Until then the others cost their place searches (while lost, each searches at most every few
 // seconds of log time). A log found in none of the maps stays with the first, lost throughout.
 #include <functional>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -38,7 +39,7 @@ class MapsLocalizer {
 
  private:
   std::vector<Localizer*> localizers_;
-  std::optional<LocalTrajectory> trajectory_;
+  std::unique_ptr<LocalTrajectory> trajectory_;  // on the heap: the localizers keep its address
   double fix_covariance_scale_ = 1, fix_spacing_m_ = 0;
   std::vector<std::vector<LocalizedScan>> scans_;
   std::optional<size_t> chosen_;

@@ -29,6 +29,7 @@
 #include "urbanslam/alignment/SeenThroughRate.h"
 #include "urbanslam/io/Measurements.h"
 #include "urbanslam/slam/InputFilter.h"
+#include "urbanslam/slam/LocalTrajectory.h"
 #include "urbanslam/slam/Map.h"
 #include "urbanslam/slam/MapAreas.h"
 #include "urbanslam/slam/MotionIntegrator.h"
@@ -77,6 +78,12 @@ struct LocalizerOptions {
   // pose is uncertain by at least this much, whatever the matcher's covariance said.
   double lost_sigma_xy_m = 0.5;
   double lost_sigma_deg = 5.0;
+  // Following local SLAM's trajectory (Localizer::followLocalTrajectory), a confirmed pose is
+  // matched against the map only after this much travel or turn since its last match (the map's
+  // keyframe spacing: matches in between see the same map points from about the same place and
+  // add little the next one would not), local SLAM's motion carrying it in between.
+  double match_spacing_m = 0.5;
+  double match_spacing_deg = 10.0;
 };
 
 // The defaults, with the matcher, scan model and floors of the map's own [local] options.
@@ -111,6 +118,7 @@ struct LocalizedScan {
 struct LocalizerStats {
   size_t measurements = 0, scans = 0, scans_used = 0, odometry = 0;
   size_t tracking = 0, lost = 0, matches_failed = 0;
+  size_t matches_skipped = 0;  // scans a confirmed pose was carried to by local SLAM's motion, unmatched
   size_t place_searches = 0, relocalisations = 0, lost_events = 0;
   size_t fixes_rejected = 0;        // place-search fixes the confirmed dead-reckoned pose ruled out
   size_t place_search_windows = 0;  // windows searched by branch and bound, over all place searches
@@ -129,6 +137,13 @@ class Localizer {
 
   // The vehicle's pose at the first scan, in the map frame: tracking starts there.
   void setInitialPose(const common::Pose2& pose);
+  // Local SLAM's trajectory of the same log, given each measurement before this localizer is
+  // (it must outlive the localizer): its motion between scans predicts the pose instead of the
+  // odometry's (the odometry's covariance stays: an upper bound), and a confirmed pose is matched
+  // against the map only every match_spacing_m or match_spacing_deg of its travel. Local SLAM's
+  // match costs about what a map match does, and it is needed anyway for the smoothed trajectory
+  // (LocalizationSmoothing.h): the two together would cost both for every scan.
+  void followLocalTrajectory(const LocalTrajectory* trajectory) { trajectory_ = trajectory; }
   // One measurement; the result when it was a scan that was used.
   std::optional<LocalizedScan> add(const io::Measurement& m);
   LocalizationState state() const { return state_; }
@@ -166,11 +181,16 @@ class Localizer {
   // dead reckoning from it while lost) descends from a run of confirm_matches of them.
   int consecutive_matches_ = 0;
   bool confirmed_ = false;
+  bool initial_pose_ = false;  // the pose descends from setInitialPose, not yet confirmed
   double continuity_gate_ = 0;
+  double initial_gate_ = 0;  // a match's correction of a given initial pose beyond this refutes it
   common::Pose2 pose_;
   Eigen::Matrix3d cov_ = Eigen::Matrix3d::Identity();
   bool have_scan_ = false;
   double last_scan_time_ = 0;
+  const LocalTrajectory* trajectory_ = nullptr;
+  std::optional<common::Pose2> local_previous_;  // the previous scan's pose in local SLAM's frame
+  std::optional<common::Pose2> local_at_match_;  // ... and the last map match's
   // Place-search schedule while lost.
   bool searched_ = false;
   double last_search_time_ = 0, search_interval_s_ = 0;
