@@ -14,16 +14,44 @@
 namespace ua = urbanslam::alignment;
 namespace uc = urbanslam::common;
 
+// A scan's returns: dense near the vehicle, sparse out to 200 m (beyond what the search's cell
+// grid covers around the median: those points and the queries near them take the kd-tree).
+TEST(NearestNeighbours, BoundedSearchAgreesWithBruteForceOverAWideSparseSet) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> near(-6, 6), far(-200, 200);
+  std::vector<Eigen::Vector2d> pts;
+  for (int i = 0; i < 800; ++i) pts.push_back({near(rng), near(rng)});
+  for (int i = 0; i < 300; ++i) pts.push_back({far(rng), far(rng) * 0.1});
+  const ua::NearestNeighbours index(pts);
+  for (int k = 0; k < 4000; ++k) {
+    Eigen::Vector2d q(near(rng) * 2.5, near(rng) * 2.5);
+    if (k % 2 == 0) q = pts[static_cast<size_t>(k) % pts.size()] + Eigen::Vector2d(0.1 * near(rng) / 6, 0.1 * near(rng) / 6);
+    const double bound = k % 3 == 0 ? 0.09 : (k % 3 == 1 ? 0.0004 : 0.25);
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& p : pts) best = std::min(best, (p - q).squaredNorm());
+    int j = -1;
+    double d2 = -1;
+    const bool found = index.nearestWithin(q, bound, &j, &d2);
+    ASSERT_EQ(found, best <= bound) << k;
+    if (found) EXPECT_EQ(d2, best) << k;
+  }
+}
+
 TEST(NearestNeighbours, BoundedSearchAgreesWithBruteForce) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-5, 5);
   std::vector<Eigen::Vector2d> pts(500);
   for (auto& p : pts) p = {u(rng), u(rng)};
   pts.push_back(pts[7]);  // a duplicate: ties must not confuse the bound
+  // Points on the grid's cell edges (every 0.1 m from the lowest point) and queries there.
+  for (int i = 0; i < 20; ++i) pts.push_back(Eigen::Vector2d(-4.0 + 0.1 * i, 1.0));
   const ua::NearestNeighbours index(pts);
   for (int k = 0; k < 2000; ++k) {
-    const Eigen::Vector2d q(u(rng) * 1.4, u(rng) * 1.4);
-    const double bound = k % 3 == 0 ? 0.01 : (k % 3 == 1 ? 0.1 : 4.0);
+    const Eigen::Vector2d q =
+        k % 7 == 0 ? Eigen::Vector2d(-4.0 + 0.05 * (k % 40), 1.0 + 0.01 * (k % 5)) : Eigen::Vector2d(u(rng) * 1.4, u(rng) * 1.4);
+    // Bounds the cell grid answers (up to 0.3 m: the matchers' gates) and ones for the kd-tree.
+    const double bounds[] = {0.0001, 0.01, 0.09, 0.1, 4.0};
+    const double bound = bounds[k % 5];
     double best = std::numeric_limits<double>::infinity();
     for (const auto& p : pts) best = std::min(best, (p - q).squaredNorm());
     int j = -1;

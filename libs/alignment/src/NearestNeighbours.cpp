@@ -1,6 +1,8 @@
 #include "urbanslam/alignment/NearestNeighbours.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include <nanoflann.hpp>
@@ -20,14 +22,121 @@ struct Cloud {
 using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>, Cloud, 2, uint32_t>;
 }  // namespace
 
+// The points bucketed by square cell (counting sort into one array): a bounded search looks at
+// the query's cell, then ring after ring of cells around it, and stops once no farther ring can
+// hold a nearer point. A matcher's queries mostly have a neighbour within centimetres (their
+// gate is 0.3 m), so one or two rings answer them, in a fraction of the kd-tree's time (which
+// was a third of a localization's and a tenth of a mapping run's: the refinements ask once per
+// scan point and iteration). A scan's returns reach tens of metres, sparsely: the grid covers a
+// square around the points' median, at most max(16 n, 65536) cells, and answers the queries
+// that fall inside it far enough from its edge that every point within their bound is in it;
+// the rest go to the kd-tree.
+struct CellGrid {
+  static constexpr double kCellM = 0.1;
+  static constexpr int kMaxRings = 4;                           // bounds reaching farther go to the kd-tree
+  static constexpr double kMarginM = kCellM * (kMaxRings - 1);  // the farthest bound the grid answers
+  double x0 = 0, y0 = 0;
+  int nx = 0, ny = 0;
+  std::vector<uint32_t> start;          // per cell, into `order`; nx * ny + 1 entries
+  std::vector<uint32_t> order;          // point indices, by cell
+  std::vector<Eigen::Vector2d> sorted;  // the points in that order
+  bool built = false;
+
+  void build(const std::vector<Eigen::Vector2d>& pts) {
+    const size_t n = pts.size();
+    const double max_cells = std::max(16.0 * static_cast<double>(n), 65536.0);
+    // The points' extent, clipped to a square of max_cells around their median.
+    std::vector<double> xs(n), ys(n);
+    for (size_t i = 0; i < n; ++i) xs[i] = pts[i].x(), ys[i] = pts[i].y();
+    std::nth_element(xs.begin(), xs.begin() + static_cast<long>(n / 2), xs.end());
+    std::nth_element(ys.begin(), ys.begin() + static_cast<long>(n / 2), ys.end());
+    const double half = 0.5 * kCellM * std::floor(std::sqrt(max_cells));
+    Eigen::Vector2d lo(xs[n / 2] + half, ys[n / 2] + half), hi(xs[n / 2] - half, ys[n / 2] - half);
+    for (const auto& p : pts) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    lo = lo.cwiseMax(Eigen::Vector2d(xs[n / 2] - half, ys[n / 2] - half));
+    hi = hi.cwiseMin(Eigen::Vector2d(xs[n / 2] + half, ys[n / 2] + half));
+    if (!(lo.x() <= hi.x() && lo.y() <= hi.y())) return;
+    x0 = lo.x(), y0 = lo.y();
+    nx = static_cast<int>(std::floor((hi.x() - lo.x()) / kCellM)) + 1;
+    ny = static_cast<int>(std::floor((hi.y() - lo.y()) / kCellM)) + 1;
+    start.assign(static_cast<size_t>(nx) * static_cast<size_t>(ny) + 1, 0);
+    constexpr uint32_t kOutside = std::numeric_limits<uint32_t>::max();
+    std::vector<uint32_t> cell(n, kOutside);
+    size_t inside = 0;
+    for (size_t i = 0; i < n; ++i) {
+      const double fx = (pts[i].x() - x0) / kCellM, fy = (pts[i].y() - y0) / kCellM;
+      if (!(fx >= 0 && fy >= 0 && fx < nx && fy < ny)) continue;
+      cell[i] = static_cast<uint32_t>(static_cast<int>(fy) * nx + static_cast<int>(fx));
+      ++start[cell[i] + 1];
+      ++inside;
+    }
+    for (size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
+    order.resize(inside);
+    sorted.resize(inside);
+    std::vector<uint32_t> next(start.begin(), start.end() - 1);
+    for (size_t i = 0; i < n; ++i) {
+      if (cell[i] == kOutside) continue;
+      const uint32_t k = next[cell[i]]++;
+      order[k] = static_cast<uint32_t>(i);
+      sorted[k] = pts[i];
+    }
+    built = true;
+  }
+
+  // Whether every point within kMarginM of q is in the grid (q far enough inside it).
+  bool covers(const Eigen::Vector2d& q) const {
+    return built && q.x() >= x0 + kMarginM && q.y() >= y0 + kMarginM && q.x() <= x0 + kCellM * nx - kMarginM &&
+           q.y() <= y0 + kCellM * ny - kMarginM;
+  }
+
+  // The nearest point within max_d2 (inclusive); ties to the lower index. False: none.
+  bool nearestWithin(const Eigen::Vector2d& q, double max_d2, int* index, double* distance_sq) const {
+    const double fx = (q.x() - x0) / kCellM, fy = (q.y() - y0) / kCellM;
+    const double cxf = std::floor(fx), cyf = std::floor(fy);
+    // Beyond ring k every point is farther than k cells plus q's distance to its own cell's edge.
+    const double edge = kCellM * std::min(std::min(fx - cxf, 1.0 - (fx - cxf)), std::min(fy - cyf, 1.0 - (fy - cyf)));
+    const long cx = static_cast<long>(cxf), cy = static_cast<long>(cyf);
+    double best = max_d2;
+    long best_i = -1;
+    for (int ring = 0; ring <= kMaxRings; ++ring) {
+      const double reach = kCellM * (ring - 1) + edge;  // the nearest any point of this ring can be
+      if (ring > 0 && reach > 0 && reach * reach > best) break;
+      for (long y = cy - ring; y <= cy + ring; ++y) {
+        if (y < 0 || y >= ny) continue;
+        const bool edge_row = y == cy - ring || y == cy + ring;
+        for (long x = cx - ring; x <= cx + ring; x += (edge_row || ring == 0) ? 1 : 2 * ring) {
+          if (x < 0 || x >= nx) continue;
+          // The cell's nearest corner or side: farther than the best so far, nothing in it wins.
+          const double gx = std::max(0.0, std::max(static_cast<double>(x) - fx, fx - static_cast<double>(x + 1)));
+          const double gy = std::max(0.0, std::max(static_cast<double>(y) - fy, fy - static_cast<double>(y + 1)));
+          if (kCellM * kCellM * (gx * gx + gy * gy) > best) continue;
+          const size_t c = static_cast<size_t>(y * nx + x);
+          for (uint32_t k = start[c]; k < start[c + 1]; ++k) {
+            const double d2 = (sorted[k] - q).squaredNorm();
+            if (d2 < best || (d2 == best && (best_i < 0 || order[k] < best_i))) best = d2, best_i = order[k];
+          }
+        }
+      }
+    }
+    if (best_i < 0) return false;
+    *index = static_cast<int>(best_i);
+    *distance_sq = best;
+    return true;
+  }
+};
+
 struct NearestNeighbours::Impl {
   Cloud cloud;
   std::unique_ptr<Tree> tree;
+  CellGrid grid;
 };
 
 NearestNeighbours::NearestNeighbours(std::vector<Eigen::Vector2d> points) : impl_(new Impl) {
   impl_->cloud.pts = std::move(points);
-  if (!impl_->cloud.pts.empty()) impl_->tree = std::make_unique<Tree>(2, impl_->cloud, nanoflann::KDTreeSingleIndexAdaptorParams(8));
+  if (!impl_->cloud.pts.empty()) {
+    impl_->tree = std::make_unique<Tree>(2, impl_->cloud, nanoflann::KDTreeSingleIndexAdaptorParams(8));
+    impl_->grid.build(impl_->cloud.pts);
+  }
 }
 
 NearestNeighbours::~NearestNeighbours() = default;
@@ -47,6 +156,8 @@ bool NearestNeighbours::nearest(const Eigen::Vector2d& query, int* index, double
 
 bool NearestNeighbours::nearestWithin(const Eigen::Vector2d& query, double max_distance_sq, int* index, double* distance_sq) const {
   if (!impl_->tree) return false;
+  if (max_distance_sq <= CellGrid::kMarginM * CellGrid::kMarginM && impl_->grid.covers(query))
+    return impl_->grid.nearestWithin(query, max_distance_sq, index, distance_sq);
   uint32_t idx = 0;
   double d2 = 0;
   nanoflann::KNNResultSet<double, uint32_t> result(1);
