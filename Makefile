@@ -69,13 +69,13 @@ fuzz: fuzz-deps
 # (default: all). SANITIZE_EXCLUDE: the tests left to the optimised build because a sanitized
 # sibling runs the same code on less data (they would triple the sanitized run): the library
 # merges (MergeCommand joins through them), the FR079 resumes (the Intel one), the CLI resume
-# (MapResume), four of the five whole-excerpt localizations (FindsItsPlace, LocalizeCommand),
+# (MapResume), five of the six whole-excerpt localizations (FindsItsPlace, LocalizeCommand),
 # the spill equivalence (ScanStore's spill tests), the memory bound (RSS means nothing under
 # ASan), the bag mapped twice (RosBag's reader test), the GUI window (the GUI model's tests),
 # the largest pose-graph recovery (six smaller ones) and the city drive searched for in another
 # city (the same searches and checks run in SessionJoinCity's join, on half the data).
 SANITIZE_TESTS ?=
-SANITIZE_EXCLUDE ?= ^(SessionMerge\.|MapResume\.Fr079|RunResume\.Continued|Localizer\.(NeverTracks|StaysLost|Recovers|Tracks)|EsdfPipeline\.Spilled|MemoryBound\.Shipped|RosBag\.Maps|GuiSmoke\.Autorun|PoseGraphBackend\.HeadingsFirst|SessionJoinCity\.NeverJoins)
+SANITIZE_EXCLUDE ?= ^(SessionMerge\.|MapResume\.Fr079|RunResume\.Continued|Localizer\.(NeverTracks|StaysLost|Recovers|Tracks|Following)|EsdfPipeline\.Spilled|MemoryBound\.Shipped|RosBag\.Maps|GuiSmoke\.Autorun|PoseGraphBackend\.HeadingsFirst|SessionJoinCity\.NeverJoins)
 SANITIZE_ENV = ASAN_OPTIONS=abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
   LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan-suppressions.txt
 sanitize: deps
