@@ -81,6 +81,15 @@ std::vector<io::StampedPose> tracked(const std::vector<slam::LocalizedScan>& sca
   return out;
 }
 
+// The excerpt's relations whose two ends are both tracked (none across a lost stretch).
+std::vector<evaluation::Relation> relationsWithin(const std::vector<io::StampedPose>& traj) {
+  std::vector<evaluation::Relation> inside;
+  common::Pose2 unused;
+  for (const auto& r : evaluation::readRelations(test::repoPath("rawlogs/fr079-raw-excerpt.relations")))
+    if (evaluation::interpolatePose(traj, r.t1, 0.5, unused) && evaluation::interpolatePose(traj, r.t2, 0.5, unused)) inside.push_back(r);
+  return inside;
+}
+
 // The full run's pose at a scan time (both place every scan of the excerpt).
 common::Pose2 reference(double t) {
   common::Pose2 p;
@@ -106,11 +115,7 @@ TEST(Localizer, TracksTheRestOfTheExcerptAsWellAsTheFullRunMapsIt) {
   const auto traj = tracked(loc.scans);
   ASSERT_GT(traj.size(), 200u);
 
-  // The relations whose two ends are both tracked (none across a lost stretch).
-  std::vector<evaluation::Relation> inside;
-  common::Pose2 unused;
-  for (const auto& r : evaluation::readRelations(test::repoPath("rawlogs/fr079-raw-excerpt.relations")))
-    if (evaluation::interpolatePose(traj, r.t1, 0.5, unused) && evaluation::interpolatePose(traj, r.t2, 0.5, unused)) inside.push_back(r);
+  const std::vector<evaluation::Relation> inside = relationsWithin(traj);
   ASSERT_GE(inside.size(), 40u);
   const auto localized = evaluation::relationMetrics(traj, inside, 0.0, 0.5);
   const auto mapped = evaluation::relationMetrics(maps().full->scanTrajectory(), inside, 0.0, 0.5);
@@ -152,10 +157,7 @@ TEST(Localizer, FollowingLocalSlamMatchesTheMapOncePerKeyframeSpacing) {
   const Localized loc = localizeRest(start, excerpt(), maps().skip, 100000, true);
   const auto traj = tracked(loc.scans);
   ASSERT_GT(traj.size(), 200u);
-  std::vector<evaluation::Relation> inside;
-  common::Pose2 unused;
-  for (const auto& r : evaluation::readRelations(test::repoPath("rawlogs/fr079-raw-excerpt.relations")))
-    if (evaluation::interpolatePose(traj, r.t1, 0.5, unused) && evaluation::interpolatePose(traj, r.t2, 0.5, unused)) inside.push_back(r);
+  const std::vector<evaluation::Relation> inside = relationsWithin(traj);
   ASSERT_GE(inside.size(), 40u);
   std::vector<io::StampedPose> smoothed;
   for (size_t i = 0; i < loc.scans.size(); ++i)
