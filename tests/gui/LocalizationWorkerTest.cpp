@@ -46,7 +46,7 @@ TEST(LocalizationWorker, LocalizesLikeTheBatchLocalizerAndDrawsTheMapAndThePath)
   loaded->finish();
   slam::Localizer batch(loaded->map(), loaded->options(), slam::localizerOptions(loaded->options()));
   auto src = io::openDataSource(kLog);
-  const auto expected = slam::localizeInMaps({&batch}, *src).scans;
+  const auto expected = slam::localizeInMaps({&batch}, *src, {}, &loaded->options()).scans;
   ASSERT_GT(expected.size(), 50u);
   size_t expected_poses = 0, expected_lost = 0;
   for (const auto& r : expected) {
@@ -119,7 +119,7 @@ TEST(LocalizationWorker, SearchesEveryMapOfTheFileAndDrawsTheOneThatHoldsTheLog)
   separate[0]->finish();
   slam::Localizer alone(separate[0]->map(), separate[0]->options(), slam::localizerOptions(separate[0]->options()));
   auto src = io::openDataSource(kLog);
-  const auto expected = slam::localizeInMaps({&alone}, *src).scans;
+  const auto expected = slam::localizeInMaps({&alone}, *src, {}, &separate[0]->options()).scans;
   size_t found = 0;
   while (found < expected.size() && expected[found].state != slam::LocalizationState::Tracking) ++found;
   ASSERT_LT(found, expected.size() / 2);

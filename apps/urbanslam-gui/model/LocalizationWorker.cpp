@@ -22,7 +22,8 @@ LocalizationWorker::LocalizationWorker(const std::string& map_path, const std::s
     localizers_.push_back(std::make_unique<slam::Localizer>(p->map(), p->options(), slam::localizerOptions(p->options())));
     running.push_back(localizers_.back().get());
   }
-  localizer_ = std::make_unique<slam::MapsLocalizer>(running);
+  // Following local SLAM's trajectory, as `urbanslam localize` does by default.
+  localizer_ = std::make_unique<slam::MapsLocalizer>(running, &maps_[0]->options());
   state_.localizing = true;
   drawMap(0);
 }
