@@ -48,12 +48,14 @@ size_t parseSeparateMap(const std::string& text) {
 }  // namespace
 
 int localizeCommand(const Argv& args) {
-  ArgParser ap("urbanslam localize --map MAP LOG [--initial x,y,phi] [--separate-map K] [--out DIR] [--quiet] [--json]",
+  ArgParser ap("urbanslam localize --map MAP LOG [--initial x,y,phi] [--separate-map K] [--no-smoothing] [--out DIR] [--quiet] [--json]",
                "Tracks the vehicle of LOG in the map of an earlier `urbanslam run` (its map.usmap, or its output\n"
-               "folder), which is not changed: every scan is predicted by the odometry and matched against the\n"
-               "map's scans near that pose. Without --initial, and whenever the matches stop supporting the pose\n"
-               "(lost), the map is searched for the scan's place until one place clearly wins: the whole map,\n"
-               "or, once matches have confirmed the pose, only where the odometry from it can have gone.\n"
+               "folder), which is not changed. Local SLAM runs over the log as in a mapping run; its motion\n"
+               "predicts each scan's pose, which is matched against the map's scans near it (once the matches\n"
+               "confirm the pose, once per keyframe spacing of travel). Without --initial, and whenever the\n"
+               "matches stop supporting the pose (lost), the map is searched for the scan's place until one\n"
+               "place clearly wins: the whole map, or, once matches have confirmed the pose, only where the\n"
+               "motion from it can have gone.\n"
                "A map file that holds separate maps (`merge`, `run --map`; stats.json's separate_maps lists\n"
                "them): the vehicle is localized in the one --separate-map names, in the first with --initial,\n"
                "and otherwise searched for in all of them, side by side, until one finds its place; that map\n"
@@ -66,8 +68,8 @@ int localizeCommand(const Argv& args) {
   ap.addOption("initial", "x,y,phi", "the vehicle's pose at the first scan in the map frame (m, m, rad); default: searched");
   ap.addOption("out", "DIR", "output folder (created if needed)", "out_localize");
   ap.addFlag("no-smoothing",
-             "write the tracked poses as they were at each scan into trajectory_scans.tum too, and skip local SLAM's\n"
-             "trajectory of the log (faster; trajectory_online.tum holds those poses either way)");
+             "no local SLAM: every scan predicted by the odometry and matched against the map, and trajectory_scans.tum "
+             "holds the poses as tracked (faster)");
   ap.addFlag("quiet", "no progress bar and no summary on stderr");
   ap.addFlag("json", "print stats.json as one JSON object on stdout");
   ap.addEpilog(
@@ -75,8 +77,8 @@ int localizeCommand(const Argv& args) {
       "motion between scans weighed against the map's matches; `urbanslam eval DIR --relations F` scores\n"
       "it), trajectory_online.tum (the same scans as tracked at each scan), localization.csv (every\n"
       "scan as tracked then: time, x, y, phi, covariance upper triangle xx xy xphi yy yphi phiphi, state\n"
-      "tracking|lost), stats.json (counts, time lost, relocalisations, wall time,\n"
-      "real-time factor). DIR appears complete at the end; it is replaced only when it is empty or\n"
+      "tracking|lost), stats.json (counts, time lost, relocalisations, wall time, real-time\n"
+      "factor). DIR appears complete at the end; it is replaced only when it is empty or\n"
       "holds an earlier localization.");
   if (!ap.parse(args)) return 0;
   if (!ap.has("map")) throw common::InputError("localize: --map MAP is required (a map.usmap or a run folder)");
