@@ -1,8 +1,9 @@
 #pragma once
 // Localization in a frozen map: the vehicle tracked scan by scan in a map that a run built
-// (map.usmap), the map never changed. Each scan's pose is predicted by the odometry (the motion
-// model of local SLAM, MotionIntegrator) from the previous scan's, the prediction's covariance
-// carried along, and the scan is matched near it against the map's keyframe scans
+// (map.usmap), the map never changed. Each scan's pose is predicted from the previous scan's by
+// the odometry (the motion model of local SLAM, MotionIntegrator) or, following local SLAM's
+// trajectory of the log (followLocalTrajectory), by local SLAM's motion, the prediction's
+// covariance carried along, and the scan is matched near it against the map's keyframe scans
 // (MapAreas: the tile's reference, built on demand) by local SLAM's matcher, which weighs the
 // odometry prior against the scan by their covariances; its posterior is the scan's pose and
 // covariance. A TrackingMonitor decides when the matches no longer support the pose (lost);
