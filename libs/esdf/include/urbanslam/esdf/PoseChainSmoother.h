@@ -50,8 +50,8 @@ class PoseChainSmoother {
 
   std::vector<Node> nodes_;
   size_t first_fixed_ = static_cast<size_t>(-1);
-  Eigen::Vector3d x_;  // the filter's estimate of the newest pose, and its covariance
-  Eigen::Matrix3d p_;
+  Eigen::Vector3d x_ = Eigen::Vector3d::Zero();  // the filter's estimate of the newest pose, and its covariance
+  Eigen::Matrix3d p_ = Eigen::Matrix3d::Identity();
 };
 
 }  // namespace urbanslam::esdf

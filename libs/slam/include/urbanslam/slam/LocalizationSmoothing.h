@@ -5,7 +5,8 @@
 // (esdf::PoseChainSmoother) weighs both, every pose given the matches before and after it. The
 // scans between keyframes keep local SLAM's offsets. Where the localizer follows a look-alike
 // pose for a few scans and snaps back, the smoothed trajectory stays with local SLAM's motion;
-// where local SLAM drifts, the map's matches pull it back gradually.
+// where local SLAM drifts, the map's matches pull it back gradually. Each stretch between
+// relocalisations (a place search's fix after the pose was lost) is smoothed on its own.
 //
 // One fix per `fix_spacing_m` of travel (the map's keyframe spacing, [keyframes]
 // min_translation_m), the first matched scan of the first keyframe span that far from the last
