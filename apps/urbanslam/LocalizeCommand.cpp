@@ -92,7 +92,7 @@ int localizeCommand(const Argv& args) {
     info.initial_pose_given = true;
   }
   if (ap.has("separate-map")) info.separate_map = parseSeparateMap(ap.option("separate-map"));
-  info.smoothed = !ap.flag("no-smoothing");
+  const bool smooth = !ap.flag("no-smoothing");
   // Without a named map or an initial pose (which is in the first map's frame), every map of the
   // file is searched.
   const bool search_maps = !ap.has("separate-map") && !info.initial_pose_given;
@@ -135,7 +135,7 @@ int localizeCommand(const Argv& args) {
         bar.update(static_cast<uint64_t>(progress * 1000), std::to_string(shown_scans) + " scans, " + slam::stateName(r.state) + ", " +
                                                                std::to_string(shown_fixes) + " relocalisations");
       },
-      info.smoothed ? &maps[0]->options() : nullptr);
+      smooth ? &maps[0]->options() : nullptr);
   bar.finish();
   const slam::Localizer& localizer = *localizers[result.map];
   const std::vector<slam::LocalizedScan>& scans = result.scans;

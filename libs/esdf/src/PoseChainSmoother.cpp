@@ -18,19 +18,24 @@ void update(Vec3& x, Mat3& p, const Vec3& z, const Mat3& r) {
   p = 0.5 * (p + p.transpose());
 }
 
+// The prediction of the next pose by `motion` from the previous one (x, p), linearised about
+// `at` (x itself, for the filter): x⁻ = at ⊕ u + F (x − at), P⁻ = F P F' + G Q G' (F, G: the
+// composition's Jacobians at `at`, thesis appendix B). Returns F.
+Mat3 predict(const Vec3& at, Vec3& x, Mat3& p, const Vec3& motion, const Mat3& motion_cov) {
+  Mat3 f, g;
+  composeJacobians(at, motion, &f, &g);
+  x = compose(at, motion) + f * poseDifference(x, at);
+  p = f * p * f.transpose() + g * motion_cov * g.transpose();
+  return f;
+}
+
 }  // namespace
 
 size_t PoseChainSmoother::addPose(const common::Pose2& motion, const Eigen::Matrix3d& cov) {
   Node n;
   n.motion = toVec(motion);
   n.motion_cov = 0.5 * (cov + cov.transpose());
-  if (hasFix()) {
-    // x⁻ = x ⊕ u, P⁻ = F P F' + G Q G' (F, G: the composition's Jacobians, thesis appendix B).
-    Mat3 f, g;
-    composeJacobians(x_, n.motion, &f, &g);
-    x_ = compose(x_, n.motion);
-    p_ = f * p_ * f.transpose() + g * n.motion_cov * g.transpose();
-  }
+  if (hasFix()) predict(Vec3(x_), x_, p_, n.motion, n.motion_cov);
   nodes_.push_back(std::move(n));
   return nodes_.size() - 1;
 }
@@ -56,8 +61,8 @@ common::Pose2 PoseChainSmoother::filtered() const {
 
 std::vector<Vec3> PoseChainSmoother::pass(const std::vector<Vec3>& about) const {
   const size_t n = nodes_.size() - first_fixed_;
-  // Forward: the filter, its prediction linearised about `about` when given (the prediction's
-  // mean is then the linearisation's, x̄ᵢ₋₁ ⊕ u + F (xᵢ₋₁ − x̄ᵢ₋₁), as Gauss-Newton takes it).
+  // Forward: the filter, its prediction linearised about `about` when given (as Gauss-Newton
+  // takes it), else about the filter's own estimate.
   std::vector<Vec3> x(n), x_pred(n);
   std::vector<Mat3> p(n), p_pred(n), f(n);
   for (size_t k = 0; k < n; ++k) {
@@ -68,11 +73,9 @@ std::vector<Vec3> PoseChainSmoother::pass(const std::vector<Vec3>& about) const 
       p[0] = node.fixes[0].cov;
       first_update = 1;
     } else {
-      const Vec3& at = about.empty() ? x[k - 1] : about[k - 1];
-      Mat3 g;
-      composeJacobians(at, node.motion, &f[k], &g);
-      x_pred[k] = compose(at, node.motion) + f[k] * poseDifference(x[k - 1], at);
-      p_pred[k] = f[k] * p[k - 1] * f[k].transpose() + g * node.motion_cov * g.transpose();
+      x_pred[k] = x[k - 1];
+      p_pred[k] = p[k - 1];
+      f[k] = predict(about.empty() ? x[k - 1] : about[k - 1], x_pred[k], p_pred[k], node.motion, node.motion_cov);
       x[k] = x_pred[k];
       p[k] = p_pred[k];
     }

@@ -140,8 +140,9 @@ class Localizer {
   void setInitialPose(const common::Pose2& pose);
   // Local SLAM's trajectory of the same log, given each measurement before this localizer is
   // (it must outlive the localizer): its motion between scans predicts the pose instead of the
-  // odometry's (the odometry's covariance stays: an upper bound), and a confirmed pose is matched
-  // against the map only every match_spacing_m or match_spacing_deg of its travel. Local SLAM's
+  // odometry's, with the odometry's covariance (an upper bound) until the pose is confirmed and
+  // local SLAM's own after; a confirmed pose is matched against the map only every
+  // match_spacing_m or match_spacing_deg of its travel. Local SLAM's
   // match costs about what a map match does, and it is needed anyway for the smoothed trajectory
   // (LocalizationSmoothing.h): the two together would cost both for every scan.
   void followLocalTrajectory(const LocalTrajectory* trajectory) { trajectory_ = trajectory; }
