@@ -67,9 +67,9 @@ common::Json localizationStats(const std::vector<LocalizedScan>& scans, const Lo
     if (r.state == LocalizationState::Tracking) sigma.push_back(std::sqrt(std::max(0.0, r.cov(0, 0) + r.cov(1, 1))));
   l["position_sigma_m_p50"] = common::percentile(sigma, 50);
   l["position_sigma_m_p95"] = common::percentile(sigma, 95);
-  Json& t = j["timing"];
-  const double duration = s.last_timestamp - s.first_timestamp;
   l["smoothed"] = info.smoothed;
+  Json& t = j["timing"];  // l is invalid from here: inserting into j may move its values
+  const double duration = s.last_timestamp - s.first_timestamp;
   t["wall_s"] = info.wall_s;
   t["localizer_wall_s"] = s.wall_s;
   t["place_search_wall_s"] = s.place_search_wall_s;

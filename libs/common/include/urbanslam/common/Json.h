@@ -43,7 +43,8 @@ class Json {
     return j;
   }
 
-  // Object access: inserts the key (in order) when absent.
+  // Object access: inserts the key (in order) when absent. A reference it returns is valid only
+  // until the next key is inserted into the same object (the values live in a vector).
   Json& operator[](const std::string& key);
   Json& push(Json v);
   Type type() const { return type_; }
