@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <mutex>
 
 #include <nanoflann.hpp>
 
@@ -41,6 +42,7 @@ struct CellGrid {
   std::vector<uint32_t> order;          // point indices, by cell
   std::vector<Eigen::Vector2d> sorted;  // the points in that order
   bool built = false;
+  bool holds_all = false;  // no point was clipped: the grid answers any query, however far
 
   void build(const std::vector<Eigen::Vector2d>& pts) {
     const size_t n = pts.size();
@@ -81,16 +83,21 @@ struct CellGrid {
       sorted[k] = pts[i];
     }
     built = true;
+    holds_all = inside == n;
   }
 
-  // Whether every point within kMarginM of q is in the grid (q far enough inside it).
+  // Whether every point within kMarginM of q is in the grid (all are, or q is far enough inside).
   bool covers(const Eigen::Vector2d& q) const {
-    return built && q.x() >= x0 + kMarginM && q.y() >= y0 + kMarginM && q.x() <= x0 + kCellM * nx - kMarginM &&
-           q.y() <= y0 + kCellM * ny - kMarginM;
+    return built && (holds_all || (q.x() >= x0 + kMarginM && q.y() >= y0 + kMarginM && q.x() <= x0 + kCellM * nx - kMarginM &&
+                                   q.y() <= y0 + kCellM * ny - kMarginM));
   }
 
   // The nearest point within max_d2 (inclusive); ties to the lower index. False: none.
   bool nearestWithin(const Eigen::Vector2d& q, double max_d2, int* index, double* distance_sq) const {
+    // A query farther than the bound from the grid's rectangle has nothing within it.
+    const double ox = std::max(0.0, std::max(x0 - q.x(), q.x() - (x0 + kCellM * nx)));
+    const double oy = std::max(0.0, std::max(y0 - q.y(), q.y() - (y0 + kCellM * ny)));
+    if (ox * ox + oy * oy > max_d2) return false;
     const double fx = (q.x() - x0) / kCellM, fy = (q.y() - y0) / kCellM;
     const double cxf = std::floor(fx), cyf = std::floor(fy);
     // Beyond ring k every point is farther than k cells plus q's distance to its own cell's edge.
@@ -125,18 +132,25 @@ struct CellGrid {
   }
 };
 
+// The kd-tree is built on its first query: the matchers' bounded queries all go to the grid,
+// and building a tree nobody asks was a twentieth of a localization's time. Built once, under a
+// once_flag: a reference may be read by several threads.
 struct NearestNeighbours::Impl {
   Cloud cloud;
-  std::unique_ptr<Tree> tree;
   CellGrid grid;
+  const Tree& tree() const {
+    std::call_once(tree_built, [this] { tree_ = std::make_unique<Tree>(2, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(8)); });
+    return *tree_;
+  }
+
+ private:
+  mutable std::once_flag tree_built;
+  mutable std::unique_ptr<Tree> tree_;
 };
 
 NearestNeighbours::NearestNeighbours(std::vector<Eigen::Vector2d> points) : impl_(new Impl) {
   impl_->cloud.pts = std::move(points);
-  if (!impl_->cloud.pts.empty()) {
-    impl_->tree = std::make_unique<Tree>(2, impl_->cloud, nanoflann::KDTreeSingleIndexAdaptorParams(8));
-    impl_->grid.build(impl_->cloud.pts);
-  }
+  if (!impl_->cloud.pts.empty()) impl_->grid.build(impl_->cloud.pts);
 }
 
 NearestNeighbours::~NearestNeighbours() = default;
@@ -144,18 +158,18 @@ NearestNeighbours::~NearestNeighbours() = default;
 size_t NearestNeighbours::size() const { return impl_->cloud.pts.size(); }
 
 bool NearestNeighbours::nearest(const Eigen::Vector2d& query, int* index, double* distance_sq) const {
-  if (!impl_->tree) return false;
+  if (impl_->cloud.pts.empty()) return false;
   uint32_t idx = 0;
   double d2 = 0;
   const double q[2] = {query.x(), query.y()};
-  if (impl_->tree->knnSearch(q, 1, &idx, &d2) == 0) return false;
+  if (impl_->tree().knnSearch(q, 1, &idx, &d2) == 0) return false;
   *index = static_cast<int>(idx);
   *distance_sq = d2;
   return true;
 }
 
 bool NearestNeighbours::nearestWithin(const Eigen::Vector2d& query, double max_distance_sq, int* index, double* distance_sq) const {
-  if (!impl_->tree) return false;
+  if (impl_->cloud.pts.empty()) return false;
   if (max_distance_sq <= CellGrid::kMarginM * CellGrid::kMarginM && impl_->grid.covers(query))
     return impl_->grid.nearestWithin(query, max_distance_sq, index, distance_sq);
   uint32_t idx = 0;
@@ -166,7 +180,7 @@ bool NearestNeighbours::nearestWithin(const Eigen::Vector2d& query, double max_d
   // is the next double above the limit to keep a point exactly at it.
   d2 = std::nextafter(max_distance_sq, std::numeric_limits<double>::infinity());
   const double q[2] = {query.x(), query.y()};
-  impl_->tree->findNeighbors(result, q, nanoflann::SearchParams());
+  impl_->tree().findNeighbors(result, q, nanoflann::SearchParams());
   if (result.size() == 0) return false;
   *index = static_cast<int>(idx);
   *distance_sq = d2;
@@ -176,11 +190,11 @@ bool NearestNeighbours::nearestWithin(const Eigen::Vector2d& query, double max_d
 size_t NearestNeighbours::knn(const Eigen::Vector2d& query, size_t k, std::vector<int>* indices, std::vector<double>* distances_sq) const {
   indices->clear();
   distances_sq->clear();
-  if (!impl_->tree || k == 0) return 0;
+  if (impl_->cloud.pts.empty() || k == 0) return 0;
   std::vector<uint32_t> idx(k);
   distances_sq->resize(k);
   const double q[2] = {query.x(), query.y()};
-  const size_t n = impl_->tree->knnSearch(q, k, idx.data(), distances_sq->data());
+  const size_t n = impl_->tree().knnSearch(q, k, idx.data(), distances_sq->data());
   distances_sq->resize(n);
   indices->assign(idx.begin(), idx.begin() + static_cast<long>(n));
   return n;

@@ -1,5 +1,6 @@
 #pragma once
-// Nearest-neighbour queries over a 2D point set through a nanoflann kd-tree (the one MRPT ships).
+// Nearest-neighbour queries over a 2D point set: bounded ones (a matcher's gate) by a grid of
+// cells, the rest through a nanoflann kd-tree (the one MRPT ships), built on its first use.
 // nanoflann stays behind a pimpl so that only this module needs its include path.
 #include <cstddef>
 #include <memory>
