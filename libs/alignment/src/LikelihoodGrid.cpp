@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace urbanslam::alignment {
 
@@ -25,7 +26,6 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
   const int h = any ? static_cast<int>(std::ceil((hi.y() - lo.y()) / resolution_)) + 1 : 1;
   width_ = w + pad_;
   height_ = h + pad_;
-  Cells base(static_cast<size_t>(width_) * static_cast<size_t>(height_), floor_);
   const int r = static_cast<int>(std::ceil(reach / resolution_));
   const double inv2s2 = 1.0 / (2.0 * o.hit_sigma_m * o.hit_sigma_m);
   // The cell value as a function of the squared distance, tabulated (a stamp of (2r+1)² cells
@@ -36,6 +36,12 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
   for (int k = 0; k <= kTable; ++k)
     table[static_cast<size_t>(k)] = static_cast<float>(std::log(std::exp(-(max_d2 * k / kTable) * inv2s2) + o.miss_floor));
   const double to_index = kTable / max_d2;
+  // A cell's value is the largest over the points of the table at their squared distance, and
+  // the table falls with the distance: it is the table at the squared distance to the nearest
+  // point. So the stamps keep that minimum (a min of doubles, cheaper than a table lookup per cell), and
+  // one pass turns it into the value; a cell no stamp reached keeps the floor.
+  const size_t cells = static_cast<size_t>(width_) * static_cast<size_t>(height_);
+  std::vector<double> nearest_d2(cells, std::numeric_limits<double>::infinity());
   std::vector<double> dx2(static_cast<size_t>(2 * r + 1));  // a stamp's columns' squared offsets
   for (const auto& sp : reference) {
     if (std::abs(sp.p.x() - centre.x()) > o.max_radius_m || std::abs(sp.p.y() - centre.y()) > o.max_radius_m) continue;
@@ -48,14 +54,19 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
       const double dx = (origin_.x() + resolution_ * (i + 0.5)) - sp.p.x();
       dx2[static_cast<size_t>(i - i0)] = dx * dx;
     }
+    const int n = i1 - i0 + 1;
     for (int j = j0; j <= j1; ++j) {
       const double dy = (origin_.y() + resolution_ * (j + 0.5)) - sp.p.y(), dy2 = dy * dy;
-      float* row = base.data() + static_cast<size_t>(j + pad_) * static_cast<size_t>(width_) + static_cast<size_t>(pad_);
-      for (int i = i0; i <= i1; ++i) {
-        const float v = table[static_cast<size_t>(std::min<double>(kTable, (dx2[static_cast<size_t>(i - i0)] + dy2) * to_index + 0.5))];
-        row[i] = std::max(row[i], v);
-      }
+      double* row = nearest_d2.data() + static_cast<size_t>(j + pad_) * static_cast<size_t>(width_) + static_cast<size_t>(pad_ + i0);
+      for (int i = 0; i < n; ++i) row[i] = std::min(row[i], dx2[static_cast<size_t>(i)] + dy2);
     }
+  }
+  Cells base(cells);  // every cell written below
+  for (size_t k = 0; k < cells; ++k) {
+    const double d2 = nearest_d2[k];
+    base[k] = d2 == std::numeric_limits<double>::infinity()
+                  ? floor_
+                  : std::max(floor_, table[static_cast<size_t>(std::min<double>(kTable, d2 * to_index + 0.5))]);
   }
   level_.push_back(std::move(base));
   // Level h from level h-1 by doubling: the block of 2^h starting at (i, j) is four blocks of

@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Eigenvalues>
-
 namespace urbanslam::alignment {
 
 namespace {
@@ -28,21 +26,24 @@ struct LineSums {
     C << sxx / n - m.x() * m.x(), sxy / n - m.x() * m.y(), sxy / n - m.x() * m.y(), syy / n - m.y() * m.y();
     return C;
   }
-  // Normal (eigenvector of the smallest eigenvalue), smallest and largest eigenvalue. Eigen's
-  // closed form for small matrices (computeDirect): the iterative solver was a tenth of a
-  // localization's time, every point of every reference scan being fitted twice.
-  void fit(Eigen::Vector2d* normal, double* lmin, double* lmax) const {
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es;
-    es.computeDirect(scatter());
-    *normal = es.eigenvectors().col(0).normalized();
-    *lmin = std::max(0.0, es.eigenvalues()(0));
-    *lmax = std::max(0.0, es.eigenvalues()(1));
-  }
-  // The smallest eigenvalue alone: (a + c) / 2 - sqrt(((a - c) / 2)² + b²).
-  double smallestEigenvalue() const {
+  // Normal (eigenvector of the smallest eigenvalue) and the smallest eigenvalue, in closed form
+  // (Eigen's iterative solver was a tenth of a localization's time, every point of every
+  // reference scan being fitted twice; its closed form for small matrices still 5 %).
+  void fit(Eigen::Vector2d* normal, double* lmin) const {
     const Eigen::Matrix2d C = scatter();
+    const double a = C(0, 0), b = C(0, 1), c = C(1, 1), l = smallestEigenvalue(C);
+    *lmin = std::max(0.0, l);
+    // (C - l I) v = 0: v is orthogonal to either row of C - l I; the longer row is the better
+    // conditioned. Both rows vanish only for a multiple of the identity (no direction at all).
+    const Eigen::Vector2d r0(a - l, b), r1(b, c - l);
+    const Eigen::Vector2d& row = r0.squaredNorm() >= r1.squaredNorm() ? r0 : r1;
+    const double len = row.norm();
+    *normal = len > 0 ? Eigen::Vector2d(-row.y() / len, row.x() / len) : Eigen::Vector2d(1, 0);
+  }
+  // (a + c) / 2 - sqrt(((a - c) / 2)² + b²) of [[a, b], [b, c]].
+  static double smallestEigenvalue(const Eigen::Matrix2d& C) {
     const double h = 0.5 * (C(0, 0) - C(1, 1));
-    return std::max(0.0, 0.5 * (C(0, 0) + C(1, 1)) - std::sqrt(h * h + C(0, 1) * C(0, 1)));
+    return 0.5 * (C(0, 0) + C(1, 1)) - std::sqrt(h * h + C(0, 1) * C(0, 1));
   }
 };
 
@@ -63,23 +64,23 @@ std::vector<LineNormal> computeLineNormals(const PointSet& points, const LineNor
     s.add(points[i].p);
     int j = i + 1;
     Eigen::Vector2d normal(0, 1);
-    double lmin = 0, lmax = 0;
+    double lmin = 0;
     for (; j < n; ++j) {
       if (!adjacent(points[j - 1], points[j], options)) break;
       if (s.n >= 2) {
         // The candidate must lie near the current line, and the line refitted with it must
         // stay thin: the first stops at corners, the second at slow bends.
-        s.fit(&normal, &lmin, &lmax);
+        s.fit(&normal, &lmin);
         if (std::abs(normal.dot(points[j].p - s.mean())) > options.line_tolerance_m) break;
         LineSums t = s;
         t.add(points[j].p);
-        if (std::sqrt(t.smallestEigenvalue()) > 0.5 * options.line_tolerance_m) break;
+        if (std::sqrt(std::max(0.0, LineSums::smallestEigenvalue(t.scatter()))) > 0.5 * options.line_tolerance_m) break;
       }
       s.add(points[j].p);
     }
     // Piece [i, j).
     if (s.n >= options.min_points) {
-      s.fit(&normal, &lmin, &lmax);
+      s.fit(&normal, &lmin);
       const double length = (points[j - 1].p - points[i].p).norm();
       if (length >= options.min_length_m) {
         for (int k = i; k < j; ++k) {
