@@ -23,10 +23,12 @@ def tum(p):
 
 loc, full = load("eval_loc.json")["relations"], load("eval_full.json")["relations"]
 onl = load("eval_online.json")["relations"]
-s, k, fast = load("loc/stats.json"), load("kidnap/stats.json"), load("loc_fast/stats.json")
+s, k, fast = load("loc/stats.json"), load("start_lost/stats.json"), load("loc_fast/stats.json")
+j = load("jumps/summary.json")
+jump_s = j["relocalised_s_median"] if j["relocalised_s_median"] is not None else float("nan")
 fix = k["localization"]["first_fix_s"]
 fix_err = float("nan")
-kt = tum("kidnap/trajectory_online.tum")  # the first fix as found
+kt = tum("start_lost/trajectory_online.tum")  # the first fix as found
 ft = tum("full/trajectory_scans.tum")
 if kt:
     times = [p[0] for p in ft]
@@ -37,4 +39,5 @@ print(f"{ds:<7} {loc['used']:6d} {loc['abs_trans_mean_m']:8.4f} {onl['abs_trans_
       f"{loc['abs_rot_mean_deg']:8.3f} {onl['abs_rot_mean_deg']:8.3f} {full['abs_rot_mean_deg']:8.3f} "
       f"{s['localization']['tracking_fraction']:8.3f} {s['counts']['relocalisations']:6d} "
       f"{fix if fix is not None else float('nan'):7.2f} {fix_err:9.3f} {s['timing']['real_time_factor']:8.1f} "
-      f"{fast['timing']['real_time_factor']:8.1f} {k['timing']['real_time_factor']:8.1f}")
+      f"{fast['timing']['real_time_factor']:8.1f} {k['timing']['real_time_factor']:8.1f} "
+      f"{j['relocalised']}/{j['within_3s']}/{j['jumps']:<3} {jump_s:7.2f}")

@@ -15,13 +15,18 @@
 #   tracked            share of the second half's scans tracked (the rest: lost, e.g. rooms the first
 #                      half never entered);
 #   reloc              relocalisations (place searches that found the pose) in the run with --initial;
-#   fix_s              kidnapping: the second half localized with no initial pose, log time from its
+#   fix_s              started lost: the second half localized with no initial pose, log time from its
 #                      first scan to the first tracked one;
 #   fix_err_m          that first fix against the full run's pose at the same scan (map frames agree:
 #                      both runs start at the same first scan);
 #   rtf                log duration / wall time of `urbanslam localize` with --initial (map loading
 #                      included); rtf_onl the same with --no-smoothing (no local SLAM trajectory);
-#                      rtf_kidnap the kidnapped run's (smoothed).
+#                      rtf_lost the run started lost (smoothed);
+#   jumps              kidnapping (kidnap.py): five times the vehicle tracked for 10 s, then carried
+#                      to a place at least 5 m away and 30 s later in the log, its odometry
+#                      unaware; relocalised within 20 s / within 3 s / jumps;
+#   jump_s             the median log time from the jump to the first pose within 0.5 m and 10° of
+#                      the uninterrupted run's (of the jumps relocalised).
 # Environment: DATASETS="intel fr079" (default: intel aces fr079 csail).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
@@ -33,8 +38,8 @@ HERE=bench/localize
 mkdir -p "$OUT"
 declare -A LOG=([intel]=intel [aces]=aces [fr079]=fr079 [csail]=mit-csail)
 declare -A REL=([intel]=intel [aces]=aces [fr079]=fr079 [csail]=mit-csail)
-printf "%-7s %6s %8s %8s %8s %8s %8s %8s %8s %6s %7s %9s %8s %8s %8s\n" dataset rel_n rel_m_loc rel_m_onl rel_m_full rel_deg_loc \
-  rel_deg_onl rel_deg_full tracked reloc fix_s fix_err_m rtf rtf_onl rtf_kidnap
+printf "%-7s %6s %8s %8s %8s %8s %8s %8s %8s %6s %7s %9s %8s %8s %8s %7s %7s\n" dataset rel_n rel_m_loc rel_m_onl rel_m_full rel_deg_loc \
+  rel_deg_onl rel_deg_full tracked reloc fix_s fix_err_m rtf rtf_onl rtf_lost jumps jump_s
 for ds in ${DATASETS:-intel aces fr079 csail}; do
   W=$OUT/$ds
   mkdir -p "$W"
@@ -50,7 +55,8 @@ for ds in ${DATASETS:-intel aces fr079 csail}; do
   cp "$W/loc/stats.json" "$W/loc_online/"
   cp "$W/loc/trajectory_online.tum" "$W/loc_online/trajectory_scans.tum"
   cp "$W/loc/trajectory_online.tum" "$W/loc_online/trajectory_odometry.tum"
-  "$U" localize --quiet --map "$W/map" --out "$W/kidnap" "$W/second.clf"
+  "$U" localize --quiet --map "$W/map" --out "$W/start_lost" "$W/second.clf"
+  python3 $HERE/kidnap.py "$U" "$W/map" "$W/second.clf" "$W/loc/localization.csv" "$W/jumps" > /dev/null 2>&1
   python3 $HERE/relations_within.py "$D/relations/${REL[$ds]}.relations" "$W/loc/trajectory_scans.tum" 1.0 > "$W/relations_tracked"
   "$U" eval "$W/loc" --relations "$W/relations_tracked" --time-offset 0 --max-gap 1 --json > "$W/eval_loc.json"
   "$U" eval "$W/loc_online" --relations "$W/relations_tracked" --time-offset 0 --max-gap 1 --json > "$W/eval_online.json"
