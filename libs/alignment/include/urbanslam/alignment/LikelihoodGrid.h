@@ -45,6 +45,8 @@ class LikelihoodGrid {
     return {static_cast<int>(std::floor((p.x() - origin_.x()) / resolution_)),
             static_cast<int>(std::floor((p.y() - origin_.y()) / resolution_))};
   }
+  // The centre of cell (i, j), where its value is taken.
+  Eigen::Vector2d cellCentre(int i, int j) const { return origin_ + resolution_ * Eigen::Vector2d(i + 0.5, j + 0.5); }
   // Levels up to options' full_resolution_levels are stored at full resolution (exact block
   // maxima); higher ones at 1/2^h of it (a looser bound).
   int shiftOf(int level) const { return level <= full_levels_ ? 0 : level; }
