@@ -42,6 +42,7 @@ KeyframeConstraint LocalSlam::keyframeConstraint(const io::LaserScan& scan) cons
   // Scan matching needs scans on both sides (camera-only keyframes have none).
   if (!options_.scan_matching || scan.ranges.empty() || !last_keyframe_has_scan_) return c;
   const alignment::PriorMatchResult r = matchSubmap(scan, c.z, c.cov);
+  c.matched_fraction = r.valid ? r.matchedFraction() : 0.0;
   if (!r.valid) {
     c.match = KeyframeConstraint::Match::Rejected;
     return c;
@@ -63,7 +64,7 @@ KeyframeConstraint LocalSlam::keyframeConstraint(const io::LaserScan& scan) cons
   return c;
 }
 
-std::optional<ScanAnchor> LocalSlam::placeScan(const io::LaserScan& scan, const ScanAnchor* previous) {
+std::optional<ScanAnchor> LocalSlam::placeScan(const io::LaserScan& scan, const ScanAnchor* previous, double* matched_fraction) {
   if (!options_.scan_matching || !options_.match_every_scan || scan.ranges.empty() || !last_keyframe_has_scan_) return std::nullopt;
   if (have_anchor_ && std::abs(scan.timestamp - last_anchor_time_) < options_.match_min_interval_s) return std::nullopt;
   // Its pose in the last keyframe's frame, for the trajectory at sensor times only (the filter
@@ -81,6 +82,7 @@ std::optional<ScanAnchor> LocalSlam::placeScan(const io::LaserScan& scan, const 
     reach = std::hypot(z.x - previous->offset.x, z.y - previous->offset.y) + std::hypot(since.x, since.y);
   }
   const alignment::PriorMatchResult r = matchSubmap(scan, motion_.increment(), cov, reach);
+  if (matched_fraction) *matched_fraction = r.valid ? r.matchedFraction() : 0.0;
   if (!r.valid) return std::nullopt;
   last_anchor_time_ = scan.timestamp;
   have_anchor_ = true;

@@ -27,18 +27,19 @@ void LocalTrajectory::onScan(io::LaserScan scan) {
     const size_t k = local_.keyframes();
     if (k > 0) keyframe_pose_ = common::compose(keyframe_pose_, c.z);
     keyframes_.push_back({c.z, c.cov});
-    scans_.push_back({t, k, {}});
+    scans_.push_back({t, k, {}, c.match == KeyframeConstraint::Match::NotTried ? -1.0 : c.matched_fraction});
     last_anchor_ = {t, k, {}, local_.motion().odometryPose()};
     local_.keyframeAdded(scan, c.z);
     return;
   }
   if (keyframes_.empty()) return;  // isKeyframe() holds for the first scan: not reached
-  if (const auto anchor = local_.placeScan(scan, &last_anchor_)) {
+  double matched = -1;
+  if (const auto anchor = local_.placeScan(scan, &last_anchor_, &matched)) {
     last_anchor_ = *anchor;
-    scans_.push_back({t, anchor->keyframe, anchor->offset});
+    scans_.push_back({t, anchor->keyframe, anchor->offset, matched});
   } else {
     // Not matched: the odometry since the keyframe places it.
-    scans_.push_back({t, local_.keyframes() - 1, local_.motion().increment()});
+    scans_.push_back({t, local_.keyframes() - 1, local_.motion().increment(), matched});
   }
 }
 

@@ -55,6 +55,8 @@ common::Json localizationStats(const std::vector<LocalizedScan>& scans, const Lo
   c["place_searches"] = s.place_searches;
   c["relocalisations"] = s.relocalisations;
   c["fixes_rejected"] = s.fixes_rejected;
+  c["discontinuities"] = s.discontinuities;
+  c["poses_replaced"] = s.poses_replaced;
   c["place_search_windows"] = s.place_search_windows;
   c["map_references_built"] = s.references_built;
   c["coarse_grids_built"] = s.coarse_grids_built;

@@ -127,10 +127,17 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
   stats_.last_timestamp = t;
   const alignment::PointSet points = alignment::pointSetFromScan(scan, areas_.options().scan_model, true);
 
-  // Local SLAM's pose of this scan, when it follows a local trajectory that placed it.
+  // Local SLAM's pose of this scan, when it follows a local trajectory that placed it, and
+  // whether its view broke off (header).
   std::optional<common::Pose2> local_now;
+  bool discontinuity = false;
   if (trajectory_)
-    if (const auto newest = trajectory_->newestScan(); newest && newest->timestamp == t) local_now = newest->pose;
+    if (const auto newest = trajectory_->newestScan(); newest && newest->timestamp == t) {
+      local_now = newest->pose;
+      const double f = trajectory_->scans().back().matched_fraction;
+      local_low_run_ = f >= 0 && f < options_.discontinuity_matched_fraction ? local_low_run_ + 1 : (f >= 0 ? 0 : local_low_run_);
+      discontinuity = local_low_run_ == options_.discontinuity_scans && state_ == LocalizationState::Tracking;
+    }
 
   // The prediction: the motion since the previous scan (local SLAM's, or the odometry's)
   // composed onto its pose, the covariance carried through the composition's Jacobians.
@@ -167,7 +174,39 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
     match_due = std::hypot(moved.x, moved.y) >= options_.match_spacing_m || std::abs(moved.phi) >= options_.match_spacing_deg * kDeg;
   }
   bool initial_contradicted = false;
-  if (state_ == LocalizationState::Tracking && !match_due) {
+  bool replaced = false;
+  if (discontinuity) {
+    // The dead reckoning from the pose rules nothing out any more; the whole map is searched,
+    // and the scan matched near the pose if the search does not replace it.
+    ++stats_.discontinuities;
+    confirmed_ = false;
+    match_due = true;
+    initial_pose_ = false;
+    common::Stopwatch sw;
+    const PlaceHypothesis h = places_.locate(points, matcher_);
+    stats_.place_search_wall_s += sw.seconds();
+    ++stats_.place_searches;
+    stats_.place_search_windows += static_cast<size_t>(h.candidates);
+    if (h.found && (std::hypot(h.pose.x - predicted.x, h.pose.y - predicted.y) > options_.places.distinct_m ||
+                    std::abs(common::wrapToPi(h.pose.phi - predicted.phi)) > options_.places.distinct_deg * kDeg)) {
+      setPose(h.pose, options_.covariance_scale * h.cov);
+      out.map_fix = true;
+      out.map_pose = pose_;
+      out.map_cov = cov_;
+      out.matched = true;
+      out.relocalised = true;
+      out.matched_fraction = h.matched_fraction;
+      consecutive_matches_ = 0;
+      monitor_.reset();
+      local_at_match_ = local_now;
+      ++stats_.relocalisations;
+      ++stats_.poses_replaced;
+      replaced = true;
+    }
+  }
+  if (replaced) {
+    // Placed by the search.
+  } else if (state_ == LocalizationState::Tracking && !match_due) {
     ++stats_.matches_skipped;
     setPose(predicted, predicted_cov);
   } else if (state_ == LocalizationState::Tracking) {

@@ -24,6 +24,7 @@ struct KeyframeConstraint {
   common::Pose2 z;
   Eigen::Matrix3d cov = Eigen::Matrix3d::Identity();
   enum class Match { NotTried, Used, Rejected } match = Match::NotTried;
+  double matched_fraction = 0;  // of the scan, by the submap match (when tried)
 };
 
 class LocalSlam {
@@ -44,7 +45,9 @@ class LocalSlam {
   // when not matched (disabled, too soon after the last anchor, or no valid match). `previous`:
   // the map's newest anchor (the last keyframe or a scan matched since): the vehicle was there,
   // so odometry wrong in direction can only have misled it since (the search's reach).
-  std::optional<ScanAnchor> placeScan(const io::LaserScan& scan, const ScanAnchor* previous);
+  // `matched_fraction`: set to the share of the scan the match explained (0 when it failed), left
+  // as it is when no match was tried.
+  std::optional<ScanAnchor> placeScan(const io::LaserScan& scan, const ScanAnchor* previous, double* matched_fraction = nullptr);
   // Keyframes so far (the index the next one gets).
   size_t keyframes() const { return keyframes_; }
   // `scan` became the newest keyframe, `z` the constraint from the previous one that global SLAM

@@ -35,6 +35,9 @@ class LocalTrajectory {
     double timestamp;
     size_t keyframe;       // the keyframe it hangs from (itself, for a keyframe's scan)
     common::Pose2 offset;  // its pose in that keyframe's frame
+    // The share of the scan local SLAM's submap match explained (0: the match failed); -1 when
+    // no match was tried (the first keyframe, a scan too soon after the last one).
+    double matched_fraction = -1;
   };
   const std::vector<Step>& keyframes() const { return keyframes_; }
   // Every scan [input] accepted, in order.
