@@ -24,19 +24,8 @@ import statistics
 import subprocess
 import sys
 
-
-def compose(a, b):
-    c, s = math.cos(a[2]), math.sin(a[2])
-    return (a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], a[2] + b[2])
-
-
-def inverse(a):
-    c, s = math.cos(a[2]), math.sin(a[2])
-    return (-c * a[0] - s * a[1], s * a[0] - c * a[1], -a[2])
-
-
-def wrap(a):
-    return math.atan2(math.sin(a), math.cos(a))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "slam"))
+from pose2 import between, compose, wrap  # noqa: E402
 
 
 def fmt(v):
@@ -142,7 +131,7 @@ def main():
         kind = "ODOM" if any(m.f[0] == "ODOM" for m in msgs) else "FLASER"
         o1 = next(m for m in reversed(before) if m.f[0] == kind).odometry()
         o2 = next(m for m in after if m.f[0] == kind).odometry()
-        transform = compose(o1, inverse(o2))
+        transform = compose(o1, between(o2, (0.0, 0.0, 0.0)))  # o1 ⊕ ⊖o2: takes o2 to o1
         log = os.path.join(a.out, f"jump{k}.clf")
         with open(log, "w") as fh:
             fh.write("\n".join(header) + "\n")

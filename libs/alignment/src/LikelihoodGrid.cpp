@@ -125,7 +125,7 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
       std::fill(dst + a1 + 1, dst + w_, floor_);
       span_lo[b] = a0;
     }
-    // Rows past the last step rows take the floor below them: no change.
+    // The last `step` rows' blocks reach past the grid, into the floor: they stay as they are.
     for (size_t b = 0; b + static_cast<size_t>(step) < h_; ++b) {
       const size_t c = b + static_cast<size_t>(step);
       if (span_lo[c] > span_hi[c]) continue;

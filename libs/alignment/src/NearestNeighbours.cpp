@@ -30,8 +30,8 @@ using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<do
 // was a third of a localization's and a tenth of a mapping run's: the refinements ask once per
 // scan point and iteration). A scan's returns reach tens of metres, sparsely: the grid covers a
 // square around the points' median, at most max(16 n, 65536) cells, and answers the queries
-// that fall inside it far enough from its edge that every point within their bound is in it;
-// the rest go to the kd-tree.
+// whose bound cannot reach a point outside it: every query when no point was left out, else
+// those far enough inside; the rest go to the kd-tree.
 struct CellGrid {
   static constexpr double kCellM = 0.1;
   static constexpr int kMaxRings = 4;                           // bounds reaching farther go to the kd-tree

@@ -110,6 +110,31 @@ common::Pose2 Localizer::odometryLead(double t) const {
   return {f * step.x, f * step.y, f * step.phi};
 }
 
+PlaceHypothesis Localizer::searchPlaces(const alignment::PointSet& points, const std::optional<PlaceSearchRegion>& region) {
+  common::Stopwatch sw;
+  PlaceHypothesis h = places_.locate(points, matcher_, region);
+  stats_.place_search_wall_s += sw.seconds();
+  ++stats_.place_searches;
+  stats_.place_search_windows += static_cast<size_t>(h.candidates);
+  return h;
+}
+
+void Localizer::takeFix(const PlaceHypothesis& h, bool confirmed, LocalizedScan& out) {
+  setPose(h.pose, options_.covariance_scale * h.cov);
+  state_ = LocalizationState::Tracking;
+  confirmed_ = confirmed;
+  consecutive_matches_ = 0;
+  monitor_.reset();
+  searched_ = false;
+  out.map_fix = true;
+  out.map_pose = pose_;
+  out.map_cov = cov_;
+  out.relocalised = true;
+  out.matched = true;
+  out.matched_fraction = h.matched_fraction;
+  ++stats_.relocalisations;
+}
+
 bool Localizer::placeSearchDue(double t) const {
   if (!searched_) return true;
   if (t - last_search_time_ < search_interval_s_) return false;
@@ -134,8 +159,9 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
   if (trajectory_)
     if (const auto newest = trajectory_->newestScan(); newest && newest->timestamp == t) {
       local_now = newest->pose;
-      const double f = trajectory_->scans().back().matched_fraction;
-      local_low_run_ = f >= 0 && f < options_.discontinuity_matched_fraction ? local_low_run_ + 1 : (f >= 0 ? 0 : local_low_run_);
+      // A scan local SLAM did not try to match (too soon after the last) neither extends nor ends a run.
+      if (const double f = trajectory_->scans().back().matched_fraction; f >= 0)
+        local_low_run_ = f < options_.discontinuity_matched_fraction ? local_low_run_ + 1 : 0;
       discontinuity = local_low_run_ == options_.discontinuity_scans && state_ == LocalizationState::Tracking;
     }
 
@@ -182,24 +208,10 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
     confirmed_ = false;
     match_due = true;
     initial_pose_ = false;
-    common::Stopwatch sw;
-    const PlaceHypothesis h = places_.locate(points, matcher_);
-    stats_.place_search_wall_s += sw.seconds();
-    ++stats_.place_searches;
-    stats_.place_search_windows += static_cast<size_t>(h.candidates);
+    const PlaceHypothesis h = searchPlaces(points);
     if (h.found && (std::hypot(h.pose.x - predicted.x, h.pose.y - predicted.y) > options_.places.distinct_m ||
                     std::abs(common::wrapToPi(h.pose.phi - predicted.phi)) > options_.places.distinct_deg * kDeg)) {
-      setPose(h.pose, options_.covariance_scale * h.cov);
-      out.map_fix = true;
-      out.map_pose = pose_;
-      out.map_cov = cov_;
-      out.matched = true;
-      out.relocalised = true;
-      out.matched_fraction = h.matched_fraction;
-      consecutive_matches_ = 0;
-      monitor_.reset();
-      local_at_match_ = local_now;
-      ++stats_.relocalisations;
+      takeFix(h, false, out);
       ++stats_.poses_replaced;
       replaced = true;
     }
@@ -293,16 +305,12 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
   motion_.reset();
   lead_ = odometryLead(t);
   if (state_ == LocalizationState::Lost && placeSearchDue(t)) {
-    common::Stopwatch sw;
     // A confirmed dead reckoning rules out every place beyond its gate (below): those are not
     // searched at all, which also leaves no search where the map never reached.
     std::optional<PlaceSearchRegion> region;
     const double k2 = options_.continuity_sigma_scale * options_.continuity_sigma_scale;
     if (confirmed_ && have_pose_) region = PlaceSearchRegion{{pose_.x, pose_.y}, k2 * cov_.topLeftCorner<2, 2>(), continuity_gate_};
-    const PlaceHypothesis h = places_.locate(points, matcher_, region);
-    stats_.place_search_wall_s += sw.seconds();
-    ++stats_.place_searches;
-    stats_.place_search_windows += static_cast<size_t>(h.candidates);
+    const PlaceHypothesis h = searchPlaces(points, region);
     bool accepted = h.found;
     if (h.found && region) {
       const Eigen::Vector2d d(h.pose.x - pose_.x, h.pose.y - pose_.y);
@@ -311,21 +319,9 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
       if (!accepted) ++stats_.fixes_rejected;
     }
     if (accepted) {
-      setPose(h.pose, options_.covariance_scale * h.cov);
-      out.map_fix = true;
-      out.map_pose = pose_;
-      out.map_cov = cov_;
-      consecutive_matches_ = 0;
       // A fix that the confirmed dead reckoning admitted carries its confirmation on; one from
       // the whole map has yet to earn it.
-      confirmed_ = region.has_value();
-      state_ = LocalizationState::Tracking;
-      monitor_.reset();
-      out.relocalised = true;
-      out.matched = true;
-      out.matched_fraction = h.matched_fraction;
-      ++stats_.relocalisations;
-      searched_ = false;
+      takeFix(h, region.has_value(), out);
     } else {
       search_interval_s_ =
           searched_ ? std::min(options_.relocalise_max_interval_s, 2 * search_interval_s_) : options_.relocalise_interval_s;

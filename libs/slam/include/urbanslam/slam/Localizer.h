@@ -172,6 +172,11 @@ class Localizer {
  private:
   LocalizedScan onScan(io::LaserScan scan);
   bool placeSearchDue(double t) const;
+  // A place search (the whole map, or only `region`), counted in the stats.
+  PlaceHypothesis searchPlaces(const alignment::PointSet& points, const std::optional<PlaceSearchRegion>& region = std::nullopt);
+  // A place search's fix becomes the pose: tracking again, confirmed only when `confirmed` (a fix
+  // the confirmed dead reckoning admitted), a relocalisation in `out` and the stats.
+  void takeFix(const PlaceHypothesis& h, bool confirmed, LocalizedScan& out);
   // The pose and its covariance, floored (withFloors).
   void setPose(const common::Pose2& pose, const Eigen::Matrix3d& cov);
 
