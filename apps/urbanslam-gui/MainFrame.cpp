@@ -18,6 +18,7 @@
 
 #include "urbanslam/common/Error.h"
 #include "urbanslam/io/MapOutputs.h"
+#include "urbanslam/slam/MovingPoints.h"
 #include "urbanslam/slam/RunOutputs.h"
 
 namespace urbanslam::gui {
@@ -313,8 +314,14 @@ void MainFrame::buildMenus() {
       },
       kColourHeight);
 
-  // Exports use the same writers as `urbanslam run`.
-  const auto cloud = [](const slam::Pipeline& p) { return io::mapPoints(p.posedKeyframes(), p.options().map.point_decimation); };
+  // Exports use the same writers and the same moving-point removal as `urbanslam run`.
+  const auto cloud = [](const slam::Pipeline& p) {
+    const auto posed = p.posedKeyframes();
+    const slam::MapOptions& m = p.options().map;
+    if (!m.remove_moving_points) return io::mapPoints(posed, m.point_decimation);
+    const io::PointMask keep = slam::findMovingPoints(posed, m.movingPoints()).static_points;
+    return io::mapPoints(posed, m.point_decimation, &keep);
+  };
   Bind(
       wxEVT_MENU,
       [this, cloud](wxCommandEvent&) {

@@ -37,8 +37,9 @@ int evalCommand(const Argv& args) {
                "    at_scans, one_interval (inside one interval between two scans: odometry only), other; each\n"
                "    with n, abs_trans_mean_m and share_m (its error sum over all relations; the shares add up).\n"
                "  --truth: a simulated drive's folder (`urbanslam simulate`): its truth.tum is the reference, and\n"
-               "    also map (distance of every keyframe scan point, placed by the run and carried by the ATE's\n"
-               "    alignment, to the nearest true wall of walls.csv: mean, median, p95, within_0_1_m, beyond_1_m)\n"
+               "    also map (distance of every point of RUN_DIR/map.ply, or without it of the keyframe scans of\n"
+               "    map.simplemap, carried by the ATE's alignment, to the nearest true wall of walls.csv: source,\n"
+               "    mean, median, p95, within_0_1_m, beyond_1_m)\n"
                "    and loops_recall (revisited scans of loops.csv joined by an accepted closure within 2 s of both times).\n"
                "Plots: RUN_DIR/eval_trajectory.png, RUN_DIR/eval_error.png.");
   ap.addPositional("RUN_DIR", "output folder of urbanslam run");

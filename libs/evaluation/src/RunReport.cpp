@@ -63,14 +63,23 @@ common::Json poseJson(const common::Pose2& p) {
 
 // The map against the simulated city's walls, and the share of true revisits closed.
 void evaluateAgainstSimulation(const fs::path& run, const fs::path& sim, const common::Pose2& to_truth, common::Json& j) {
-  const fs::path simplemap = run / "map.simplemap";
-  if (!fs::exists(simplemap))
-    throw common::InputError(simplemap.string() + ": missing (the map is scored on the keyframe scans; [output] write_simplemap = true)");
-  const auto keyframes = io::readSimpleMap(simplemap.string());
-  std::vector<io::PosedScan> posed;
-  for (const auto& k : keyframes) posed.push_back({k.pose, &k.scan});
-  const auto acc = mapAccuracy(io::mapPoints(posed), to_truth, readWallsCsv((sim / "walls.csv").string()));
+  // The map as the run exported it (map.ply: moving things left out), or else every point of
+  // the keyframes' scans.
+  const fs::path ply = run / "map.ply", simplemap = run / "map.simplemap";
+  std::vector<io::MapPoint> points;
+  if (fs::exists(ply)) {
+    points = io::readPly(ply.string());
+  } else if (fs::exists(simplemap)) {
+    const auto keyframes = io::readSimpleMap(simplemap.string());
+    std::vector<io::PosedScan> posed;
+    for (const auto& k : keyframes) posed.push_back({k.pose, &k.scan});
+    points = io::mapPoints(posed);
+  } else {
+    throw common::InputError(run.string() + ": neither map.ply nor map.simplemap (the map is scored on one of them; [output])");
+  }
+  const auto acc = mapAccuracy(points, to_truth, readWallsCsv((sim / "walls.csv").string()));
   common::Json m = common::Json::object();
+  m["source"] = fs::exists(ply) ? "map.ply" : "map.simplemap";
   m["points"] = acc.points;
   m["mean_m"] = acc.mean_m;
   m["median_m"] = acc.median_m;

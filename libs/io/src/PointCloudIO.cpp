@@ -6,9 +6,12 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
+#include <sstream>
 #include <ostream>
 
 #include "urbanslam/common/AtomicFile.h"
+#include "urbanslam/common/Error.h"
 #include "urbanslam/io/MapOutputs.h"
 
 namespace urbanslam::io {
@@ -55,9 +58,10 @@ PointsSource whole(const std::vector<MapPoint>& pts) {
   return [&pts](const std::function<void(const std::vector<MapPoint>&)>& visit) { visit(pts); };
 }
 
-PointsSource streamed(const std::vector<PosedScan>& scans, int decimation) {
-  return
-      [&scans, decimation](const std::function<void(const std::vector<MapPoint>&)>& visit) { forEachMapPoint(scans, decimation, visit); };
+PointsSource streamed(const std::vector<PosedScan>& scans, int decimation, const PointMask* mask) {
+  return [&scans, decimation, mask](const std::function<void(const std::vector<MapPoint>&)>& visit) {
+    forEachMapPoint(scans, decimation, visit, mask);
+  };
 }
 
 }  // namespace
@@ -77,16 +81,17 @@ size_t PosedScan::validCount() const {
   return scan ? scan->validCount() : compact ? compact->validCount() : store ? store->validCount(id) : 0;
 }
 
-size_t forEachMapPoint(const std::vector<PosedScan>& scans, int decimation,
-                       const std::function<void(const std::vector<MapPoint>&)>& visit) {
+size_t forEachMapPoint(const std::vector<PosedScan>& scans, int decimation, const std::function<void(const std::vector<MapPoint>&)>& visit,
+                       const PointMask* mask) {
   const size_t step = decimationStep(decimation);
-  size_t k = 0, n = 0;
+  size_t point = 0, k = 0, n = 0;
   LaserScan buffer;
   std::vector<MapPoint> pts;
   for (const auto& ps : scans) {
     const double c = std::cos(ps.pose.phi), s = std::sin(ps.pose.phi);
     pts.clear();
     for (const auto& p : scanToPoints(ps.get(buffer), true)) {
+      if (mask && !mask->keeps(point++)) continue;
       if (k++ % step) continue;
       pts.push_back({static_cast<float>(ps.pose.x + c * p.x - s * p.y), static_cast<float>(ps.pose.y + s * p.x + c * p.y), 0.f});
     }
@@ -96,18 +101,20 @@ size_t forEachMapPoint(const std::vector<PosedScan>& scans, int decimation,
   return n;
 }
 
-size_t countMapPoints(const std::vector<PosedScan>& scans, int decimation) {
+size_t countMapPoints(const std::vector<PosedScan>& scans, int decimation, const PointMask* mask) {
   size_t valid = 0;
   for (const auto& ps : scans) valid += ps.validCount();
+  if (mask) valid = mask->kept() + (valid > mask->size() ? valid - mask->size() : 0);
   // Points k = 0, step, 2 step, ... of the valid beams in order.
   const size_t step = decimationStep(decimation);
   return (valid + step - 1) / step;
 }
 
-std::vector<MapPoint> mapPoints(const std::vector<PosedScan>& scans, int decimation) {
+std::vector<MapPoint> mapPoints(const std::vector<PosedScan>& scans, int decimation, const PointMask* mask) {
   std::vector<MapPoint> out;
-  out.reserve(countMapPoints(scans, decimation));
-  forEachMapPoint(scans, decimation, [&](const std::vector<MapPoint>& pts) { out.insert(out.end(), pts.begin(), pts.end()); });
+  out.reserve(countMapPoints(scans, decimation, mask));
+  forEachMapPoint(
+      scans, decimation, [&](const std::vector<MapPoint>& pts) { out.insert(out.end(), pts.begin(), pts.end()); }, mask);
   return out;
 }
 
@@ -117,9 +124,9 @@ void writePly(const std::string& path, const std::vector<MapPoint>& pts, PlyEnco
   f.commit();
 }
 
-void writePly(const std::string& path, const std::vector<PosedScan>& scans, int decimation, PlyEncoding encoding) {
+void writePly(const std::string& path, const std::vector<PosedScan>& scans, int decimation, PlyEncoding encoding, const PointMask* mask) {
   common::AtomicFile f(path, encoding == PlyEncoding::BinaryLittleEndian);
-  writePlyBody(f.stream(), countMapPoints(scans, decimation), encoding, streamed(scans, decimation));
+  writePlyBody(f.stream(), countMapPoints(scans, decimation, mask), encoding, streamed(scans, decimation, mask));
   f.commit();
 }
 
@@ -129,9 +136,9 @@ void writePcd(const std::string& path, const std::vector<MapPoint>& pts) {
   f.commit();
 }
 
-void writePcd(const std::string& path, const std::vector<PosedScan>& scans, int decimation) {
+void writePcd(const std::string& path, const std::vector<PosedScan>& scans, int decimation, const PointMask* mask) {
   common::AtomicFile f(path);
-  writePcdBody(f.stream(), countMapPoints(scans, decimation), streamed(scans, decimation));
+  writePcdBody(f.stream(), countMapPoints(scans, decimation, mask), streamed(scans, decimation, mask));
   f.commit();
 }
 
@@ -141,10 +148,60 @@ void writeXyz(const std::string& path, const std::vector<MapPoint>& pts) {
   f.commit();
 }
 
-void writeXyz(const std::string& path, const std::vector<PosedScan>& scans, int decimation) {
+void writeXyz(const std::string& path, const std::vector<PosedScan>& scans, int decimation, const PointMask* mask) {
   common::AtomicFile f(path);
-  writeXyzLines(f.stream(), streamed(scans, decimation));
+  writeXyzLines(f.stream(), streamed(scans, decimation, mask));
   f.commit();
+}
+
+std::vector<MapPoint> readPly(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw common::InputError(path + ": cannot open");
+  std::string line;
+  if (!std::getline(in, line) || line != "ply") throw common::InputError(path + ": not a PLY file");
+  bool binary = false, have_format = false;
+  size_t count = 0;
+  std::vector<std::string> properties;
+  bool in_vertex = false;
+  while (std::getline(in, line) && line != "end_header") {
+    std::istringstream ls(line);
+    std::string word;
+    ls >> word;
+    if (word == "format") {
+      std::string f;
+      ls >> f;
+      if (f != "ascii" && f != "binary_little_endian") throw common::InputError(path + ": PLY format '" + f + "' is not read");
+      binary = f == "binary_little_endian";
+      have_format = true;
+    } else if (word == "element") {
+      std::string name;
+      long long n = -1;
+      ls >> name >> n;
+      in_vertex = name == "vertex";
+      if (in_vertex) {
+        if (n < 0) throw common::InputError(path + ": bad vertex count");
+        count = static_cast<size_t>(n);
+      } else if (n != 0) {
+        throw common::InputError(path + ": element '" + name + "' is not read (only vertices)");
+      }
+    } else if (word == "property" && in_vertex) {
+      std::string type, name;
+      ls >> type >> name;
+      if (type != "float") throw common::InputError(path + ": vertex property '" + name + "' is not a float");
+      properties.push_back(name);
+    }
+  }
+  if (line != "end_header" || !have_format) throw common::InputError(path + ": PLY header incomplete");
+  if (properties != std::vector<std::string>{"x", "y", "z"}) throw common::InputError(path + ": vertices are not (x, y, z)");
+  std::vector<MapPoint> out;
+  // Not reserved from the header's count: a corrupt count must not allocate gigabytes.
+  for (size_t i = 0; i < count; ++i) {
+    MapPoint p;
+    if (binary ? !in.read(reinterpret_cast<char*>(&p), sizeof p) : !(in >> p.x >> p.y >> p.z))
+      throw common::InputError(path + ": truncated after " + std::to_string(i) + " of " + std::to_string(count) + " vertices");
+    out.push_back(p);
+  }
+  return out;
 }
 
 }  // namespace urbanslam::io

@@ -150,6 +150,11 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("scan_cache_mb", o.map.scan_cache_mb, 0, 1e6, "MB", "keyframe scans held in memory at most; the rest wait in a spill file");
   s.add("scan_spill_dir", o.map.scan_spill_dir, {},
         "folder of the spill file (deleted with the run); empty: the system's temporary folder");
+  s.add("remove_moving_points", o.map.remove_moving_points,
+        "leave out of the point clouds the points another keyframe's scan saw through (cars, people, doors that moved)");
+  s.add("moving_points_reach_m", o.map.moving_points_reach_m, 1.0, 1000.0, "m", "keyframes within this distance judge a keyframe's points");
+  s.add("moving_points_views", o.map.moving_points_views, 1, 1000, "keyframes", "at most this many of them, spread over the log");
+  s.add("moving_points_min_views", o.map.moving_points_min_views, 1, 1000, "keyframes", "a point seen through by this many has moved");
 
   s.section("output", "Which files a run writes besides the trajectory, stats.json and config.ini");
   s.add("write_ply_binary", o.output.write_ply_binary, "map.ply (binary little-endian PLY)");

@@ -12,6 +12,7 @@
 #include "urbanslam/io/GridTiles.h"
 #include "urbanslam/io/MapOutputs.h"
 #include "urbanslam/slam/MapFile.h"
+#include "urbanslam/slam/MovingPoints.h"
 
 namespace urbanslam::slam {
 
@@ -116,21 +117,25 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   // the largest thing in memory.
   const auto posed = p.posedKeyframes();
   const int decimation = o.map.point_decimation;
-  const size_t map_points = io::countMapPoints(posed, decimation);
+  const bool clouds = o.output.write_ply_binary || o.output.write_ply_ascii || o.output.write_pcd || o.output.write_xyz;
+  MovingPointsResult moving;
+  if (clouds && o.map.remove_moving_points) moving = findMovingPoints(posed, o.map.movingPoints());
+  const io::PointMask* mask = o.map.remove_moving_points ? &moving.static_points : nullptr;
+  const size_t map_points = io::countMapPoints(posed, decimation, mask);
   if (o.output.write_ply_binary) {
-    io::writePly(path("map.ply"), posed, decimation, io::PlyEncoding::BinaryLittleEndian);
+    io::writePly(path("map.ply"), posed, decimation, io::PlyEncoding::BinaryLittleEndian, mask);
     files.push("map.ply");
   }
   if (o.output.write_ply_ascii) {
-    io::writePly(path("map_ascii.ply"), posed, decimation, io::PlyEncoding::Ascii);
+    io::writePly(path("map_ascii.ply"), posed, decimation, io::PlyEncoding::Ascii, mask);
     files.push("map_ascii.ply");
   }
   if (o.output.write_pcd) {
-    io::writePcd(path("map.pcd"), posed, decimation);
+    io::writePcd(path("map.pcd"), posed, decimation, mask);
     files.push("map.pcd");
   }
   if (o.output.write_xyz) {
-    io::writeXyz(path("map.xyz"), posed, decimation);
+    io::writeXyz(path("map.xyz"), posed, decimation, mask);
     files.push("map.xyz");
   }
   if (o.output.write_simplemap) {
@@ -179,6 +184,7 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   c["reference_poses"] = s.reference;
   c["keyframes"] = p.keyframes().size();
   c["map_points"] = map_points;
+  c["map_points_moving"] = moving.moving;
   c["scan_matches_used"] = s.scan_matches_used;
   c["scan_matches_rejected"] = s.scan_matches_rejected;
   c["camera_motions_used"] = s.camera_motions_used;
@@ -211,6 +217,7 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   t["global_backlog_max"] = s.global_backlog_max;
   t["global_wait_s"] = s.global_wait_s;
   t["outputs_s"] = sw.seconds();
+  t["moving_points_s"] = moving.seconds;
   t["peak_rss_mb"] = static_cast<double>(common::peakResidentBytes()) / (1024.0 * 1024.0);
   // The keyframe scans: held in memory (bounded by [map] scan_cache_mb) and spilled to disk.
   Json scans = Json::object();

@@ -9,6 +9,7 @@
 #include "urbanslam/common/Pose2.h"
 #include "urbanslam/io/CompactScan.h"
 #include "urbanslam/io/LaserScan.h"
+#include "urbanslam/io/PointMask.h"
 #include "urbanslam/io/ScanStore.h"
 
 namespace urbanslam::io {
@@ -40,22 +41,28 @@ void writeTum(const std::string& path, const std::vector<StampedPose>& poses);
 // Reads a TUM trajectory (2D part). Throws common::InputError naming file and line.
 std::vector<StampedPose> readTum(const std::string& path);
 
-// World-frame points of all valid beams, optionally keeping every `decimation`-th point.
-std::vector<MapPoint> mapPoints(const std::vector<PosedScan>& scans, int decimation = 1);
+// World-frame points of all valid beams, optionally keeping every `decimation`-th point. With a
+// mask, only the points it keeps take part (decimation counts those).
+std::vector<MapPoint> mapPoints(const std::vector<PosedScan>& scans, int decimation = 1, const PointMask* mask = nullptr);
 // The same points one scan at a time, for writers that stream them (a city's cloud is tens of
 // bytes a beam held whole): `visit` gets each scan's points. Returns how many there were.
-size_t forEachMapPoint(const std::vector<PosedScan>& scans, int decimation, const std::function<void(const std::vector<MapPoint>&)>& visit);
+size_t forEachMapPoint(const std::vector<PosedScan>& scans, int decimation, const std::function<void(const std::vector<MapPoint>&)>& visit,
+                       const PointMask* mask = nullptr);
 // How many points mapPoints would give, without building them.
-size_t countMapPoints(const std::vector<PosedScan>& scans, int decimation = 1);
+size_t countMapPoints(const std::vector<PosedScan>& scans, int decimation = 1, const PointMask* mask = nullptr);
 
 enum class PlyEncoding { Ascii, BinaryLittleEndian };
 void writePly(const std::string& path, const std::vector<MapPoint>& pts, PlyEncoding encoding);
 void writePcd(const std::string& path, const std::vector<MapPoint>& pts);  // PCD v0.7, ASCII
 void writeXyz(const std::string& path, const std::vector<MapPoint>& pts);  // "x y z" per line
-// The same files for mapPoints(scans, decimation), streamed scan by scan.
-void writePly(const std::string& path, const std::vector<PosedScan>& scans, int decimation, PlyEncoding encoding);
-void writePcd(const std::string& path, const std::vector<PosedScan>& scans, int decimation);
-void writeXyz(const std::string& path, const std::vector<PosedScan>& scans, int decimation);
+// The same files for mapPoints(scans, decimation, mask), streamed scan by scan.
+void writePly(const std::string& path, const std::vector<PosedScan>& scans, int decimation, PlyEncoding encoding,
+              const PointMask* mask = nullptr);
+void writePcd(const std::string& path, const std::vector<PosedScan>& scans, int decimation, const PointMask* mask = nullptr);
+void writeXyz(const std::string& path, const std::vector<PosedScan>& scans, int decimation, const PointMask* mask = nullptr);
+// The points of a PLY file as writePly writes them (x, y, z floats, binary little-endian or
+// ASCII). Throws common::InputError naming the file.
+std::vector<MapPoint> readPly(const std::string& path);
 
 // MRPT CSimpleMap: one (pose, sensory frame with the scan) per keyframe.
 void writeSimpleMap(const std::string& path, const std::vector<PosedScan>& scans);

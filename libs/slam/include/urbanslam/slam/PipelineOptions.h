@@ -5,6 +5,7 @@
 #include <string>
 
 #include "urbanslam/common/OptionsSchema.h"
+#include "urbanslam/slam/MovingPoints.h"
 #include "urbanslam/vision_loop/ImageLoopOptions.h"
 
 namespace urbanslam::slam {
@@ -143,6 +144,18 @@ struct MapOptions {
   // the run) until a loop candidate or an output reads them.
   double scan_cache_mb = 256;
   std::string scan_spill_dir;  // the spill file's folder; empty: the system's temporary folder
+  // The point clouds leave out what another keyframe's scan saw through (MovingPoints.h).
+  bool remove_moving_points = true;
+  double moving_points_reach_m = 30;  // keyframes within this distance judge a keyframe's points
+  int moving_points_views = 16;       // ... at most this many of them
+  int moving_points_min_views = 2;    // a point seen through by this many has moved
+  MovingPointsOptions movingPoints() const {
+    MovingPointsOptions m;
+    m.reach_m = moving_points_reach_m;
+    m.views = moving_points_views;
+    m.min_views = moving_points_min_views;
+    return m;
+  }
 };
 
 struct OutputOptions {
