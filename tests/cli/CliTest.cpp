@@ -239,6 +239,19 @@ TEST(Cli, SimulatedDriveRunsFromFileAndStream) {
   };
   EXPECT_GT(field("within_0_1_m"), 0.5) << e.out;
   EXPECT_NE(e.out.find("\"loops_recall\":"), std::string::npos) << e.out;  // a 400 m drive has no revisit to score
+  // The exported cloud is what is scored; it left out the simulated traffic's points, so fewer of
+  // its points lie far from every true wall than of all the keyframes' points (map.simplemap,
+  // scored once map.ply is gone).
+  EXPECT_NE(e.out.find("\"source\":\"map.ply\""), std::string::npos) << e.out;
+  const double cloud_far = field("beyond_1_m");
+  fs::remove(d / "file" / "map.ply");
+  const CliResult all = runCli("eval --json " + (d / "file").string() + " --truth " + (d / "sim").string());
+  ASSERT_EQ(all.code, 0) << all.err;
+  EXPECT_NE(all.out.find("\"source\":\"map.simplemap\""), std::string::npos) << all.out;
+  const auto at = all.out.find("\"beyond_1_m\":");
+  ASSERT_NE(at, std::string::npos);
+  const double all_far = std::stod(all.out.substr(at + 13));
+  EXPECT_LT(cloud_far, 0.5 * all_far) << cloud_far << " vs " << all_far;
 }
 
 namespace {
