@@ -67,7 +67,8 @@ void evaluateAgainstSimulation(const fs::path& run, const fs::path& sim, const c
   // the keyframes' scans.
   const fs::path ply = run / "map.ply", simplemap = run / "map.simplemap";
   std::vector<io::MapPoint> points;
-  if (fs::exists(ply)) {
+  const bool from_ply = fs::exists(ply);
+  if (from_ply) {
     points = io::readPly(ply.string());
   } else if (fs::exists(simplemap)) {
     const auto keyframes = io::readSimpleMap(simplemap.string());
@@ -79,7 +80,7 @@ void evaluateAgainstSimulation(const fs::path& run, const fs::path& sim, const c
   }
   const auto acc = mapAccuracy(points, to_truth, readWallsCsv((sim / "walls.csv").string()));
   common::Json m = common::Json::object();
-  m["source"] = fs::exists(ply) ? "map.ply" : "map.simplemap";
+  m["source"] = from_ply ? "map.ply" : "map.simplemap";
   m["points"] = acc.points;
   m["mean_m"] = acc.mean_m;
   m["median_m"] = acc.median_m;

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 #include <limits>
 #include <list>
 #include <unordered_map>
@@ -10,39 +9,11 @@
 #include "urbanslam/alignment/BeamFreeSpace.h"
 #include "urbanslam/alignment/ScanModel.h"
 #include "urbanslam/common/Timing.h"
+#include "urbanslam/slam/KeyframeGrid.h"
 
 namespace urbanslam::slam {
 
 namespace {
-
-// The keyframes' positions in square cells of the reach: a keyframe's judges are in the 3 x 3
-// cells around it.
-class PositionGrid {
- public:
-  PositionGrid(const std::vector<io::PosedScan>& scans, double cell_m) : cell_(cell_m) {
-    for (size_t i = 0; i < scans.size(); ++i) cells_[key(cellOf(scans[i].pose.x), cellOf(scans[i].pose.y))].push_back(i);
-  }
-  // Indices within reach of (x, y), ascending.
-  void near(const std::vector<io::PosedScan>& scans, double x, double y, double reach_m, std::vector<size_t>& out) const {
-    out.clear();
-    const long long cx = cellOf(x), cy = cellOf(y);
-    for (long long i = cx - 1; i <= cx + 1; ++i)
-      for (long long j = cy - 1; j <= cy + 1; ++j)
-        if (const auto it = cells_.find(key(i, j)); it != cells_.end())
-          for (size_t k : it->second)
-            if (std::hypot(scans[k].pose.x - x, scans[k].pose.y - y) <= reach_m) out.push_back(k);
-    std::sort(out.begin(), out.end());
-  }
-
- private:
-  long long cellOf(double v) const { return static_cast<long long>(std::floor(v / cell_)); }
-  // Shifted unsigned: a left shift of a negative value is undefined behaviour.
-  static long long key(long long i, long long j) {
-    return static_cast<long long>(static_cast<unsigned long long>(i) << 32) ^ (j & 0xffffffffLL);
-  }
-  double cell_;
-  std::unordered_map<long long, std::vector<size_t>> cells_;
-};
 
 // The free space of the scans judged with recently, least recently used dropped: consecutive
 // keyframes mostly share their judges.
@@ -84,7 +55,9 @@ MovingPointsResult findMovingPoints(const std::vector<io::PosedScan>& scans, con
   common::Stopwatch sw;
   MovingPointsResult out;
   const size_t views = static_cast<size_t>(std::max(0, o.views));
-  const PositionGrid grid(scans, std::max(o.reach_m, 1.0));
+  // The map's own spatial index, over the scans' positions.
+  KeyframeGrid grid(std::max(o.reach_m, 1.0));
+  for (size_t i = 0; i < scans.size(); ++i) grid.insert(i, scans[i].pose.x, scans[i].pose.y);
   FreeSpaceCache cache(scans, o, std::max<size_t>(64, 8 * views));
   io::LaserScan buffer;
   std::vector<Eigen::Vector2d> world;
@@ -98,8 +71,14 @@ MovingPointsResult findMovingPoints(const std::vector<io::PosedScan>& scans, con
     // The points in the order the cloud writers visit them (forEachMapPoint).
     for (const auto& p : io::scanToPoints(scans[i].get(buffer), true))
       world.emplace_back(pose.x + c * p.x - s * p.y, pose.y + s * p.x + c * p.y);
-    grid.near(scans, pose.x, pose.y, o.reach_m, near);
-    near.erase(std::remove(near.begin(), near.end(), i), near.end());
+    near.clear();
+    grid.query(pose.x, pose.y, o.reach_m, near);
+    // Within reach, in log order, the keyframe itself left out.
+    near.erase(
+        std::remove_if(near.begin(), near.end(),
+                       [&](size_t k) { return k == i || !(std::hypot(scans[k].pose.x - pose.x, scans[k].pose.y - pose.y) <= o.reach_m); }),
+        near.end());
+    std::sort(near.begin(), near.end());
     // Spread over time: the judges evenly among the keyframes within reach, in log order.
     judges.clear();
     if (near.size() <= views) {

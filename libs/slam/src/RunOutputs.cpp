@@ -119,8 +119,9 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   const int decimation = o.map.point_decimation;
   const bool clouds = o.output.write_ply_binary || o.output.write_ply_ascii || o.output.write_pcd || o.output.write_xyz;
   MovingPointsResult moving;
-  if (clouds && o.map.remove_moving_points) moving = findMovingPoints(posed, o.map.movingPoints());
-  const io::PointMask* mask = o.map.remove_moving_points ? &moving.static_points : nullptr;
+  const bool remove_moving = clouds && o.map.remove_moving_points;
+  if (remove_moving) moving = findMovingPoints(posed, o.map.movingPoints());
+  const io::PointMask* mask = remove_moving ? &moving.static_points : nullptr;
   const size_t map_points = io::countMapPoints(posed, decimation, mask);
   if (o.output.write_ply_binary) {
     io::writePly(path("map.ply"), posed, decimation, io::PlyEncoding::BinaryLittleEndian, mask);
