@@ -34,9 +34,11 @@ for i in "${!CITIES[@]}"; do
   "$U" eval "$OUT/$name" --truth "$OUT/$name-truth" --json > "$OUT/$name.eval.json"
   rows+=("$name")
 done
+declare -A FILE=([intel]=intel [aces]=aces [fr079]=fr079 [csail]=mit-csail)
 for log in $LOGS; do
-  [ -f "$D/$log.clf.gz" ] || continue
-  "$B" --log "$D/$log.clf.gz" --ini "ini/$log.ini" --out "$OUT/$log" > "$OUT/$log.json"
+  f=$D/${FILE[$log]:-$log}.clf.gz
+  [ -f "$f" ] || { echo "run_scale.sh: $f not found, $log skipped" >&2; continue; }
+  "$B" --log "$f" --ini "ini/$log.ini" --out "$OUT/$log" > "$OUT/$log.json"
   rows+=("$log")
 done
 

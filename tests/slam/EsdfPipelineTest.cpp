@@ -120,11 +120,18 @@ TEST(EsdfPipeline, WrongPlaceClosureIsGatedOut) {
   lo.min_constraint_ratio = 0;                           // the other refusals off: this is about the gate
   lo.ambiguity_offset_m = 0;
   lo.max_free_space_conflict = 1;
-  slam::LoopCloser closer(lo);
+  lo.view_test = false;
   const size_t factors_before = f.factorCount();
-  const slam::LoopClosureRecord r = closer.tryClose(f, corrupted, i, k);
+  const slam::LoopClosureRecord r = slam::LoopCloser(lo).tryClose(f, corrupted, i, k);
   EXPECT_FALSE(r.accepted);
   EXPECT_EQ(r.reason, slam::ClosureReason::Gating) << "rms " << r.rms_m;
   EXPECT_GT(r.mahalanobis2, r.gate_threshold);
   EXPECT_EQ(f.factorCount(), factors_before);  // nothing touched the filter
+  // The view test knows it before aligning: nowhere the gate admits do the two scans (the same
+  // scan, metres from where the filter puts the pair) overlap enough.
+  lo.view_test = true;
+  const slam::LoopClosureRecord v = slam::LoopCloser(lo).tryClose(f, corrupted, i, k);
+  EXPECT_FALSE(v.accepted);
+  EXPECT_EQ(v.reason, slam::ClosureReason::NoOverlap);
+  EXPECT_EQ(f.factorCount(), factors_before);
 }

@@ -11,6 +11,7 @@
 #include "urbanslam/esdf/Gating.h"
 #include "urbanslam/esdf/PoseOps.h"
 #include "urbanslam/slam/Map.h"
+#include "urbanslam/slam/PathSubmaps.h"
 
 namespace urbanslam::slam {
 
@@ -43,12 +44,18 @@ const char* reasonName(ClosureReason reason) {
       return "no_filter";
     case ClosureReason::LoopClosureDisabled:
       return "loop_closure_disabled";
+    case ClosureReason::NoOverlap:
+      return "no_overlap";
+    case ClosureReason::Submaps:
+      return "submaps";
   }
   return "";
 }
 
 LoopCloser::LoopCloser(const LoopClosureOptions& options)
-    : options_(options), chi2_2dof_(esdf::chi2Quantile(options.mahalanobis_probability, 2)) {}
+    : options_(options),
+      chi2_2dof_(esdf::chi2Quantile(options.mahalanobis_probability, 2)),
+      chi2_3dof_gate_(esdf::chi2Quantile(options.chi2_gate_probability, 3)) {}
 
 void LoopCloser::setScorer(CandidateScorer scorer) { scorer_ = std::move(scorer); }
 
@@ -168,14 +175,28 @@ bool LoopCloser::ambiguous(const alignment::IndexedReference& earlier_points, co
 
 alignment::AlignmentResult LoopCloser::verifyAlignment(const io::LaserScan& earlier_scan, const io::LaserScan& current_scan,
                                                        const common::Pose2& guess, alignment::Method method, double reach_m,
-                                                       LoopClosureRecord& r) const {
+                                                       LoopClosureRecord& r, const alignment::PoseRegion* admitted) const {
   alignment::AlignerOptions ao;
   ao.min_constraint_ratio = options_.min_constraint_ratio;
   ao.method = method;
+  alignment::PointSet earlier_set = alignment::pointSetFromScan(earlier_scan, ao.scan, ao.in_vehicle_frame);
+  const alignment::PointSet current_points = alignment::pointSetFromScan(current_scan, ao.scan, ao.in_vehicle_frame);
+  // Two 180° scans that looked away from each other, or at places the other never saw, share no
+  // points wherever the gate would put them: the check costs microseconds, a global alignment
+  // that is bound to fail milliseconds (the most common failure in a city: the opposite lane).
+  if (admitted) {
+    alignment::ViewOverlapOptions vo;
+    vo.gate_m = ao.icp.gate_final_m;
+    const alignment::ViewSector sector = alignment::viewSector(earlier_set, earlier_scan.sensor_pose);
+    if (!alignment::mayMatchShare(sector, current_points, *admitted, options_.min_matched_fraction, vo)) {
+      r.measurement = guess;
+      r.reason = ClosureReason::NoOverlap;
+      return {};
+    }
+  }
   // The point sets, kd-tree and line normals built once for every alignment below (the
   // ambiguity test restarts PL-ICP up to 16 times).
-  const alignment::IndexedReference earlier_points(alignment::pointSetFromScan(earlier_scan, ao.scan, ao.in_vehicle_frame));
-  const alignment::PointSet current_points = alignment::pointSetFromScan(current_scan, ao.scan, ao.in_vehicle_frame);
+  const alignment::IndexedReference earlier_points(std::move(earlier_set));
   const alignment::AlignmentResult a = alignment::alignPointSets(earlier_points, current_points, guess, ao);
   r.measurement = a.transform;
   r.rms_m = a.rms_residual_m;
@@ -228,9 +249,28 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_
   // minima that pass the residual test — ATE 2.96 m vs 0.26 m on Intel.)
   // The map keeps its scans compact (and maybe on disk): expanded once for this candidate.
   const common::Pose2 guess = esdf::toPose(esdf::between(xi, xk));
-  const alignment::AlignmentResult a = verifyAlignment(map.scan(earlier), map.scan(current), guess, method, 3 * r.prior_sigma_m, r);
+  // Where the innovation gate admits a measurement: the relative pose's own uncertainty (the
+  // alignment's, centimetres, is left out).
+  const alignment::PoseRegion admitted{guess, s, chi2_3dof_gate_};
+  const alignment::AlignmentResult a = verifyAlignment(map.scan(earlier), map.scan(current), guess, method, 3 * r.prior_sigma_m, r,
+                                                       options_.view_test ? &admitted : nullptr);
   if (!detection) r.score = a.matchedFraction();
   if (r.reason != ClosureReason::None) return r;
+  // A closure far beyond what the estimate knew (found by appearance or from a wide prior) is
+  // where a consistently aliased street gets in: the two visits' path submaps, aligned from it,
+  // must stay there (within the confirmation tolerance) and have no other alignment nearly as
+  // good within the gate's reach.
+  if (options_.submap_check_path_m > 0 && r.prior_sigma_m > options_.appearance_min_sigma_m) {
+    PathSubmapOptions po;
+    po.path_m = options_.submap_check_path_m;
+    const SubmapCheck c = alignPathSubmaps(map, earlier, current, a.transform, 3 * r.prior_sigma_m, po);
+    const common::Pose2 d = common::between(a.transform, c.measurement);
+    if (c.ambiguous || (c.aligned && (std::hypot(d.x, d.y) > options_.confirm_tolerance_m ||
+                                      std::abs(d.phi) > options_.confirm_tolerance_deg * M_PI / 180))) {
+      r.reason = ClosureReason::Submaps;
+      return r;
+    }
+  }
   // Innovation gate, then the information-form update.
   const esdf::Mat3 cov = options_.covariance_scale * a.cov;
   r.information = cov.inverse();

@@ -110,12 +110,18 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("max_rms_m", o.loop_closure.max_rms_m, 0.001, 10.0, "m", "alignment accepted only below this RMS residual");
   s.add("min_matched_fraction", o.loop_closure.min_matched_fraction, 0.0, 1.0, "",
         "alignment accepted only with this share of points matched");
+  s.add("view_test", o.loop_closure.view_test,
+        "a pair whose scans could share min_matched_fraction of the current scan's points nowhere the innovation gate admits is not "
+        "aligned (a proof: off gives the same map, slower)");
   s.add("ambiguity_offset_m", o.loop_closure.ambiguity_offset_m, 0.0, 100.0, "m",
         "alignment accepted only when PL-ICP restarted from the result shifted by this along x and y finds no pose matching clearly more "
         "points; 0: off");
   s.add("ambiguity_min_gain", o.loop_closure.ambiguity_min_gain, 0.0, 1.0, "", "clearly more: this share more points matched");
   s.add("max_free_space_conflict", o.loop_closure.max_free_space_conflict, 0.0, 1.0, "",
         "alignment accepted only when at most this share of either scan's points lies in the other scan's free space; 1: off");
+  s.add("submap_check_path_m", o.loop_closure.submap_check_path_m, 0.0, 1000.0, "m",
+        "a closure beyond appearance_min_sigma_m is accepted only when the two visits' keyframes within this much path, aligned as two "
+        "submaps from it, stay within the confirmation tolerance; 0: off");
   s.add("free_space_no_return_m", o.loop_closure.free_space_no_return_m, 0.0, 1000.0, "m",
         "free-space test: a beam without a return (or beyond max_range_m) saw free space this far; 0: says nothing");
   s.add("free_space_margin_m", o.loop_closure.free_space_margin_m, 0.0, 10.0, "m",

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "urbanslam/alignment/Aligner.h"
+#include "urbanslam/alignment/ViewOverlap.h"
 #include "urbanslam/common/BinaryStream.h"
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/io/LaserScan.h"
@@ -38,6 +39,8 @@ enum class ClosureReason {
   CameraGeometry,       // an image proposal whose images gave no relative pose (too few inliers, degenerate)
   NoFilter,             // an image proposal in dead reckoning
   LoopClosureDisabled,  // an image proposal with [loop_closure] enabled = false
+  NoOverlap,            // nowhere the gate admits could the scans share min_matched_fraction (not aligned)
+  Submaps,              // the two visits' path submaps, aligned from the closure, moved away from it
 };
 // Its name in loop_closures.csv and in observer events ("" for None).
 const char* reasonName(ClosureReason reason);
@@ -104,9 +107,13 @@ class LoopCloser {
   // `method`: the alignment's residual and matched share, the ambiguity restarts as far as
   // reach_m, the free-space test. Fills r's measurement, rms_m, free_space_conflict and (when it
   // fails) reason; returns the alignment, its covariance not scaled yet. A place found with no
-  // estimate at all (another session's scan) is checked by this alone.
+  // estimate at all (another session's scan) is checked by this alone. With `admitted` (the
+  // relative poses the innovation gate would let in), scans that could not share
+  // min_matched_fraction of the current scan's points at any of them are not aligned at all
+  // (reason NoOverlap, the alignment not converged).
   alignment::AlignmentResult verifyAlignment(const io::LaserScan& earlier, const io::LaserScan& current, const common::Pose2& guess,
-                                             alignment::Method method, double reach_m, LoopClosureRecord& r) const;
+                                             alignment::Method method, double reach_m, LoopClosureRecord& r,
+                                             const alignment::PoseRegion* admitted = nullptr) const;
   // The relative covariances kept for the current keyframe (a later image proposal for it
   // reuses them). The scorer is code: whoever set it sets it again.
   void writeState(common::BinaryWriter& w) const;
@@ -120,6 +127,7 @@ class LoopCloser {
   LoopClosureOptions options_;
   CandidateScorer scorer_;
   double chi2_2dof_;
+  double chi2_3dof_gate_;  // the innovation gate's threshold
   size_t cached_for_ = static_cast<size_t>(-1);
   std::unordered_map<size_t, Eigen::Matrix3d> cached_;  // relative covariances for cached_for_
 };

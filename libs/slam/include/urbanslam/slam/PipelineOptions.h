@@ -98,6 +98,10 @@ struct LoopClosureOptions {
   double auto_local_max_deg = 15.0;   // ... and this; CRF-match + ICP otherwise
   double max_rms_m = 0.08;            // alignment accepted only below this residual ...
   double min_matched_fraction = 0.5;  // ... and with this share of points matched
+  // Pairs whose scans could not share min_matched_fraction of the current scan's points at any
+  // relative pose the innovation gate admits are not aligned (alignment::mayMatchShare, a proof:
+  // off gives the same map, slower; for measuring it and for tests of the later checks).
+  bool view_test = true;
   // ... and with the geometry constraining every direction: the weakest / strongest translation
   // eigenvalue of the alignment's information at least this. A closure along a corridor slides.
   double min_constraint_ratio = 0.15;
@@ -110,6 +114,10 @@ struct LoopClosureOptions {
   // ... and with the two scans agreeing on free space: at most this share of either scan's
   // points may lie where the other scan's beams passed through (1: off).
   double max_free_space_conflict = 0.2;
+  // ... and, for a closure beyond appearance_min_sigma_m, with the two visits' path submaps (their
+  // keyframes within this much path, PathSubmaps.h) aligning where the closure puts them, within
+  // the confirmation tolerance (0: off).
+  double submap_check_path_m = 30;
   double free_space_margin_m = 0.3;   // a point conflicts this far (+5 % of the range) inside free space
   double free_space_no_return_m = 0;  // a beam without a return saw free space this far (0: unknown)
   double covariance_scale = 4.0;

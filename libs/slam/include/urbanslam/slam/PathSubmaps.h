@@ -1,0 +1,46 @@
+#pragma once
+// A closure of two single scans can be wrong in a way no test of those two scans finds: along a
+// street of one building design, two scans from opposite lanes align about as well 1.5 m along
+// the street as at the right place, and the next pair of scans repeats the same aliasing. The
+// scans each visit took along its path see more of the street: a cross street, a gap between
+// buildings, a parked car. So each visit's neighbourhood along its own path becomes one point set
+// in its keyframe's frame (the poses within one visit are known to centimetres), and the
+// closure must still hold when these two point sets are aligned, starting from it.
+#include <cstddef>
+
+#include "urbanslam/alignment/PointSet.h"
+#include "urbanslam/common/Pose2.h"
+
+namespace urbanslam::slam {
+
+class Map;
+
+struct PathSubmapOptions {
+  double path_m = 30;    // each visit's keyframes within this much path of the closure's keyframe
+  double spacing_m = 3;  // one keyframe every this much path of it
+  double voxel_m = 0.3;  // one point per cell of this size
+  double min_shift_m = 6;  // the restarts' first shift (the single-scan ambiguity test covers the shorter ones)
+  double ambiguity_loss = 0.05;
+};
+
+// The scans of keyframes [first, last] within path_m of path of `center` (one every spacing_m),
+// thinned to a point per voxel, in center's vehicle frame (the keyframes' map poses).
+alignment::PointSet pathSubmap(const Map& map, size_t center, size_t first, size_t last, const PathSubmapOptions& options);
+
+struct SubmapCheck {
+  bool aligned = false;       // the two submaps could be aligned (enough overlap, not degenerate)
+  common::Pose2 measurement;  // the alignment of the current visit's submap onto the earlier's
+  // Another alignment, min_shift_m or more away, matches nearly as many points (at least
+  // 1 - ambiguity_loss of them): a street of one repeated design, as far as the submaps reach.
+  bool ambiguous = false;
+};
+
+// The two visits' submaps (the current one's path up to `current`, the earlier one's around
+// `earlier`, each on its own side of the halfway keyframe between them) aligned by PL-ICP from
+// the closure's measurement z (pose of current in earlier's frame); then restarted from that
+// alignment shifted along x and y by min_shift_m, twice and four times that, ... as far as
+// reach_m (what the innovation gate could admit).
+SubmapCheck alignPathSubmaps(const Map& map, size_t earlier, size_t current, const common::Pose2& z, double reach_m,
+                             const PathSubmapOptions& options);
+
+}  // namespace urbanslam::slam

@@ -1,0 +1,79 @@
+#include "urbanslam/slam/PathSubmaps.h"
+
+#include <cmath>
+#include <cstdint>
+#include <unordered_set>
+
+#include "urbanslam/alignment/Aligner.h"
+#include "urbanslam/alignment/IndexedReference.h"
+#include "urbanslam/alignment/ScanModel.h"
+#include "urbanslam/slam/Map.h"
+
+namespace urbanslam::slam {
+
+alignment::PointSet pathSubmap(const Map& map, size_t center, size_t first, size_t last, const PathSubmapOptions& options) {
+  const auto& kf = map.keyframes();
+  std::vector<size_t> chosen;
+  // Along the path each way from the centre, a keyframe every spacing_m.
+  for (const int step : {-1, 1}) {
+    double path = 0, last_taken = -options.spacing_m;
+    for (size_t j = center;;) {
+      if (kf[j].hasScan() && (j == center || path - last_taken >= options.spacing_m)) {
+        if (j != center || step < 0) chosen.push_back(j);
+        last_taken = path;
+      }
+      if ((step < 0 && j <= first) || (step > 0 && j >= last)) break;
+      const size_t next = step < 0 ? j - 1 : j + 1;
+      path += std::hypot(kf[next].pose.x - kf[j].pose.x, kf[next].pose.y - kf[j].pose.y);
+      if (path > options.path_m) break;
+      j = next;
+    }
+  }
+  alignment::PointSet out;
+  std::unordered_set<std::int64_t> taken;
+  const common::Pose2& origin = kf[center].pose;
+  for (const size_t j : chosen) {
+    const alignment::PointSet points = alignment::transformed(alignment::pointSetFromScan(map.scan(j), alignment::ScanModelOptions{}, true),
+                                                              common::between(origin, kf[j].pose));
+    for (const alignment::ScanPoint& p : points) {
+      const auto cx = static_cast<std::int64_t>(std::floor(p.p.x() / options.voxel_m));
+      const auto cy = static_cast<std::int64_t>(std::floor(p.p.y() / options.voxel_m));
+      if (taken.insert(cx * 2000003 + cy).second) out.push_back(p);
+    }
+  }
+  return out;
+}
+
+SubmapCheck alignPathSubmaps(const Map& map, size_t earlier, size_t current, const common::Pose2& z, double reach_m,
+                             const PathSubmapOptions& options) {
+  SubmapCheck out;
+  if (earlier >= current || current >= map.size()) return out;
+  // Each visit on its own side of the halfway keyframe: a short loop's two neighbourhoods must
+  // not share keyframes (they would align as the trajectory says, not as the closure does).
+  const size_t half = earlier + (current - earlier) / 2;
+  const alignment::IndexedReference before(pathSubmap(map, earlier, 0, half, options));
+  const alignment::PointSet now = pathSubmap(map, current, half + 1, current, options);
+  alignment::AlignerOptions ao;
+  ao.method = alignment::Method::PlIcp;
+  const alignment::AlignmentResult a = alignment::alignPointSets(before, now, z, ao);
+  out.aligned = a.converged;
+  out.measurement = a.transform;
+  if (!a.converged) return out;
+  const common::Pose2& t = a.transform;
+  for (double d = options.min_shift_m; d <= reach_m; d *= 2) {
+    for (const common::Pose2& g : {common::Pose2{t.x + d, t.y, t.phi}, common::Pose2{t.x - d, t.y, t.phi},
+                                   common::Pose2{t.x, t.y + d, t.phi}, common::Pose2{t.x, t.y - d, t.phi}}) {
+      const alignment::AlignmentResult b = alignment::alignPointSets(before, now, g, ao);
+      if (!b.converged) continue;
+      const common::Pose2 e = common::between(t, b.transform);
+      if (std::hypot(e.x, e.y) < 0.5 * options.min_shift_m) continue;  // back to the same minimum
+      if (b.matches >= (1.0 - options.ambiguity_loss) * a.matches) {
+        out.ambiguous = true;
+        return out;
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace urbanslam::slam
