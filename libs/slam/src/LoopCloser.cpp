@@ -258,27 +258,27 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_
   if (r.reason != ClosureReason::None) return r;
   // A closure far beyond what the estimate knew (found by appearance or from a wide prior) is
   // where a consistently aliased street gets in: the two visits' path submaps, aligned from it,
-  // must stay there (within the confirmation tolerance) and have no other alignment nearly as
-  // good within the gate's reach.
+  // must have no other alignment nearly as good within the gate's reach, and their alignment
+  // becomes the measurement (more of the street than two scans see).
   if (options_.submap_check_path_m > 0 && r.prior_sigma_m > options_.appearance_min_sigma_m) {
     PathSubmapOptions po;
     po.path_m = options_.submap_check_path_m;
     const SubmapCheck c = alignPathSubmaps(map, earlier, current, a.transform, 3 * r.prior_sigma_m, po);
-    const common::Pose2 d = common::between(a.transform, c.measurement);
-    if (c.ambiguous || (c.aligned && (std::hypot(d.x, d.y) > options_.confirm_tolerance_m ||
-                                      std::abs(d.phi) > options_.confirm_tolerance_deg * M_PI / 180))) {
+    if (c.ambiguous) {
       r.reason = ClosureReason::Submaps;
       return r;
     }
+    if (c.aligned) r.measurement = c.measurement;
   }
   // Innovation gate, then the information-form update.
   const esdf::Mat3 cov = options_.covariance_scale * a.cov;
   r.information = cov.inverse();
   esdf::GateResult gate;
   if (commit) {
-    gate = filter.observeRelative(static_cast<int>(earlier), static_cast<int>(current), esdf::toVec(a.transform), r.information, true).gate;
+    gate =
+        filter.observeRelative(static_cast<int>(earlier), static_cast<int>(current), esdf::toVec(r.measurement), r.information, true).gate;
   } else {
-    gate = filter.gateRelative(static_cast<int>(earlier), static_cast<int>(current), esdf::toVec(a.transform), r.information);
+    gate = filter.gateRelative(static_cast<int>(earlier), static_cast<int>(current), esdf::toVec(r.measurement), r.information);
   }
   r.mahalanobis2 = gate.mahalanobis2;
   r.gate_threshold = gate.threshold;

@@ -120,8 +120,8 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("max_free_space_conflict", o.loop_closure.max_free_space_conflict, 0.0, 1.0, "",
         "alignment accepted only when at most this share of either scan's points lies in the other scan's free space; 1: off");
   s.add("submap_check_path_m", o.loop_closure.submap_check_path_m, 0.0, 1000.0, "m",
-        "a closure beyond appearance_min_sigma_m is accepted only when the two visits' keyframes within this much path, aligned as two "
-        "submaps from it, stay within the confirmation tolerance; 0: off");
+        "a closure beyond appearance_min_sigma_m is measured by aligning the two visits' keyframes within this much path as two submaps, "
+        "and refused when another alignment of them is nearly as good; 0: off");
   s.add("free_space_no_return_m", o.loop_closure.free_space_no_return_m, 0.0, 1000.0, "m",
         "free-space test: a beam without a return (or beyond max_range_m) saw free space this far; 0: says nothing");
   s.add("free_space_margin_m", o.loop_closure.free_space_margin_m, 0.0, 10.0, "m",

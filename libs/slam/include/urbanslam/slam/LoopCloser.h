@@ -40,7 +40,7 @@ enum class ClosureReason {
   NoFilter,             // an image proposal in dead reckoning
   LoopClosureDisabled,  // an image proposal with [loop_closure] enabled = false
   NoOverlap,            // nowhere the gate admits could the scans share min_matched_fraction (not aligned)
-  Submaps,              // the two visits' path submaps, aligned from the closure, moved away from it
+  Submaps,              // the two visits' path submaps have another alignment nearly as good (a repeated street)
 };
 // Its name in loop_closures.csv and in observer events ("" for None).
 const char* reasonName(ClosureReason reason);

@@ -4,8 +4,10 @@
 // the street as at the right place, and the next pair of scans repeats the same aliasing. The
 // scans each visit took along its path see more of the street: a cross street, a gap between
 // buildings, a parked car. So each visit's neighbourhood along its own path becomes one point set
-// in its keyframe's frame (the poses within one visit are known to centimetres), and the
-// closure must still hold when these two point sets are aligned, starting from it.
+// in its keyframe's frame (the poses within one visit are known to centimetres). The two point
+// sets aligned from the closure measure it better than the two scans did (a closure 0.4 m off
+// along a street comes back to within centimetres), and another alignment nearly as good within
+// the gate's reach says that the street repeats itself beyond what even they can tell.
 #include <cstddef>
 
 #include "urbanslam/alignment/PointSet.h"
@@ -16,9 +18,9 @@ namespace urbanslam::slam {
 class Map;
 
 struct PathSubmapOptions {
-  double path_m = 30;    // each visit's keyframes within this much path of the closure's keyframe
-  double spacing_m = 3;  // one keyframe every this much path of it
-  double voxel_m = 0.3;  // one point per cell of this size
+  double path_m = 30;      // each visit's keyframes within this much path of the closure's keyframe
+  double spacing_m = 3;    // one keyframe every this much path of it
+  double voxel_m = 0.3;    // one point per cell of this size
   double min_shift_m = 6;  // the restarts' first shift (the single-scan ambiguity test covers the shorter ones)
   double ambiguity_loss = 0.05;
 };

@@ -114,9 +114,9 @@ struct LoopClosureOptions {
   // ... and with the two scans agreeing on free space: at most this share of either scan's
   // points may lie where the other scan's beams passed through (1: off).
   double max_free_space_conflict = 0.2;
-  // ... and, for a closure beyond appearance_min_sigma_m, with the two visits' path submaps (their
-  // keyframes within this much path, PathSubmaps.h) aligning where the closure puts them, within
-  // the confirmation tolerance (0: off).
+  // ... and, for a closure beyond appearance_min_sigma_m, with no other alignment of the two
+  // visits' path submaps (their keyframes within this much path, PathSubmaps.h) nearly as good as
+  // the one from the closure, which becomes its measurement (0: off).
   double submap_check_path_m = 30;
   double free_space_margin_m = 0.3;   // a point conflicts this far (+5 % of the range) inside free space
   double free_space_no_return_m = 0;  // a beam without a return saw free space this far (0: unknown)
