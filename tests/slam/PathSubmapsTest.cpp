@@ -1,9 +1,12 @@
 #include <gtest/gtest.h>
 
+#include <Eigen/LU>
 #include <cmath>
 
 #include "../alignment/SyntheticScan.h"
 #include "urbanslam/esdf/Esdf.h"
+#include "urbanslam/esdf/PoseOps.h"
+#include "urbanslam/slam/LoopCloser.h"
 #include "urbanslam/slam/Map.h"
 #include "urbanslam/slam/PathSubmaps.h"
 
@@ -106,4 +109,40 @@ TEST(PathSubmaps, ACrossStreetTellsTheTrueClosureFromItsAlias) {
   EXPECT_FALSE(refused(right, truth)) << right.measurement.x - truth.x << " " << right.measurement.y - truth.y;
   const common::Pose2 alias = common::compose(common::Pose2{12, 0, 0}, truth);  // a building further east
   EXPECT_TRUE(refused(slam::alignPathSubmaps(*map, kEarlier, kCurrent, alias, 40, {}), alias));
+}
+
+// Through the loop closer: a closure far from what the filter knows (the two visits joined by
+// a link known to 5 m, placed 2 m wrong) is measured by the two visits' submaps, aligned from
+// the scans' own alignment; with the test off, by the scans alone.
+TEST(PathSubmaps, AFarClosureIsMeasuredByTheSubmaps) {
+  const auto map = twoVisits(street(true));
+  const auto& kf = map->keyframes();
+  esdf::Esdf filter;
+  filter.initialise(esdf::toVec(kf[0].pose), esdf::Mat3::Identity() * 1e-9);
+  const esdf::Mat3 tight = esdf::Vec3(1e-4, 1e-4, 1e-6).asDiagonal(), loose = esdf::Vec3(25, 25, 1e-4).asDiagonal();
+  for (size_t j = 1; j < kf.size(); ++j) {
+    common::Pose2 z = common::between(kf[j - 1].pose, kf[j].pose);
+    if (j == 121) z.x += 2;  // the link between the visits
+    filter.augmentRelative(static_cast<int>(j - 1), esdf::toVec(z), (j == 121 ? loose : tight).inverse());
+  }
+  filter.recover();
+  const common::Pose2 truth = common::between(kf[kEarlier].pose, kf[kCurrent].pose);
+  slam::LoopClosureOptions o;
+  o.submap_check_path_m = 0;
+  const slam::LoopClosureRecord scans = slam::LoopCloser(o).tryClose(filter, *map, kEarlier, kCurrent, false);
+  ASSERT_EQ(scans.reason, slam::ClosureReason::None);
+  ASSERT_GT(scans.prior_sigma_m, o.appearance_min_sigma_m);
+  o.submap_check_path_m = 30;
+  const slam::LoopClosureRecord submaps = slam::LoopCloser(o).tryClose(filter, *map, kEarlier, kCurrent, false);
+  ASSERT_EQ(submaps.reason, slam::ClosureReason::None);
+  slam::PathSubmapOptions po;
+  const slam::SubmapCheck c = slam::alignPathSubmaps(*map, kEarlier, kCurrent, scans.measurement, 3 * scans.prior_sigma_m, po);
+  ASSERT_TRUE(c.aligned);
+  EXPECT_NEAR(submaps.measurement.x, c.measurement.x, 1e-9);
+  EXPECT_NEAR(submaps.measurement.y, c.measurement.y, 1e-9);
+  EXPECT_NEAR(submaps.measurement.phi, c.measurement.phi, 1e-12);
+  // Against the truth, the submaps' measurement is at least as good as the scans'.
+  const common::Pose2 es = common::between(truth, scans.measurement), em = common::between(truth, submaps.measurement);
+  EXPECT_LT(std::hypot(em.x, em.y), 0.05);
+  EXPECT_LE(std::hypot(em.x, em.y), std::hypot(es.x, es.y) + 0.01);
 }
