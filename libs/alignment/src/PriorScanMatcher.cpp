@@ -11,32 +11,16 @@
 #include "urbanslam/alignment/BeamFreeSpace.h"
 #include "urbanslam/alignment/CorrelativeSearch.h"
 #include "urbanslam/alignment/MotionPrior.h"
+#include "urbanslam/alignment/Voxels.h"
 
 namespace urbanslam::alignment {
 
 namespace {
 
-// The first point of each voxel (sweep order) represents it in the search. The voxels seen are
-// kept in an open-addressing table of twice the points (every scan is thinned, and a node-based
-// set would allocate once per voxel).
+// The first point of each voxel (sweep order) represents it in the search.
 std::vector<Eigen::Vector2d> thin(const PointSet& scan, double voxel_m) {
   std::vector<Eigen::Vector2d> out;
-  size_t capacity = 16;
-  while (capacity < 2 * scan.size()) capacity *= 2;
-  std::vector<unsigned long long> keys(capacity);
-  std::vector<char> used(capacity, 0);
-  for (const auto& sp : scan) {
-    const long long vx = static_cast<long long>(std::floor(sp.p.x() / voxel_m));
-    const long long vy = static_cast<long long>(std::floor(sp.p.y() / voxel_m));
-    // Shifted unsigned: a left shift of a negative value is undefined behaviour.
-    const unsigned long long key = (static_cast<unsigned long long>(vx) << 32) ^ static_cast<unsigned long long>(vy & 0xffffffffLL);
-    size_t slot = static_cast<size_t>((key * 0x9E3779B97F4A7C15ULL) >> 20) & (capacity - 1);
-    while (used[slot] && keys[slot] != key) slot = (slot + 1) & (capacity - 1);
-    if (used[slot]) continue;
-    used[slot] = 1;
-    keys[slot] = key;
-    out.push_back(sp.p);
-  }
+  for (const size_t i : firstPerVoxel(scan, voxel_m)) out.push_back(scan[i].p);
   return out;
 }
 

@@ -58,6 +58,27 @@ class SectorTest {
   Eigen::Vector2d mid_, u0_, u1_;
 };
 
+// Where a pose of B in A's frame puts B's points in A's sensor frame.
+class InSensorFrame {
+ public:
+  InSensorFrame(const common::Pose2& b_in_a, const common::Pose2& sensor)
+      : c_(std::cos(b_in_a.phi)),
+        s_(std::sin(b_in_a.phi)),
+        sc_(std::cos(sensor.phi)),
+        ss_(std::sin(sensor.phi)),
+        bx_(b_in_a.x),
+        by_(b_in_a.y),
+        sx_(sensor.x),
+        sy_(sensor.y) {}
+  Eigen::Vector2d operator()(const Eigen::Vector2d& p) const {
+    const double x = c_ * p.x() - s_ * p.y() + bx_ - sx_, y = s_ * p.x() + c_ * p.y() + by_ - sy_;
+    return {sc_ * x + ss_ * y, -ss_ * x + sc_ * y};
+  }
+
+ private:
+  double c_, s_, sc_, ss_, bx_, by_, sx_, sy_;
+};
+
 // A box of poses: centre and half-widths in x, y and heading.
 struct Cell {
   Eigen::Vector3d c;
@@ -68,18 +89,14 @@ struct Cell {
 // of the cell moves it from where the cell's centre puts it; stops once `needed` is out of reach.
 bool cellReaches(const SectorTest& sector, const common::Pose2& sensor, const PointSet& b, const std::vector<double>& norms,
                  const Cell& cell, double gate_m, int needed) {
-  const double c = std::cos(cell.c.z()), s = std::sin(cell.c.z());
-  const double sc = std::cos(sensor.phi), ss = std::sin(sensor.phi);
+  const InSensorFrame place({cell.c.x(), cell.c.y(), cell.c.z()}, sensor);
   const double shift = std::hypot(cell.h.x(), cell.h.y());
   const int n = static_cast<int>(b.size()), may_miss = n - needed;
   int misses = 0;
   for (int i = 0; i < n; ++i) {
-    const Eigen::Vector2d& p = b[static_cast<size_t>(i)].p;
-    // B's point in A's frame, then in A's sensor frame.
-    const double x = c * p.x() - s * p.y() + cell.c.x() - sensor.x, y = s * p.x() + c * p.y() + cell.c.y() - sensor.y;
-    const Eigen::Vector2d q(sc * x + ss * y, -ss * x + sc * y);
     // A turn by up to h_phi moves a point at distance |p| by at most |p| h_phi.
-    if (!sector.within(q, gate_m + shift + norms[static_cast<size_t>(i)] * cell.h.z()) && ++misses > may_miss) return false;
+    const double slack = gate_m + shift + norms[static_cast<size_t>(i)] * cell.h.z();
+    if (!sector.within(place(b[static_cast<size_t>(i)].p), slack) && ++misses > may_miss) return false;
   }
   return true;
 }
@@ -89,14 +106,10 @@ bool cellReaches(const SectorTest& sector, const common::Pose2& sensor, const Po
 double shareInView(const ViewSector& a, const PointSet& b, const common::Pose2& b_in_a, double gate_m) {
   if (b.empty() || a.empty) return 0.0;
   const SectorTest sector(a);
-  const double c = std::cos(b_in_a.phi), s = std::sin(b_in_a.phi);
-  const double sc = std::cos(a.sensor_pose.phi), ss = std::sin(a.sensor_pose.phi);
+  const InSensorFrame place(b_in_a, a.sensor_pose);
   int in = 0;
-  for (const ScanPoint& pt : b) {
-    const double x = c * pt.p.x() - s * pt.p.y() + b_in_a.x - a.sensor_pose.x;
-    const double y = s * pt.p.x() + c * pt.p.y() + b_in_a.y - a.sensor_pose.y;
-    if (sector.within({sc * x + ss * y, -ss * x + sc * y}, gate_m)) ++in;
-  }
+  for (const ScanPoint& pt : b)
+    if (sector.within(place(pt.p), gate_m)) ++in;
   return static_cast<double>(in) / static_cast<double>(b.size());
 }
 

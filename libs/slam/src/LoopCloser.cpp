@@ -8,6 +8,7 @@
 #include "urbanslam/alignment/Aligner.h"
 #include "urbanslam/alignment/FreeSpace.h"
 #include "urbanslam/alignment/IndexedReference.h"
+#include "urbanslam/alignment/ShiftedRestarts.h"
 #include "urbanslam/esdf/Gating.h"
 #include "urbanslam/esdf/PoseOps.h"
 #include "urbanslam/slam/Map.h"
@@ -150,29 +151,6 @@ std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const Map& map
   return out;
 }
 
-// A wrong closure is usually a wrong local minimum (aliasing along a corridor or a facade) that
-// the drifted estimate happened to start PL-ICP in. Restarts from the result shifted along each
-// axis by ambiguity_offset_m, then twice, four and eight times that, as far as reach_m (for a
-// closure, 3 sigma of the relative position: what the innovation gate could admit): if one
-// converges elsewhere and matches clearly more points, the alignment is not the best
-// explanation of the two scans.
-bool LoopCloser::ambiguous(const alignment::IndexedReference& earlier_points, const alignment::PointSet& current_points,
-                           const alignment::AlignmentResult& a, alignment::AlignerOptions ao, double reach_m) const {
-  ao.method = alignment::Method::PlIcp;
-  const auto& t = a.transform;
-  for (double d = options_.ambiguity_offset_m; d <= 8 * options_.ambiguity_offset_m && 0.5 * d <= reach_m; d *= 2) {
-    for (const common::Pose2& g : {common::Pose2{t.x + d, t.y, t.phi}, common::Pose2{t.x - d, t.y, t.phi},
-                                   common::Pose2{t.x, t.y + d, t.phi}, common::Pose2{t.x, t.y - d, t.phi}}) {
-      const auto b = alignment::alignPointSets(earlier_points, current_points, g, ao);
-      if (!b.converged || b.rms_residual_m > options_.max_rms_m) continue;
-      const common::Pose2 e = common::between(t, b.transform);
-      if (std::hypot(e.x, e.y) < 0.25 * options_.ambiguity_offset_m) continue;  // back to the same minimum
-      if (b.matches >= (1.0 + options_.ambiguity_min_gain) * a.matches) return true;
-    }
-  }
-  return false;
-}
-
 alignment::AlignmentResult LoopCloser::verifyAlignment(const io::LaserScan& earlier_scan, const io::LaserScan& current_scan,
                                                        const common::Pose2& guess, alignment::Method method, double reach_m,
                                                        LoopClosureRecord& r, const alignment::PoseRegion* admitted) const {
@@ -204,7 +182,18 @@ alignment::AlignmentResult LoopCloser::verifyAlignment(const io::LaserScan& earl
     r.reason = ClosureReason::Alignment;
     return a;
   }
-  if (options_.ambiguity_offset_m > 0 && ambiguous(earlier_points, current_points, a, ao, reach_m)) {
+  // A wrong closure is usually a wrong local minimum (aliasing along a corridor or a facade) that
+  // the drifted estimate happened to start PL-ICP in: restarts from the result shifted by
+  // ambiguity_offset_m, twice, four and eight times that, as far as reach_m (for a closure, 3
+  // sigma of the relative position: what the innovation gate could admit) must find no minimum
+  // elsewhere that matches clearly more points.
+  alignment::ShiftedRestarts restarts;
+  restarts.first_shift_m = options_.ambiguity_offset_m;
+  restarts.last_shift_m = std::min(8 * options_.ambiguity_offset_m, 2 * reach_m);
+  restarts.same_minimum_m = 0.25 * options_.ambiguity_offset_m;
+  restarts.min_match_ratio = 1.0 + options_.ambiguity_min_gain;
+  restarts.max_rms_m = options_.max_rms_m;
+  if (options_.ambiguity_offset_m > 0 && alignment::findsOtherMinimum(earlier_points, current_points, a, ao, restarts)) {
     r.reason = ClosureReason::Ambiguous;
     return a;
   }
@@ -259,7 +248,8 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_
   // A closure far beyond what the estimate knew (found by appearance or from a wide prior) is
   // where a consistently aliased street gets in: the two visits' path submaps, aligned from it,
   // must have no other alignment nearly as good within the gate's reach, and their alignment
-  // becomes the measurement (more of the street than two scans see).
+  // becomes the measurement (more of the street than two scans see; the two scans' covariance
+  // is kept, the conservative of the two).
   if (options_.submap_check_path_m > 0 && r.prior_sigma_m > options_.appearance_min_sigma_m) {
     PathSubmapOptions po;
     po.path_m = options_.submap_check_path_m;

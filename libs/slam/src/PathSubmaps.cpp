@@ -1,12 +1,12 @@
 #include "urbanslam/slam/PathSubmaps.h"
 
 #include <cmath>
-#include <cstdint>
-#include <unordered_set>
 
 #include "urbanslam/alignment/Aligner.h"
 #include "urbanslam/alignment/IndexedReference.h"
 #include "urbanslam/alignment/ScanModel.h"
+#include "urbanslam/alignment/ShiftedRestarts.h"
+#include "urbanslam/alignment/Voxels.h"
 #include "urbanslam/slam/Map.h"
 
 namespace urbanslam::slam {
@@ -29,18 +29,15 @@ alignment::PointSet pathSubmap(const Map& map, size_t center, size_t first, size
       j = next;
     }
   }
-  alignment::PointSet out;
-  std::unordered_set<std::int64_t> taken;
+  alignment::PointSet all;
   const common::Pose2& origin = kf[center].pose;
   for (const size_t j : chosen) {
     const alignment::PointSet points = alignment::transformed(alignment::pointSetFromScan(map.scan(j), alignment::ScanModelOptions{}, true),
                                                               common::between(origin, kf[j].pose));
-    for (const alignment::ScanPoint& p : points) {
-      const auto cx = static_cast<std::int64_t>(std::floor(p.p.x() / options.voxel_m));
-      const auto cy = static_cast<std::int64_t>(std::floor(p.p.y() / options.voxel_m));
-      if (taken.insert(cx * 2000003 + cy).second) out.push_back(p);
-    }
+    all.insert(all.end(), points.begin(), points.end());
   }
+  alignment::PointSet out;
+  for (const size_t i : alignment::firstPerVoxel(all, options.voxel_m)) out.push_back(all[i]);
   return out;
 }
 
@@ -59,20 +56,12 @@ SubmapCheck alignPathSubmaps(const Map& map, size_t earlier, size_t current, con
   out.aligned = a.converged;
   out.measurement = a.transform;
   if (!a.converged) return out;
-  const common::Pose2& t = a.transform;
-  for (double d = options.min_shift_m; d <= reach_m; d *= 2) {
-    for (const common::Pose2& g : {common::Pose2{t.x + d, t.y, t.phi}, common::Pose2{t.x - d, t.y, t.phi},
-                                   common::Pose2{t.x, t.y + d, t.phi}, common::Pose2{t.x, t.y - d, t.phi}}) {
-      const alignment::AlignmentResult b = alignment::alignPointSets(before, now, g, ao);
-      if (!b.converged) continue;
-      const common::Pose2 e = common::between(t, b.transform);
-      if (std::hypot(e.x, e.y) < 0.5 * options.min_shift_m) continue;  // back to the same minimum
-      if (b.matches >= (1.0 - options.ambiguity_loss) * a.matches) {
-        out.ambiguous = true;
-        return out;
-      }
-    }
-  }
+  alignment::ShiftedRestarts restarts;
+  restarts.first_shift_m = options.min_shift_m;
+  restarts.last_shift_m = reach_m;
+  restarts.same_minimum_m = 0.5 * options.min_shift_m;
+  restarts.min_match_ratio = 1.0 - options.ambiguity_loss;
+  out.ambiguous = alignment::findsOtherMinimum(before, now, a, ao, restarts);
   return out;
 }
 

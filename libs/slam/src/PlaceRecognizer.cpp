@@ -5,10 +5,10 @@
 #include <cmath>
 #include <limits>
 #include <set>
-#include <unordered_set>
 
 #include "urbanslam/alignment/CorrelativeSearch.h"
 #include "urbanslam/alignment/MotionPrior.h"
+#include "urbanslam/alignment/Voxels.h"
 
 namespace urbanslam::slam {
 
@@ -34,14 +34,11 @@ PlaceHypothesis PlaceRecognizer::locate(const alignment::PointSet& scan, const a
                                         const std::optional<PlaceSearchRegion>& region) {
   PlaceHypothesis h;
   // The search's points: one per voxel, near returns only (far ones fall outside the grids).
+  alignment::PointSet near;
+  for (const auto& sp : scan)
+    if (sp.p.norm() <= options_.max_range_m) near.push_back(sp);
   std::vector<Eigen::Vector2d> points;
-  std::unordered_set<int64_t> voxels;
-  for (const auto& sp : scan) {
-    if (sp.p.norm() > options_.max_range_m) continue;
-    const auto vx = static_cast<int64_t>(std::floor(sp.p.x() / options_.voxel_m));
-    const auto vy = static_cast<int64_t>(std::floor(sp.p.y() / options_.voxel_m));
-    if (voxels.insert(vx * 1000003 + vy).second) points.push_back(sp.p);
-  }
+  for (const size_t i : alignment::firstPerVoxel(near, options_.voxel_m)) points.push_back(near[i].p);
   h.points = static_cast<int>(points.size());
   if (h.points < options_.min_points) {
     h.reason = "too few points";

@@ -121,8 +121,6 @@ class LoopCloser {
 
  private:
   Eigen::Matrix3d relativeCovariance(esdf::Esdf& filter, size_t i, size_t k);
-  bool ambiguous(const alignment::IndexedReference& earlier_points, const alignment::PointSet& current_points,
-                 const alignment::AlignmentResult& a, alignment::AlignerOptions ao, double reach_m) const;
 
   LoopClosureOptions options_;
   CandidateScorer scorer_;

@@ -1,0 +1,24 @@
+#include "urbanslam/alignment/ShiftedRestarts.h"
+
+#include <cmath>
+
+namespace urbanslam::alignment {
+
+bool findsOtherMinimum(const IndexedReference& a, const PointSet& b, const AlignmentResult& result, AlignerOptions options,
+                       const ShiftedRestarts& restarts) {
+  options.method = Method::PlIcp;
+  const common::Pose2& t = result.transform;
+  for (double d = restarts.first_shift_m; d <= restarts.last_shift_m; d *= 2) {
+    for (const common::Pose2& g : {common::Pose2{t.x + d, t.y, t.phi}, common::Pose2{t.x - d, t.y, t.phi},
+                                   common::Pose2{t.x, t.y + d, t.phi}, common::Pose2{t.x, t.y - d, t.phi}}) {
+      const AlignmentResult other = alignPointSets(a, b, g, options);
+      if (!other.converged || other.rms_residual_m > restarts.max_rms_m) continue;
+      const common::Pose2 e = common::between(t, other.transform);
+      if (std::hypot(e.x, e.y) < restarts.same_minimum_m) continue;  // back to the same minimum
+      if (other.matches >= restarts.min_match_ratio * result.matches) return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace urbanslam::alignment
