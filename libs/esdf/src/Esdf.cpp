@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "urbanslam/common/Timing.h"
+#include "urbanslam/esdf/PoseOps.h"
 
 namespace urbanslam::esdf {
 
@@ -261,6 +262,8 @@ void Esdf::ensureFactor() {
   chain_valid_ = true;
   base_columns_.resize(0, 0);
   factored_marginals_.clear();
+  anchor_base_ = -1;  // the anchor is looked for again in the new chain
+  anchor_columns_pose_ = -1;
 }
 
 RecoveryStats Esdf::recover(int max_passes) {
@@ -436,19 +439,66 @@ Mat6 Esdf::conservativeJoint(int i, int j) {
     // Both dead-reckoned: x_b = Phi_b Phi_a^-1 x_a + independent noise.
     return marginal(a) * (chainPhi(b) * chainPhi(a).inverse()).transpose();
   };
-  Mat6 s;
-  if (i == j) {
-    const Mat3 c = marginal(i);
-    s << c, c, c, c;
-  } else {
-    const int a = std::min(i, j), b = std::max(i, j);
-    const Mat3 saa = marginal(a), sbb = marginal(b), sab = cross(a, b);
-    if (i < j)
+  const auto joint = [&](const Mat3& saa, const Mat3& sbb, const Mat3& sab) {
+    Mat6 s;
+    if (i <= j)
       s << saa, sab, sab.transpose(), sbb;
     else
       s << sbb, sab.transpose(), sab, saa;
+    return Mat6(0.5 * (s + s.transpose()));
+  };
+  const int a = std::min(i, j), b = std::max(i, j);
+  const Mat6 s = i == j ? joint(marginal(i), marginal(i), marginal(i)) : joint(marginal(a), marginal(b), cross(a, b));
+  // Through the newest closure into the chain, when it lies on the way to b (and a is factored or
+  // b's own marginal is asked): both are upper bounds, and the one that bounds the relative pose
+  // (or the marginal) tighter is returned.
+  const ChainAnchor& an = chainAnchor();
+  if (an.a < 0 || b < an.b || (a >= m && i != j)) return s;
+  if (anchor_columns_pose_ != an.a) {
+    covarianceColumnsBlock(an.a, &anchor_columns_);
+    anchor_columns_pose_ = an.a;
   }
-  return 0.5 * (s + s.transpose());
+  const Mat3 step = chainPhi(b) * chainPhi(an.b).inverse();  // x_b from x_{an.b} by the chain
+  const Mat3 to_b = step * an.phi;                           // d x_b / d x_{an.a}
+  const Mat3 increments = chain_cov_[static_cast<size_t>(b - m)] - step * chain_cov_[static_cast<size_t>(an.b - m)] * step.transpose();
+  const Mat3 sbb = to_b * anchor_columns_.block<3, 3>(3 * an.a, 0) * to_b.transpose() + step * an.cov * step.transpose() + increments;
+  const Mat6 t = i == j ? joint(sbb, sbb, sbb) : joint(marginal(a), sbb, anchor_columns_.block<3, 3>(3 * a, 0) * to_b.transpose());
+  const auto spread = [&](const Mat6& c) {
+    if (i == j) return c(0, 0) + c(1, 1);
+    Mat3 ja, jb;
+    betweenJacobians(state_.mean(i), state_.mean(j), &ja, &jb);
+    Eigen::Matrix<double, 3, 6> h;
+    h << ja, jb;
+    const Mat3 r = h * c * h.transpose();
+    return r(0, 0) + r(1, 1);
+  };
+  return spread(t) < spread(s) ? t : s;
+}
+
+const Esdf::ChainAnchor& Esdf::chainAnchor() {
+  if (anchor_factors_ == factors_.size() && anchor_base_ == chain_base_) return anchor_;
+  anchor_factors_ = factors_.size();
+  anchor_base_ = chain_base_;
+  anchor_ = {};
+  const int m = chain_base_;
+  // Every factor that touches a chain pose was added after the factorisation: newest first, back
+  // to the first that does not.
+  for (size_t k = factors_.size(); k-- > 0;) {
+    const Factor& f = factors_[k];
+    if (std::max(f.a, f.b) < m) break;
+    if (f.kind != Factor::Kind::Relative || f.a >= m || f.b < m || f.b == f.a + 1) continue;
+    // x_b = x_a ⊕ z ⊕ e with e ~ N(0, weight^-1) (the error ⊖z⊕(⊖x_a⊕x_b)), linearised where the
+    // factor is.
+    Mat3 d_a, d_e;
+    composeJacobians(f.lin_a, f.z, &d_a, nullptr);
+    composeJacobians(compose(f.lin_a, f.z), Vec3::Zero(), nullptr, &d_e);
+    anchor_.a = f.a;
+    anchor_.b = f.b;
+    anchor_.phi = d_a;
+    anchor_.cov = d_e * f.weight.inverse() * d_e.transpose();
+    break;
+  }
+  return anchor_;
 }
 
 size_t Esdf::memoryBytes() const {

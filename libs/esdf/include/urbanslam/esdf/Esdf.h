@@ -216,6 +216,17 @@ class Esdf {
   void ensureFactor();
   Mat3 covarianceColumnsBlock(int i, Eigen::MatrixXd* columns);
   Mat6 conservativeJoint(int i, int j);
+  // A second path from the factorisation into the chain: the newest relative factor from a
+  // factored pose a to a chain pose b (a loop closure: x_b = x_a ⊕ z ⊕ noise). A chain pose at
+  // or after b is reached from a through it and the chain's increments after b, which, while the
+  // vehicle drives along an earlier visit, is far tighter than the dead reckoning from the
+  // chain's base. a = -1: none.
+  struct ChainAnchor {
+    int a = -1, b = -1;
+    Mat3 phi = Mat3::Identity();  // d x_b / d x_a
+    Mat3 cov = Mat3::Zero();      // the closure's noise, mapped onto x_b
+  };
+  const ChainAnchor& chainAnchor();
   void markChanged() { ++values_stamp_; }
 
   EsdfOptions options_;
@@ -234,8 +245,13 @@ class Esdf {
   int chain_base_ = 0;
   std::vector<Mat3> chain_phi_, chain_cov_;
   bool chain_valid_ = true;
-  Eigen::MatrixXd base_columns_;  // stale Sigma(:, base-1), from the last full factorisation
+  Eigen::MatrixXd base_columns_;                      // stale Sigma(:, base-1), from the last full factorisation
   std::unordered_map<int, Mat3> factored_marginals_;  // Sigma(p, p) of older poses from the same factorisation
+  ChainAnchor anchor_;
+  size_t anchor_factors_ = 0;       // factors_.size() when anchor_ was looked for ...
+  int anchor_base_ = -1;            // ... and chain_base_ then
+  Eigen::MatrixXd anchor_columns_;  // stale Sigma(:, anchor_.a), from the last full factorisation
+  int anchor_columns_pose_ = -1;
 };
 
 }  // namespace urbanslam::esdf
