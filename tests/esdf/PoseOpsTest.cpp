@@ -76,6 +76,30 @@ TEST(PoseOps, BetweenJacobiansMatchNumericalAndCompositeRule) {
   }
 }
 
+TEST(PoseOps, BetweenCovarianceIsTheJointMappedByTheNumericalJacobian) {
+  std::mt19937 rng(6);
+  std::normal_distribution<double> g(0, 1);
+  for (int t = 0; t < 20; ++t) {
+    const Vec3 a = test::randomPose(rng), b = test::randomPose(rng);
+    Eigen::Matrix<double, 6, 6> l;
+    for (int r = 0; r < 6; ++r)
+      for (int c = 0; c < 6; ++c) l(r, c) = g(rng);
+    const Eigen::Matrix<double, 6, 6> joint = l * l.transpose();
+    V ab(6);
+    ab << a, b;
+    // Away from the heading wrap, as above.
+    const Eigen::MatrixXd j = numericalJacobian(
+        [&](const V& x) -> V {
+          Vec3 r = between(x.head<3>(), x.tail<3>());
+          r.z() = x(5) - x(2);
+          return r;
+        },
+        ab);
+    const Mat3 ref = j * joint * j.transpose();
+    EXPECT_LT((betweenCovariance(a, b, joint) - ref).norm(), 1e-5 * ref.norm());
+  }
+}
+
 TEST(PoseOps, RelativePoseErrorJacobiansMatchNumerical) {
   std::mt19937 rng(5);
   for (int t = 0; t < 50; ++t) {

@@ -162,13 +162,7 @@ TEST(Recovery, ConservativeCovarianceIsExactWithoutNewInformationAndAnUpperBound
 }
 
 // Relative-pose covariance of (x_i, x_j) from their joint covariance, at the filter's means.
-Mat3 relative(const Esdf& f, int i, int j, const Mat6& joint) {
-  Mat3 ja, jb;
-  betweenJacobians(f.mean(i), f.mean(j), &ja, &jb);
-  Eigen::Matrix<double, 3, 6> h;
-  h << ja, jb;
-  return h * joint * h.transpose();
-}
+Mat3 relative(const Esdf& f, int i, int j, const Mat6& joint) { return betweenCovariance(f.mean(i), f.mean(j), joint); }
 
 TEST(Recovery, ConservativeCovarianceAfterAClosureIsReachedThroughIt) {
   // Driving back along an earlier visit: after a closure from the factored map into the

@@ -464,12 +464,7 @@ Mat6 Esdf::conservativeJoint(int i, int j) {
   const Mat3 sbb = to_b * anchor_columns_.block<3, 3>(3 * an.a, 0) * to_b.transpose() + step * an.cov * step.transpose() + increments;
   const Mat6 t = i == j ? joint(sbb, sbb, sbb) : joint(marginal(a), sbb, anchor_columns_.block<3, 3>(3 * a, 0) * to_b.transpose());
   const auto spread = [&](const Mat6& c) {
-    if (i == j) return c(0, 0) + c(1, 1);
-    Mat3 ja, jb;
-    betweenJacobians(state_.mean(i), state_.mean(j), &ja, &jb);
-    Eigen::Matrix<double, 3, 6> h;
-    h << ja, jb;
-    const Mat3 r = h * c * h.transpose();
+    const Mat3 r = i == j ? Mat3(c.topLeftCorner<3, 3>()) : betweenCovariance(state_.mean(i), state_.mean(j), c);
     return r(0, 0) + r(1, 1);
   };
   return spread(t) < spread(s) ? t : s;
@@ -486,6 +481,7 @@ const Esdf::ChainAnchor& Esdf::chainAnchor() {
   for (size_t k = factors_.size(); k-- > 0;) {
     const Factor& f = factors_[k];
     if (std::max(f.a, f.b) < m) break;
+    // (b = a + 1 from a = m - 1 is the chain's own first link.)
     if (f.kind != Factor::Kind::Relative || f.a >= m || f.b < m || f.b == f.a + 1) continue;
     // x_b = x_a ⊕ z ⊕ e with e ~ N(0, weight^-1) (the error ⊖z⊕(⊖x_a⊕x_b)), linearised where the
     // factor is.

@@ -50,6 +50,14 @@ void betweenJacobians(const Vec3& a, const Vec3& b, Mat3* ja, Mat3* jb) {
   }
 }
 
+Mat3 betweenCovariance(const Vec3& a, const Vec3& b, const Eigen::Matrix<double, 6, 6>& joint) {
+  Mat3 ja, jb;
+  betweenJacobians(a, b, &ja, &jb);
+  Eigen::Matrix<double, 3, 6> j;
+  j << ja, jb;
+  return j * joint * j.transpose();
+}
+
 Vec3 relativePoseError(const Vec3& a, const Vec3& b, const Vec3& z) { return relativePoseError(a, b, z, nullptr, nullptr); }
 
 Vec3 relativePoseError(const Vec3& a, const Vec3& b, const Vec3& z, Mat3* ja, Mat3* jb) {

@@ -69,11 +69,7 @@ Eigen::Matrix3d LoopCloser::relativeCovariance(esdf::Esdf& filter, size_t i, siz
   }
   if (const auto it = cached_.find(i); it != cached_.end()) return it->second;
   const esdf::Mat6 joint = filter.jointCovariance(static_cast<int>(i), static_cast<int>(k), esdf::CovarianceMode::Conservative);
-  esdf::Mat3 ja, jb;
-  esdf::betweenJacobians(filter.mean(static_cast<int>(i)), filter.mean(static_cast<int>(k)), &ja, &jb);
-  Eigen::Matrix<double, 3, 6> j;
-  j << ja, jb;
-  const Eigen::Matrix3d s = j * joint * j.transpose();
+  const Eigen::Matrix3d s = esdf::betweenCovariance(filter.mean(static_cast<int>(i)), filter.mean(static_cast<int>(k)), joint);
   cached_[i] = s;
   return s;
 }

@@ -30,6 +30,8 @@ Mat3 inverseJacobian(const Vec3& a);
 Vec3 between(const Vec3& a, const Vec3& b);
 // d(⊖a⊕b)/da and d(⊖a⊕b)/db (composite relationship, appendix B.3: J1⊕ J⊖ and J2⊕).
 void betweenJacobians(const Vec3& a, const Vec3& b, Mat3* ja, Mat3* jb);
+// Covariance of ⊖a⊕b to first order, from the joint covariance of (a, b) (a's block first).
+Mat3 betweenCovariance(const Vec3& a, const Vec3& b, const Eigen::Matrix<double, 6, 6>& joint);
 
 // Difference of two poses in the state chart: a - b with the heading difference wrapped.
 inline Vec3 poseDifference(const Vec3& a, const Vec3& b) { return {a.x() - b.x(), a.y() - b.y(), common::wrapToPi(a.z() - b.z())}; }
