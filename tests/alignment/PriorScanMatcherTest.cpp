@@ -10,6 +10,7 @@
 
 #include "SyntheticScan.h"
 #include "urbanslam/alignment/CorrelativeSearch.h"
+#include "urbanslam/alignment/HeadingCorrections.h"
 #include "urbanslam/alignment/LikelihoodGrid.h"
 #include "urbanslam/alignment/MotionPrior.h"
 #include "urbanslam/alignment/PriorScanMatcher.h"
@@ -262,6 +263,75 @@ TEST(PriorScanMatcher, CorridorKeepsTheOdometryAlongItsAxis) {
   EXPECT_NEAR(r.pose.phi, truth.phi, 0.003);
   EXPECT_NEAR(std::sqrt(r.cov(0, 0)), 0.05, 0.005);  // along the axis: the prior's sigma
   EXPECT_LT(std::sqrt(r.cov(1, 1)), 0.01);           // across: the walls'
+}
+
+TEST(PriorScanMatcher, ANarrowedHeadingWindowFindsTheSameMatchInsideItAndMissesBeyond) {
+  // The prior's heading sigma is 0.1 rad (a 17° window each side); the narrowed window reaches a
+  // third of that. A scan turned 0.03 rad from the odometry is the same match from both, for
+  // fewer nodes; one turned 0.2 rad is found by the full window only, and the narrowed search's
+  // best lies at its edge (what HeadingCorrections::doubts() takes for a reason to search again).
+  const Eigen::Matrix3d cov = Eigen::Vector3d(0.025 * 0.025, 0.025 * 0.025, 0.01).asDiagonal();
+  PriorMatcherOptions o;
+  o.search_window_deg = 2;
+  const MatchReference ref(scanPoints(test::roomWorld(), {0, 0, 0}), Eigen::Vector2d::Zero(), o);
+  const common::Pose2 odometry{0.3, 0.1, 0.0};
+  PriorMatcherOptions narrowed = o;
+  narrowed.heading_window_scale = 1.0 / 3;
+
+  const common::Pose2 near_truth{0.32, 0.08, 0.03};
+  const PointSet near_scan = scanPoints(test::roomWorld(), near_truth, 11);
+  const PriorMatchResult full = matchWithPrior(ref, near_scan, odometry, cov, o);
+  const PriorMatchResult first = matchWithPrior(ref, near_scan, odometry, cov, narrowed);
+  ASSERT_TRUE(full.valid && first.valid);
+  EXPECT_NEAR(full.pose.phi, near_truth.phi, 0.005);
+  EXPECT_EQ(first.pose.x, full.pose.x);
+  EXPECT_EQ(first.pose.y, full.pose.y);
+  EXPECT_EQ(first.pose.phi, full.pose.phi);
+  EXPECT_NEAR(full.search_half_angle_rad, 0.3, 1e-12);
+  EXPECT_NEAR(first.search_half_angle_rad, 0.1, 1e-12);
+  EXPECT_LT(first.search_nodes, full.search_nodes);
+
+  const common::Pose2 far_truth{0.32, 0.08, 0.2};
+  const PointSet far_scan = scanPoints(test::roomWorld(), far_truth, 11);
+  const PriorMatchResult far_full = matchWithPrior(ref, far_scan, odometry, cov, o);
+  const PriorMatchResult far_first = matchWithPrior(ref, far_scan, odometry, cov, narrowed);
+  ASSERT_TRUE(far_full.valid);
+  EXPECT_NEAR(far_full.pose.phi, far_truth.phi, 0.005);
+  EXPECT_GT(std::abs(far_first.search_pose.phi - far_truth.phi), 0.05);
+  EXPECT_GT(std::abs(far_first.search_pose.phi - odometry.phi), HeadingCorrections::kEdgeShare * far_first.search_half_angle_rad);
+}
+
+TEST(HeadingCorrections, TheWindowIsFiveRmsOfTheCorrectionsInTheModelsSigmas) {
+  std::mt19937 rng(5);
+  HeadingCorrections h;
+  const double sigma = 0.08;  // the model's heading sigma of every match here [rad]
+  std::normal_distribution<double> small(0, 0.2 * sigma), large(0, 1.5 * sigma), smaller(0, 0.05 * sigma);
+  for (int k = 0; k < 49; ++k) h.add(small(rng), sigma, 0.9);
+  EXPECT_EQ(h.windowScale(), 1.0);  // too few matches yet: the model's window
+  for (int k = 0; k < 2000; ++k) h.add(small(rng), sigma, 0.9);
+  EXPECT_NEAR(h.windowScale(), 5 * 0.2 / 3, 0.15 * 5 * 0.2 / 3);
+  // Corrections as large as the model's sigma or more: never wider than the model's window.
+  for (int k = 0; k < 2000; ++k) h.add(large(rng), sigma, 0.9);
+  EXPECT_EQ(h.windowScale(), 1.0);
+  // The memory follows better odometry.
+  for (int k = 0; k < 2000; ++k) h.add(smaller(rng), sigma, 0.9);
+  EXPECT_NEAR(h.windowScale(), 5 * 0.05 / 3, 0.2 * 5 * 0.05 / 3);
+  // The state restored is the state saved.
+  HeadingCorrections copy;
+  copy.restore(h.sumSquares(), h.sumMatched(), h.matches());
+  EXPECT_EQ(copy.windowScale(), h.windowScale());
+}
+
+TEST(HeadingCorrections, DoubtsAMatchAtTheWindowsEdgeOrExplainingLittleOfTheScan) {
+  HeadingCorrections h;
+  for (int k = 0; k < 100; ++k) h.add(0.001, 0.05, 0.8);
+  const double half = 0.1;
+  EXPECT_FALSE(h.doubts(true, 0.5 * half, half, 0.8));
+  EXPECT_FALSE(h.doubts(true, -0.7 * half, half, 0.5));
+  EXPECT_TRUE(h.doubts(true, 0.8 * half, half, 0.8));   // near the edge
+  EXPECT_TRUE(h.doubts(true, -0.8 * half, half, 0.8));  // either side
+  EXPECT_TRUE(h.doubts(true, 0.1 * half, half, 0.3));   // under half the usual 0.8 matched
+  EXPECT_TRUE(h.doubts(false, 0.0, half, 0.8));         // no match at all
 }
 
 }  // namespace

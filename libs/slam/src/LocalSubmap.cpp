@@ -1,6 +1,7 @@
 #include "urbanslam/slam/LocalSubmap.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "urbanslam/alignment/ScanModel.h"
 
@@ -78,8 +79,18 @@ alignment::PriorMatchResult LocalSubmap::match(const io::LaserScan& scan, const 
   options.seen_through_rate = seen_through_.rate();
   options.seen_through_rate_displaced = seen_through_displaced_.rate();
   options.direction_reach_m = direction_reach_m;
-  const alignment::PriorMatchResult r = alignment::matchWithPrior(*ref, points(scan), prior, prior_cov, options);
+  const alignment::PointSet scan_points = points(scan);
+  // First within the heading corrections' own reach; the prior's full window when that match is
+  // in doubt.
+  options.heading_window_scale = heading_corrections_.windowScale();
+  alignment::PriorMatchResult r = alignment::matchWithPrior(*ref, scan_points, prior, prior_cov, options);
+  if (options.heading_window_scale < 1 &&
+      heading_corrections_.doubts(r.valid, common::wrapToPi(r.search_pose.phi - prior.phi), r.search_half_angle_rad, r.matchedFraction())) {
+    options.heading_window_scale = 1;
+    r = alignment::matchWithPrior(*ref, scan_points, prior, prior_cov, options);
+  }
   if (r.valid && !r.odometry_outvoted) {
+    heading_corrections_.add(common::wrapToPi(r.pose.phi - prior.phi), std::sqrt(prior_cov(2, 2)), r.matchedFraction());
     seen_through_.add(r.in_view, r.seen_through);
     seen_through_displaced_.add(r.displaced_in_view, r.displaced_seen_through);
   }

@@ -162,7 +162,7 @@ std::unique_ptr<Pipeline> loadMap(const std::string& path, const PipelineOptions
   if (options) checkSameAlgorithmOptions(saved, *options, path);
   const PipelineOptions& used = options ? *options : saved;
   auto pipeline = std::make_unique<Pipeline>(used);
-  pipeline->readState(r);
+  pipeline->readState(r, version);
   if (separate) separate->clear();
   if (version >= 4) {
     common::BinaryReader maps = r.section(kSeparateTag);
@@ -170,7 +170,7 @@ std::unique_ptr<Pipeline> loadMap(const std::string& path, const PipelineOptions
       const size_t n = maps.count(6 * 12);  // a map is at least its six sections' tags and lengths
       for (size_t i = 0; i < n; ++i) {
         separate->push_back(std::make_unique<Pipeline>(used));
-        separate->back()->readState(maps);
+        separate->back()->readState(maps, version);
       }
       maps.expectEnd();
     }

@@ -424,9 +424,12 @@ void LocalSubmap::writeState(BinaryWriter& w) const {
   w.f64(seen_through_.pointCount());
   w.f64(seen_through_displaced_.seenCount());
   w.f64(seen_through_displaced_.pointCount());
+  w.f64(heading_corrections_.sumSquares());
+  w.f64(heading_corrections_.sumMatched());
+  w.f64(heading_corrections_.matches());
 }
 
-void LocalSubmap::readState(BinaryReader& r) {
+void LocalSubmap::readState(BinaryReader& r, bool with_heading_corrections) {
   const size_t n = r.count(8);
   if (n > capacity_) r.fail("a local submap of " + std::to_string(n) + " keyframes where it holds " + std::to_string(capacity_));
   sets_.clear();
@@ -441,6 +444,10 @@ void LocalSubmap::readState(BinaryReader& r) {
   seen_through_.restore(seen, points);
   const double seen_d = r.f64(), points_d = r.f64();
   seen_through_displaced_.restore(seen_d, points_d);
+  if (!with_heading_corrections) return;  // an older map: the next matches learn them again
+  const double sum_squares = r.f64(), sum_matched = r.f64(), matches = r.f64();
+  if (!(sum_squares >= 0) || !(sum_matched >= 0) || !(matches >= 0)) r.fail("local SLAM's heading corrections");
+  heading_corrections_.restore(sum_squares, sum_matched, matches);
 }
 
 void LocalSlam::writeState(BinaryWriter& w) const {
@@ -455,9 +462,9 @@ void LocalSlam::writeState(BinaryWriter& w) const {
   w.f64(last_anchor_time_);
 }
 
-void LocalSlam::readState(BinaryReader& r) {
+void LocalSlam::readState(BinaryReader& r, bool with_heading_corrections) {
   motion_.readState(r);
-  submap_.readState(r);
+  submap_.readState(r, with_heading_corrections);
   have_scan_keyframe_ = r.boolean();
   local_poses_.resize(r.count(24));
   for (auto& p : local_poses_) p = readPose(r);
@@ -610,7 +617,7 @@ void Pipeline::writeStateNow(BinaryWriter& w) const {
   w.endSection();
 }
 
-void Pipeline::readState(BinaryReader& r) {
+void Pipeline::readState(BinaryReader& r, std::uint32_t format_version) {
   if (map_.size() != 0 || stats_.measurements != 0 || finished_) throw std::logic_error("Pipeline::readState into a pipeline that has run");
   {
     BinaryReader s = r.section(kStatsTag);
@@ -642,7 +649,7 @@ void Pipeline::readState(BinaryReader& r) {
   }
   {
     BinaryReader s = r.section(kLocalTag);
-    local_.readState(s);
+    local_.readState(s, format_version >= 5);
     submap_corrections_.readState(s);
     s.expectEnd();
   }

@@ -52,6 +52,10 @@ struct PriorMatcherOptions {
   double search_window_deg = 30.0;   // heading reach at least
   double max_search_window_m = 3.0;  // the prior's 3σ widens the window up to this
   double max_search_window_deg = 90.0;
+  // The prior's 3σ of heading widens the heading window by this factor only (≤ 1: the heading
+  // corrections seen so far are smaller than the prior says, HeadingCorrections.h); the prior's
+  // weight, and the uniform share's density over the unscaled window, stay as they are.
+  double heading_window_scale = 1.0;
   double odometry_outlier_probability = 1e-4;  // the prior's uniform share (MotionPrior.h)
   // How far from the prior's mean odometry that is wrong in direction (reversing reported as
   // driving forwards) can have put the vehicle: the window reaches at least this far. < 0: twice
@@ -91,6 +95,7 @@ struct PriorMatchResult {
   int displaced_in_view = 0, displaced_seen_through = 0;  // the same summed over four poses displaced from the result
   bool odometry_outvoted = false;                         // the result lies outside the odometry's Gaussian (after step 2')
   int iterations = 0, search_nodes = 0;
+  double search_half_angle_rad = 0;  // the heading window searched (each side of the prior's mean)
   double time_ms = 0;
   double matchedFraction() const { return points > 0 ? static_cast<double>(matched) / points : 0.0; }
 };

@@ -67,7 +67,8 @@ class LocalSlam {
 
   // Motion, submap and keyframe decision state (PipelineState.cpp).
   void writeState(common::BinaryWriter& w) const;
-  void readState(common::BinaryReader& r);
+  // with_heading_corrections: false for maps written before they were kept (LocalSubmap.h).
+  void readState(common::BinaryReader& r, bool with_heading_corrections = true);
 
  private:
   alignment::PriorMatchResult matchSubmap(const io::LaserScan& scan, const common::Pose2& z, const Eigen::Matrix3d& cov,

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "urbanslam/alignment/BeamFreeSpace.h"
+#include "urbanslam/alignment/HeadingCorrections.h"
 #include "urbanslam/alignment/PointSet.h"
 #include "urbanslam/alignment/PriorScanMatcher.h"
 #include "urbanslam/alignment/ScanModel.h"
@@ -36,11 +37,12 @@ class LocalSubmap {
   alignment::PriorMatchResult match(const io::LaserScan& scan, const common::Pose2& prior, const Eigen::Matrix3d& prior_cov,
                                     const std::vector<common::Pose2>& poses, double direction_reach_m = -1) const;
 
-  // The keyframes' points, the count of keyframes added and the learnt seen-through rates. The
-  // beams are rebuilt from the points and the prepared reference from both at the next match,
-  // as a cache miss would (the same inputs give the same reference).
+  // The keyframes' points, the count of keyframes added, the learnt seen-through rates and
+  // heading corrections. The beams are rebuilt from the points and the prepared reference from
+  // both at the next match, as a cache miss would (the same inputs give the same reference).
+  // with_heading_corrections: false for maps written before they were kept.
   void writeState(common::BinaryWriter& w) const;
-  void readState(common::BinaryReader& r);
+  void readState(common::BinaryReader& r, bool with_heading_corrections = true);
 
  private:
   const alignment::MatchReference* reference(const std::vector<common::Pose2>& poses) const;
@@ -61,6 +63,8 @@ class LocalSubmap {
   // Learnt from the matches as they come (what the free-space evidence weighs: the matcher's
   // seen_through_rate); it changes what the submap matches, not the submap itself.
   mutable alignment::SeenThroughRate seen_through_{0.05}, seen_through_displaced_{0.3};
+  // Learnt the same way: how much of the prior's heading window the search needs.
+  mutable alignment::HeadingCorrections heading_corrections_;
 };
 
 }  // namespace urbanslam::slam

@@ -9,6 +9,7 @@
 // holds up the sensors), else inline. Local SLAM never reads what global SLAM estimates, so both
 // give the same map. Until runInput() or finish() returns, the map is global SLAM's: read it
 // through observers.
+#include <cstdint>
 #include <deque>
 #include <functional>
 #include <memory>
@@ -62,9 +63,10 @@ class Pipeline {
 
   // Everything a continued run depends on, in tagged sections (PipelineState.cpp; the file
   // around it: MapFile.h). readState() goes into a fresh pipeline built with the same options,
-  // before any step, and throws common::InputError for contents it cannot take.
+  // before any step, and throws common::InputError for contents it cannot take. format_version:
+  // the map file's (MapFile.h), which says what the sections hold.
   void writeState(common::BinaryWriter& w) const;
-  void readState(common::BinaryReader& r);
+  void readState(common::BinaryReader& r, std::uint32_t format_version);
 
   // Another session's map joined to this one (`join`: SessionJoin.h): its keyframes, scans and
   // odometry constraints appended after this map's, the first tied to this map's keyframe nearest
