@@ -163,6 +163,29 @@ TEST(Icp, RobustKernelsAllConverge) {
   }
 }
 
+TEST(Icp, ARunThatCannotReachTheCallersFractionIsGivenUpEarly) {
+  // A pair that aligns: the same answer with and without the caller's fraction.
+  const Pair p = roomPair({-3, 0, 0.2}, {-2.2, 0.4, 0.35});
+  const auto a = ua::pointSetFromScan(p.a, {}), b = ua::pointSetFromScan(p.b, {});
+  ua::IcpOptions plain, giving_up;
+  giving_up.abandon_below_fraction = 0.5;
+  const auto guess = perturb(p.truth, 0.3, 0.2, -0.05);
+  const auto r1 = ua::plIcp(a, b, guess, plain), r2 = ua::plIcp(a, b, guess, giving_up);
+  ASSERT_TRUE(r1.converged && r2.converged) << r1.failure_reason << " / " << r2.failure_reason;
+  EXPECT_EQ(r1.transform.x, r2.transform.x);
+  EXPECT_EQ(r1.transform.phi, r2.transform.phi);
+  EXPECT_EQ(r1.matches.size(), r2.matches.size());
+  // A scan of a corridor against the room: run to the end, it matches under half of its points;
+  // given up, it says so, in fewer iterations.
+  ua::test::ScanSpec spec;
+  const auto c = ua::pointSetFromScan(simulateScan(ua::test::corridorWorld(), {1, 0, 0}, spec), {});
+  const auto full = ua::plIcp(a, c, {}, plain), early = ua::plIcp(a, c, {}, giving_up);
+  EXPECT_LT(static_cast<double>(full.matches.size()), 0.5 * static_cast<double>(c.size()));
+  EXPECT_FALSE(early.converged);
+  EXPECT_NE(early.failure_reason.find("the caller needs 50 %"), std::string::npos) << early.failure_reason;
+  EXPECT_LT(early.iterations, full.iterations);
+}
+
 // --- Degenerate inputs: a clear failure, a finite transform, no crash. ---
 
 class DegenerateTest : public ::testing::TestWithParam<ua::Method> {};

@@ -147,6 +147,16 @@ RegistrationResult icpWithIndex(const PointSet& reference, const NearestNeighbou
         break;
       }
     } else if (dt < 0.05 * gate && dphi < 0.01 * gate) {
+      if (gate <= options.abandon_gate_factor * gate_final &&
+          static_cast<double>(src.size()) < options.abandon_below_fraction * static_cast<double>(moving.size())) {
+        std::ostringstream os;
+        os << "only " << src.size() << " of " << moving.size() << " points within the " << gate << " m gate (the caller needs "
+           << static_cast<int>(100 * options.abandon_below_fraction) << " % within " << gate_final << " m)";
+        result.failure_reason = os.str();
+        result.iterations = it;
+        result.transform = pose;
+        return result;
+      }
       // Settled relative to the current gate: tighten it (thesis: "a progressively smaller gate").
       gate = std::max(gate_final, gate * options.gate_shrink);
     }

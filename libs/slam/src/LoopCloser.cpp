@@ -171,7 +171,12 @@ alignment::AlignmentResult LoopCloser::verifyAlignment(const io::LaserScan& earl
   // The point sets, kd-tree and line normals built once for every alignment below (the
   // ambiguity test restarts PL-ICP up to 16 times).
   const alignment::IndexedReference earlier_points(std::move(earlier_set));
-  const alignment::AlignmentResult a = alignment::alignPointSets(earlier_points, current_points, guess, ao);
+  // Below min_matched_fraction an alignment is refused: its ICP runs (from CRF-match's
+  // hypotheses and the guess) that cannot reach it are given up early. (Not the ambiguity test's
+  // restarts below: on the Intel log, giving those up let a false closure in.)
+  alignment::AlignerOptions first = ao;
+  first.icp.abandon_below_fraction = options_.min_matched_fraction;
+  const alignment::AlignmentResult a = alignment::alignPointSets(earlier_points, current_points, guess, first);
   r.measurement = a.transform;
   r.rms_m = a.rms_residual_m;
   if (!a.converged || a.rms_residual_m > options_.max_rms_m || a.matchedFraction() < options_.min_matched_fraction) {
