@@ -172,8 +172,10 @@ alignment::AlignmentResult LoopCloser::verifyAlignment(const io::LaserScan& earl
   // ambiguity test restarts PL-ICP up to 16 times).
   const alignment::IndexedReference earlier_points(std::move(earlier_set));
   // Below min_matched_fraction an alignment is refused: its ICP runs (from CRF-match's
-  // hypotheses and the guess) that cannot reach it are given up early. (Not the ambiguity test's
-  // restarts below: on the Intel log, giving those up let a false closure in.)
+  // hypotheses and the guess) that cannot reach it are given up early. The ambiguity test's
+  // restarts below run in full: they look for another minimum matching more points than the one
+  // accepted, a safeguard against aliasing left whole (giving them up too changed no closure on
+  // Intel or FR079, and would save little: they follow accepted alignments only).
   alignment::AlignerOptions first = ao;
   first.icp.abandon_below_fraction = options_.min_matched_fraction;
   const alignment::AlignmentResult a = alignment::alignPointSets(earlier_points, current_points, guess, first);
