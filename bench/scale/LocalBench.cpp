@@ -4,12 +4,11 @@
 // one thread: the CPU time of each replay, median and spread, as one JSON line. Deterministic
 // work with no second thread and no input or output in the timed part, so a change to local
 // SLAM's matching is measured to a few per cent, where a whole run varies by ten (global SLAM's
-// share and the machine's). `check` is the last keyframe's step: equal across builds when the
-// change leaves the matches as they were.
+// share and the machine's). `check` sums every keyframe step's x, y and heading: equal across
+// builds when the change leaves the matches as they were.
 #include <time.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <cstdlib>
 #include <iostream>
 #include <string>
@@ -18,6 +17,7 @@
 
 #include "urbanslam/common/Error.h"
 #include "urbanslam/common/Heap.h"
+#include "urbanslam/common/Json.h"
 #include "urbanslam/io/DataSource.h"
 #include "urbanslam/sim/SimOptions.h"
 #include "urbanslam/sim/SimulatedSource.h"
@@ -65,7 +65,14 @@ int main(int argc, char** argv) {
         scans = static_cast<size_t>(n);
       else
         repeat = static_cast<int>(std::min<long>(n, 1000));
+    } else {
+      std::cerr << "local_bench: unknown option '" << a << "'\n" << usage;
+      return 2;
     }
+  }
+  if (argc % 2 == 0) {
+    std::cerr << "local_bench: '" << argv[argc - 1] << "' has no value\n" << usage;
+    return 2;
   }
   if (city.empty() == log.empty()) {
     std::cerr << usage;
@@ -84,22 +91,28 @@ int main(int argc, char** argv) {
     }
     std::vector<double> cpu_s;
     size_t keyframes = 0;
-    common::Pose2 check;
+    double check[3] = {0, 0, 0};
     for (int r = 0; r < repeat; ++r) {
       slam::LocalTrajectory local(options);
       const double t0 = threadCpuSeconds();
       for (const io::Measurement& x : log_in_memory) local.add(x);
       cpu_s.push_back(threadCpuSeconds() - t0);
       keyframes = local.keyframes().size();
-      if (!local.keyframes().empty()) check = local.keyframes().back().z;
+      check[0] = check[1] = check[2] = 0;
+      for (const auto& k : local.keyframes()) check[0] += k.z.x, check[1] += k.z.y, check[2] += k.z.phi;
     }
     std::sort(cpu_s.begin(), cpu_s.end());
     const double median = cpu_s[cpu_s.size() / 2];
-    std::printf(
-        "{\"scans\": %zu, \"keyframes\": %zu, \"repeat\": %d, \"cpu_s_median\": %.4f, \"cpu_s_min\": %.4f, \"cpu_s_max\": %.4f, "
-        "\"ms_per_scan\": %.4f, \"check\": [%.9f, %.9f, %.9f]}\n",
-        taken, keyframes, repeat, median, cpu_s.front(), cpu_s.back(), taken ? 1e3 * median / static_cast<double>(taken) : 0.0, check.x,
-        check.y, check.phi);
+    common::Json j = common::Json::object();
+    j["scans"] = taken;
+    j["keyframes"] = keyframes;
+    j["repeat"] = repeat;
+    j["cpu_s_median"] = median;
+    j["cpu_s_min"] = cpu_s.front();
+    j["cpu_s_max"] = cpu_s.back();
+    j["ms_per_scan"] = taken ? 1e3 * median / static_cast<double>(taken) : 0.0;
+    j["check"] = common::Json::arrayOf(std::vector<double>{check[0], check[1], check[2]});
+    std::cout << j.dump() << "\n";
     return 0;
   } catch (const common::InputError& e) {
     std::cerr << "local_bench: " << e.what() << "\n";

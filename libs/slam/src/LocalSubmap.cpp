@@ -81,10 +81,10 @@ alignment::PriorMatchResult LocalSubmap::match(const io::LaserScan& scan, const 
   options.direction_reach_m = direction_reach_m;
   const alignment::PointSet scan_points = points(scan);
   // First within the heading corrections' own reach; the prior's full window when that match is
-  // in doubt.
+  // in doubt (not when no search ran: too few points fail the same way in any window).
   options.heading_window_scale = heading_corrections_.windowScale();
   alignment::PriorMatchResult r = alignment::matchWithPrior(*ref, scan_points, prior, prior_cov, options);
-  if (options.heading_window_scale < 1 &&
+  if (options.heading_window_scale < 1 && r.search_nodes > 0 &&
       heading_corrections_.doubts(r.valid, common::wrapToPi(r.search_pose.phi - prior.phi), r.search_half_angle_rad, r.matchedFraction())) {
     options.heading_window_scale = 1;
     r = alignment::matchWithPrior(*ref, scan_points, prior, prior_cov, options);
