@@ -10,6 +10,7 @@
 #include "urbanslam/esdf/EnvelopeCholesky.h"
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/esdf/PoseOps.h"
+#include "urbanslam/esdf/Recovery.h"
 
 namespace urbanslam::esdf {
 namespace {
@@ -69,6 +70,25 @@ TEST(Recovery, PartialRecoveryEqualsDenseConditionalSolve) {
   f.recoverRecent(first);
   EXPECT_LT((f.state().denseMean().tail(r) - ref).cwiseAbs().maxCoeff(), 1e-9);
   EXPECT_LT((f.state().denseMean().head(3 * first) - mu.head(3 * first)).norm(), 1e-15);  // older poses untouched
+}
+
+// The sparse inverse's diagonal blocks against the dense inverse, with both kinds of CHOLMOD
+// factor: a loop with few closures factorises simplicially, many random closures fill it in
+// enough for supernodes.
+TEST(Recovery, InverseDiagonalBlocksEqualTheDenseInverse) {
+  for (const auto& [poses, closures, supernodal] : {std::tuple{60, 3, false}, std::tuple{300, 400, true}}) {
+    LinearGraph g(32, poses, closures);
+    SparseCholesky chol;
+    chol.factorize(g.f.state(), 0, g.f.size());
+    ASSERT_EQ(chol.supernodal(), supernodal) << poses << " poses";
+    const Eigen::MatrixXd sigma = g.f.state().denseInformation().inverse();
+    const std::vector<Mat3> blocks = chol.inverseDiagonalBlocks();
+    ASSERT_EQ(blocks.size(), static_cast<size_t>(g.f.size()));
+    double worst = 0;
+    for (int p = 0; p < g.f.size(); ++p)
+      worst = std::max(worst, (blocks[static_cast<size_t>(p)] - blk(sigma, p, p)).cwiseAbs().maxCoeff() / blk(sigma, p, p).norm());
+    EXPECT_LT(worst, 1e-9) << poses << " poses";
+  }
 }
 
 TEST(Recovery, EnvelopeCholeskySolvesEveryWindowLikeDenseLlt) {

@@ -422,12 +422,11 @@ Mat6 Esdf::conservativeJoint(int i, int j) {
   auto chainPhi = [&](int p) -> const Mat3& { return chain_phi_[static_cast<size_t>(p - m)]; };
   auto marginal = [&](int p) -> Mat3 {
     if (p >= m) return chainPhi(p) * base * chainPhi(p).transpose() + chain_cov_[static_cast<size_t>(p - m)];
-    // A solve over the whole map: kept until the next factorisation, since the keyframes of an
-    // earlier visit are candidates again and again while the vehicle drives along it.
-    const auto known = factored_marginals_.find(p);
-    if (known != factored_marginals_.end()) return known->second;
-    Eigen::MatrixXd cols;
-    return factored_marginals_[p] = covarianceColumnsBlock(p, &cols);
+    // Every factored pose's at once, from the factor's sparse inverse, on the first one asked:
+    // while the vehicle drives along an earlier visit its keyframes are candidates one after
+    // another, and a column solve each would pass over the whole map each time.
+    if (factored_marginals_.empty()) factored_marginals_ = full_factor_.inverseDiagonalBlocks();
+    return factored_marginals_[static_cast<size_t>(p)];
   };
   auto cross = [&](int a, int b) -> Mat3 {  // Sigma(a, b) for a < b
     if (b < m) {

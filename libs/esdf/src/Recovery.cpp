@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "SparseInverse.h"
+
 namespace urbanslam::esdf {
 
 namespace {
@@ -204,6 +206,44 @@ Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& b) const {
   Eigen::MatrixXd out = Eigen::Map<Eigen::MatrixXd>(static_cast<double*>(x->x), rhs.rows(), rhs.cols());
   cholmod_free_dense(&x, cm);
   return out;
+}
+
+bool SparseCholesky::supernodal() const { return impl_->factor && impl_->factor->is_super; }
+
+std::vector<Mat3> SparseCholesky::inverseDiagonalBlocks() const {
+  if (!impl_->factor) throw std::logic_error("inverseDiagonalBlocks without a factor");
+  cholmod_common* cm = &impl_->common;
+  const cholmod_factor* f = impl_->factor;
+  SupernodalFactorView v;
+  v.columns = static_cast<int>(f->n);
+  v.perm = static_cast<const int*>(f->Perm);
+  if (f->is_super) {
+    v.supernodes = static_cast<int>(f->nsuper);
+    v.first_column = static_cast<const int*>(f->super);
+    v.row_begin = static_cast<const int*>(f->pi);
+    v.rows = static_cast<const int*>(f->s);
+    v.value_begin = static_cast<const int*>(f->px);
+    v.values = static_cast<const double*>(f->x);
+    return esdf::inverseDiagonalBlocks(v);
+  }
+  // A simplicial factor is LDL' with its columns anywhere in memory: a packed LL' copy has one
+  // column per supernode, in order (the solves keep using the factor as it is).
+  cholmod_factor* ll = cholmod_copy_factor(impl_->factor, cm);
+  if (!ll || !cholmod_change_factor(CHOLMOD_REAL, 1, 0, 1, 1, ll, cm)) {
+    if (ll) cholmod_free_factor(&ll, cm);
+    throw std::runtime_error("CHOLMOD could not convert the factor to LL'");
+  }
+  std::vector<int> columns(f->n + 1);
+  for (size_t c = 0; c <= f->n; ++c) columns[c] = static_cast<int>(c);
+  v.supernodes = v.columns;
+  v.first_column = columns.data();
+  v.row_begin = static_cast<const int*>(ll->p);
+  v.rows = static_cast<const int*>(ll->i);
+  v.value_begin = static_cast<const int*>(ll->p);
+  v.values = static_cast<const double*>(ll->x);
+  std::vector<Mat3> blocks = esdf::inverseDiagonalBlocks(v);
+  cholmod_free_factor(&ll, cm);
+  return blocks;
 }
 
 long long SparseCholesky::factorNonZeros() const {

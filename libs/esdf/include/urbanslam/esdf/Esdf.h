@@ -19,7 +19,6 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
-#include <unordered_map>
 #include <vector>
 
 #include "urbanslam/esdf/EnvelopeCholesky.h"
@@ -246,7 +245,7 @@ class Esdf {
   std::vector<Mat3> chain_phi_, chain_cov_;
   bool chain_valid_ = true;
   Eigen::MatrixXd base_columns_;                      // stale Sigma(:, base-1), from the last full factorisation
-  std::unordered_map<int, Mat3> factored_marginals_;  // Sigma(p, p) of older poses from the same factorisation
+  std::vector<Mat3> factored_marginals_;              // Sigma(p, p) of the factored poses (empty: not yet computed)
   ChainAnchor anchor_;
   size_t anchor_factors_ = 0;       // factors_.size() when anchor_ was looked for ...
   int anchor_base_ = -1;            // ... and chain_base_ then

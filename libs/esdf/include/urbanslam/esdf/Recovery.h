@@ -49,6 +49,10 @@ class SparseCholesky {
   Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const;
   // Non-zeros of the factor L (for statistics).
   long long factorNonZeros() const;
+  // The 3x3 diagonal blocks of Lambda_sub^-1, one per pose of the range: the marginal
+  // covariances, all at once for about the cost of one more factorisation (SparseInverse.h).
+  std::vector<Mat3> inverseDiagonalBlocks() const;
+  bool supernodal() const;
 
   // The matrix the current factor was computed from (lower triangle, compressed columns), kept
   // so that a saved filter can rebuild exactly this factor: a covariance from an older

@@ -1,0 +1,32 @@
+#pragma once
+// Entries of A^-1 on the pattern of A's Cholesky factor L (the "sparse inverse subset"), by the
+// Takahashi recurrences run backwards over L's supernodes. Every 3x3 diagonal block of A^-1
+// lies in that pattern, so all the poses' marginal covariances cost about one more
+// factorisation, where a column solve per pose costs a pass over the whole factor each.
+#include <vector>
+
+#include "urbanslam/esdf/PoseOps.h"
+
+namespace urbanslam::esdf {
+
+// A lower-triangular factor L (A = P' L L' P) in supernodal form. Supernode s holds the columns
+// [first_column[s], first_column[s + 1]); its row indices rows[row_begin[s] .. row_begin[s + 1])
+// start with those columns in order, then the rows below them in ascending order; its values
+// are a column-major block of (row count) x (column count) at values[value_begin[s]], of which
+// the lower triangle of the top square and everything below it are L. A simplicial factor is
+// the same with one column per supernode. perm[k] is the row of A that L's row k stands for.
+struct SupernodalFactorView {
+  int columns = 0;
+  int supernodes = 0;
+  const int* first_column = nullptr;
+  const int* row_begin = nullptr;
+  const int* rows = nullptr;
+  const int* value_begin = nullptr;
+  const double* values = nullptr;
+  const int* perm = nullptr;
+};
+
+// The 3x3 diagonal blocks of A^-1 for A of size 3 * poses (rows 3p .. 3p + 2 are pose p).
+std::vector<Mat3> inverseDiagonalBlocks(const SupernodalFactorView& l);
+
+}  // namespace urbanslam::esdf
