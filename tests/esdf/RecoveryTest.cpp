@@ -150,7 +150,8 @@ TEST(Recovery, MarginalsAndPairsEqualDenseInverse) {
   }
 }
 
-double minEigen(const Mat6& m) { return Eigen::SelfAdjointEigenSolver<Mat6>(m).eigenvalues().minCoeff(); }
+template <int N>
+double minEigen(const Eigen::Matrix<double, N, N>& m) { return Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, N, N>>(m).eigenvalues().minCoeff(); }
 
 TEST(Recovery, ConservativeCovarianceIsExactWithoutNewInformationAndAnUpperBoundWithIt) {
   LinearGraph g(33, 50, 6);
@@ -176,7 +177,7 @@ TEST(Recovery, ConservativeCovarianceIsExactWithoutNewInformationAndAnUpperBound
   for (auto [i, j] : pairs2) cons.push_back(f.jointCovariance(i, j, CovarianceMode::Conservative));
   for (size_t k = 0; k < pairs2.size(); ++k) {
     const Mat6 e = f.jointCovariance(pairs2[k].first, pairs2[k].second, CovarianceMode::Exact);
-    EXPECT_GT(minEigen(cons[k] - e), -1e-9 * e.norm()) << k;
+    EXPECT_GT(minEigen<6>(cons[k] - e), -1e-9 * e.norm()) << k;
     EXPECT_GT((cons[k] - e).norm(), 1e-6 * e.norm()) << "closures should make a difference for pair " << k;
   }
 }
@@ -198,19 +199,59 @@ TEST(Recovery, ConservativeCovarianceAfterAClosureIsReachedThroughIt) {
   for (int k = 90; k < 93; ++k) f.augmentRelative(k - 1, Vec3(1, 0, 0.05), kOdoInfo);
   const std::vector<std::pair<int, int>> pairs{{11, 92}, {92, 9}, {10, 85}, {30, 92}, {3, 60}, {92, 92}};
   std::vector<Mat6> cons;
-  for (auto [i, j] : pairs) cons.push_back(f.jointCovariance(i, j, CovarianceMode::Conservative));
+  std::vector<Mat3> cons_relative;
+  for (auto [i, j] : pairs) {
+    cons.push_back(f.jointCovariance(i, j, CovarianceMode::Conservative));
+    if (i != j) cons_relative.push_back(f.relativeCovariance(i, j, CovarianceMode::Conservative));
+  }
   for (size_t k = 0; k < pairs.size(); ++k) {
     const auto [i, j] = pairs[k];
     const Mat6 e = f.jointCovariance(i, j, CovarianceMode::Exact);
-    EXPECT_GT(minEigen(cons[k] - e), -1e-9 * e.norm()) << k;
+    EXPECT_GT(minEigen<6>(cons[k] - e), -1e-9 * e.norm()) << k;
+    if (i == j) {
+      // The newest pose's own marginal through the closure: 40 steps of dead reckoning would
+      // give far more.
+      EXPECT_LT(cons[k](0, 0) + cons[k](1, 1), 3 * (e(0, 0) + e(1, 1))) << k;
+      continue;
+    }
+    const Mat3 re = relative(f, i, j, e), rc = cons_relative[k];
+    EXPECT_GT(minEigen<3>(rc - re), -1e-9 * re.norm()) << k;
     if (k < 3) {
       // Near the closure: the relative position's spread within 3x the exact one's (dead
       // reckoning from the factorisation gives 25x and 10^5x here).
-      const Mat3 rc = relative(f, i, j, cons[k]), re = relative(f, i, j, e);
       const double spread = rc(0, 0) + rc(1, 1), exact = re(0, 0) + re(1, 1);
       EXPECT_LT(spread, 3 * exact) << k << " ratio " << spread / exact;
     }
   }
+}
+
+TEST(Recovery, TheRelativeBoundThroughAClosureIsThatOfThePathsFactorsAlone) {
+  // An earlier visit (poses 0..29) factorised, then a drive of 20 poses and a closure from pose
+  // 20 of the earlier visit to the newest pose, and 5 more poses. The conservative relative
+  // covariance of pose 14 and the newest pose is the exact one of a filter that holds only the
+  // factors on the path 14 .. 20, the closure and the 5 poses after it, not a bound from the
+  // whole map's solve.
+  LinearGraph g(35, 30, 0);
+  Esdf& f = g.f;
+  f.recover();
+  const Vec3 step(1, 0, 0.02);
+  for (int k = 30; k < 50; ++k) f.augmentRelative(k - 1, step, kOdoInfo);
+  const Mat3 tight = Vec3(1e4, 1e4, 1e5).asDiagonal();
+  const Vec3 closure = between(f.mean(20), f.mean(49));
+  f.observeRelative(20, 49, closure, tight);
+  for (int k = 50; k < 55; ++k) f.augmentRelative(k - 1, step, kOdoInfo);
+  const Mat3 bound = f.relativeCovariance(14, 54, CovarianceMode::Conservative);
+
+  // The path alone: 14 -> 20 by the earlier visit's own factors, the closure, then the drive.
+  Esdf path(LinearGraph::options());
+  path.initialise(f.mean(14), Mat3::Identity() * 1e-9);
+  for (int k = 15; k <= 20; ++k) path.augmentRelative(k - 15, between(f.mean(k - 1), f.mean(k)), kOdoInfo);
+  path.augmentRelative(6, closure, tight);
+  for (int k = 0; k < 5; ++k) path.augmentRelative(7 + k, step, kOdoInfo);
+  const Mat3 reference = path.relativeCovariance(0, 12);
+  EXPECT_LT((bound - reference).cwiseAbs().maxCoeff(), 1e-6 * reference.norm()) << bound << "\n\n" << reference;
+  // And it bounds the whole map's exact relative covariance.
+  EXPECT_GT(minEigen<3>(bound - f.relativeCovariance(14, 54)), -1e-9 * bound.norm());
 }
 
 TEST(Recovery, NotPositiveDefiniteThrows) {

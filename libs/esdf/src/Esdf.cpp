@@ -198,6 +198,8 @@ void Esdf::predict(std::shared_ptr<const MotionModel> model, const VecU& u, cons
   first_factor_of_pose_.pop_back();  // the new pose takes the old one's slot and scan start
   chain_valid_ = false;
   full_factor_values_ = ~std::uint64_t{0};
+  factors_of_pose_.clear();  // factors and poses renumbered: indexed again when asked
+  factors_indexed_ = 0;
   markChanged();
 }
 
@@ -263,7 +265,7 @@ void Esdf::ensureFactor() {
   base_columns_.resize(0, 0);
   factored_marginals_.clear();
   anchor_base_ = -1;  // the anchor is looked for again in the new chain
-  anchor_columns_pose_ = -1;
+  anchor_paths_from_ = -1;
 }
 
 RecoveryStats Esdf::recover(int max_passes) {
@@ -395,11 +397,24 @@ Mat3 Esdf::covarianceColumnsBlock(int i, Eigen::MatrixXd* columns) {
 
 Mat3 Esdf::marginalCovariance(int i, CovarianceMode mode) { return jointCovariance(i, i, mode).topLeftCorner<3, 3>(); }
 
+bool Esdf::conservativeReady() const {
+  return full_factor_.valid() && chain_valid_ && full_factor_.last() == chain_base_ && chain_base_ > 0 && full_factor_.first() == 0 &&
+         static_cast<int>(chain_phi_.size()) == size() - chain_base_;
+}
+
+Mat3 Esdf::relativeCovariance(int i, int j, CovarianceMode mode) {
+  if (i < 0 || j < 0 || i >= size() || j >= size() || i == j) throw std::out_of_range("relativeCovariance: bad poses");
+  if (mode == CovarianceMode::Conservative && conservativeReady()) {
+    Mat3 r;
+    conservativeJoint(i, j, &r);
+    return r;
+  }
+  return betweenCovariance(state_.mean(i), state_.mean(j), jointCovariance(i, j, mode));
+}
+
 Mat6 Esdf::jointCovariance(int i, int j, CovarianceMode mode) {
   if (i < 0 || j < 0 || i >= size() || j >= size()) throw std::out_of_range("jointCovariance: bad pose");
-  if (mode == CovarianceMode::Conservative && full_factor_.valid() && chain_valid_ && full_factor_.last() == chain_base_ &&
-      chain_base_ > 0 && full_factor_.first() == 0 && static_cast<int>(chain_phi_.size()) == size() - chain_base_)
-    return conservativeJoint(i, j);
+  if (mode == CovarianceMode::Conservative && conservativeReady()) return conservativeJoint(i, j, nullptr);
   ensureFactor();
   const int n = size();
   Eigen::MatrixXd e = Eigen::MatrixXd::Zero(3 * n, 6);
@@ -412,7 +427,7 @@ Mat6 Esdf::jointCovariance(int i, int j, CovarianceMode mode) {
   return 0.5 * (s + s.transpose());
 }
 
-Mat6 Esdf::conservativeJoint(int i, int j) {
+Mat6 Esdf::conservativeJoint(int i, int j, Mat3* relative) {
   // The last factorisation is of an older Lambda, which holds less information than the current
   // one (if no relinearisation happened since): its inverse bounds the current covariance from
   // above. Poses added after it are reached by dead reckoning from the last factored pose m-1.
@@ -448,25 +463,28 @@ Mat6 Esdf::conservativeJoint(int i, int j) {
   };
   const int a = std::min(i, j), b = std::max(i, j);
   const Mat6 s = i == j ? joint(marginal(i), marginal(i), marginal(i)) : joint(marginal(a), marginal(b), cross(a, b));
+  const auto spread = [](const Mat3& c) { return c(0, 0) + c(1, 1); };
+  if (relative) *relative = betweenCovariance(state_.mean(i), state_.mean(j), s);
   // Through the newest closure into the chain, when it lies on the way to b (and a is factored or
-  // b's own marginal is asked): both are upper bounds, and the one that bounds the relative pose
-  // (or the marginal) tighter is returned.
+  // b's own marginal is asked): both are upper bounds, and the one that bounds the marginal (or
+  // the relative pose) tighter is returned.
   const ChainAnchor& an = chainAnchor();
   if (an.a < 0 || b < an.b || (a >= m && i != j)) return s;
-  if (anchor_columns_pose_ != an.a) {
-    covarianceColumnsBlock(an.a, &anchor_columns_);
-    anchor_columns_pose_ = an.a;
-  }
+  const Mat3 sa = marginal(an.a);
   const Mat3 step = chainPhi(b) * chainPhi(an.b).inverse();  // x_b from x_{an.b} by the chain
   const Mat3 to_b = step * an.phi;                           // d x_b / d x_{an.a}
   const Mat3 increments = chain_cov_[static_cast<size_t>(b - m)] - step * chain_cov_[static_cast<size_t>(an.b - m)] * step.transpose();
-  const Mat3 sbb = to_b * anchor_columns_.block<3, 3>(3 * an.a, 0) * to_b.transpose() + step * an.cov * step.transpose() + increments;
-  const Mat6 t = i == j ? joint(sbb, sbb, sbb) : joint(marginal(a), sbb, anchor_columns_.block<3, 3>(3 * a, 0) * to_b.transpose());
-  const auto spread = [&](const Mat6& c) {
-    const Mat3 r = i == j ? Mat3(c.topLeftCorner<3, 3>()) : betweenCovariance(state_.mean(i), state_.mean(j), c);
-    return r(0, 0) + r(1, 1);
-  };
-  return spread(t) < spread(s) ? t : s;
+  const Mat3 sbb = to_b * sa * to_b.transpose() + step * an.cov * step.transpose() + increments;
+  if (i == j) return spread(sbb) < spread(s.topLeftCorner<3, 3>()) ? joint(sbb, sbb, sbb) : s;
+  // The pair: a from an.a by the factors alone on the path between them (anchorPath), then the
+  // closure and the chain after it. That bounds their relative pose, not their joint (x_{an.a}
+  // enters both as it is), so the joint stays s.
+  const PathBound* path = relative ? anchorPath(a) : nullptr;
+  if (!path) return s;
+  const Mat3 t = betweenCovariance(state_.mean(i), state_.mean(j),
+                                   joint(path->phi * sa * path->phi.transpose() + path->cov, sbb, path->phi * sa * to_b.transpose()));
+  if (spread(t) < spread(*relative)) *relative = t;
+  return s;
 }
 
 const Esdf::ChainAnchor& Esdf::chainAnchor() {

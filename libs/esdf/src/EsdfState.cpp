@@ -178,7 +178,9 @@ void Esdf::readState(common::BinaryReader& r) {
   base_columns_ = r.dense();
   factored_marginals_.clear();
   anchor_base_ = -1;
-  anchor_columns_pose_ = -1;
+  anchor_paths_from_ = -1;
+  factors_of_pose_.clear();
+  factors_indexed_ = 0;
   if (base_columns_.size() != 0 && (!full_factor_.valid() || base_columns_.rows() != 3 * full_factor_.last() || base_columns_.cols() != 3))
     r.fail("filter covariance columns");
 }

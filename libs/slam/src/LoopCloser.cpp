@@ -68,8 +68,7 @@ Eigen::Matrix3d LoopCloser::relativeCovariance(esdf::Esdf& filter, size_t i, siz
     cached_for_ = k;
   }
   if (const auto it = cached_.find(i); it != cached_.end()) return it->second;
-  const esdf::Mat6 joint = filter.jointCovariance(static_cast<int>(i), static_cast<int>(k), esdf::CovarianceMode::Conservative);
-  const Eigen::Matrix3d s = esdf::betweenCovariance(filter.mean(static_cast<int>(i)), filter.mean(static_cast<int>(k)), joint);
+  const Eigen::Matrix3d s = filter.relativeCovariance(static_cast<int>(i), static_cast<int>(k), esdf::CovarianceMode::Conservative);
   cached_[i] = s;
   return s;
 }

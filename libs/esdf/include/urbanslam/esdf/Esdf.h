@@ -19,6 +19,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
+#include <unordered_map>
 #include <vector>
 
 #include "urbanslam/esdf/EnvelopeCholesky.h"
@@ -137,6 +138,10 @@ class Esdf {
   // Marginal covariance of pose i and joint covariance of (x_i, x_j) (6x6, i's block first).
   Mat3 marginalCovariance(int i, CovarianceMode mode = CovarianceMode::Exact);
   Mat6 jointCovariance(int i, int j, CovarianceMode mode = CovarianceMode::Exact);
+  // Covariance of the relative pose ⊖x_i ⊕ x_j (i != j). Conservative: also through the newest
+  // closure into the dead-reckoned poses and the factors alone on the path from its earlier end
+  // to the older pose (a bound on the relative pose only, with no solve over the map).
+  Mat3 relativeCovariance(int i, int j, CovarianceMode mode = CovarianceMode::Exact);
 
   int size() const { return state_.size(); }
   int currentPose() const { return state_.size() - 1; }
@@ -214,7 +219,9 @@ class Esdf {
   void pushChain(int k, int from, const Mat3& f_x, const Mat3& q);
   void ensureFactor();
   Mat3 covarianceColumnsBlock(int i, Eigen::MatrixXd* columns);
-  Mat6 conservativeJoint(int i, int j);
+  bool conservativeReady() const;
+  // The conservative joint; with `relative` (i != j) also the tightest relative-pose bound.
+  Mat6 conservativeJoint(int i, int j, Mat3* relative);
   // A second path from the factorisation into the chain: the newest relative factor from a
   // factored pose a to a chain pose b (a loop closure: x_b = x_a ⊕ z ⊕ noise). A chain pose at
   // or after b is reached from a through it and the chain's increments after b, which, while the
@@ -226,6 +233,19 @@ class Esdf {
     Mat3 cov = Mat3::Zero();      // the closure's noise, mapped onto x_b
   };
   const ChainAnchor& chainAnchor();
+  // A factored pose p as reached from the anchor's factored end a through the factors alone on
+  // the path between them (AnchorPaths.cpp): x_p = phi x_a + w, Cov w = cov. The relative pose
+  // of p and a chain pose through that path and the closure bounds the exact one (a subset of
+  // the factors holds less information), with no solve over the map. nullptr: p lies more than
+  // kAnchorPathLinks factors from a.
+  struct PathBound {
+    Mat3 phi = Mat3::Identity();
+    Mat3 cov = Mat3::Zero();
+  };
+  static constexpr int kAnchorPathLinks = 64;
+  static constexpr size_t kAnchorPathPoses = 4096;  // the breadth-first search stops at this many
+  const PathBound* anchorPath(int p);
+  void indexFactors();
   void markChanged() { ++values_stamp_; }
 
   EsdfOptions options_;
@@ -249,8 +269,10 @@ class Esdf {
   ChainAnchor anchor_;
   size_t anchor_factors_ = 0;       // factors_.size() when anchor_ was looked for ...
   int anchor_base_ = -1;            // ... and chain_base_ then
-  Eigen::MatrixXd anchor_columns_;  // stale Sigma(:, anchor_.a), from the last full factorisation
-  int anchor_columns_pose_ = -1;
+  std::unordered_map<int, PathBound> anchor_paths_;  // from anchor_paths_from_, within the factored poses
+  int anchor_paths_from_ = -1, anchor_paths_base_ = -1;
+  std::vector<std::vector<int>> factors_of_pose_;  // the factors touching each pose (anchorPath's graph) ...
+  size_t factors_indexed_ = 0;                     // ... for factors_[0, this)
 };
 
 }  // namespace urbanslam::esdf
