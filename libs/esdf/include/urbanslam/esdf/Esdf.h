@@ -243,7 +243,7 @@ class Esdf {
     Mat3 cov = Mat3::Zero();
   };
   static constexpr int kAnchorPathLinks = 64;
-  static constexpr size_t kAnchorPathPoses = 4096;  // the breadth-first search stops at this many
+  static constexpr size_t kAnchorPathPoses = 4096;  // the path search settles at most this many poses
   const PathBound* anchorPath(int p);
   void indexFactors();
   void markChanged() { ++values_stamp_; }
