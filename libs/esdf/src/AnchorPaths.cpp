@@ -1,9 +1,6 @@
 // Conservative covariances through the newest closure (Esdf::conservativeJoint): how a factored
 // pose is reached from the closure's factored end by the factors alone on the path between them.
 #include <Eigen/LU>
-#include <functional>
-#include <queue>
-#include <unordered_set>
 
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/esdf/PoseOps.h"
@@ -26,50 +23,46 @@ const Esdf::PathBound* Esdf::anchorPath(int p) {
     anchor_paths_from_ = from;
     anchor_paths_base_ = m;
     anchor_paths_.clear();
+    anchor_settled_.clear();
+    anchor_open_ = {};
     indexFactors();
-    // Every path bounds the relative pose: the tightest is looked for (Dijkstra on the spread of
-    // the accumulated position noise), over paths of at most kAnchorPathLinks factors.
-    struct Entry {
-      double spread;
-      int pose, links;
-      bool operator>(const Entry& o) const { return spread > o.spread; }
-    };
-    std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
     anchor_paths_[from] = PathBound{};
-    open.push({0.0, from, 0});
-    std::unordered_set<int> done;
-    while (!open.empty() && done.size() < kAnchorPathPoses) {
-      const Entry e = open.top();
-      open.pop();
-      if (!done.insert(e.pose).second) continue;
-      if (e.links >= kAnchorPathLinks) continue;
-      const PathBound bu = anchor_paths_.at(e.pose);  // a copy: the map grows below
-      for (const int k : factors_of_pose_[static_cast<size_t>(e.pose)]) {
-        const Factor& f = factors_[static_cast<size_t>(k)];
-        const bool forward = f.a == e.pose;
-        const int v = forward ? f.b : f.a;
-        if (v >= m || done.count(v)) continue;
-        // x_b = x_a ⊕ z ⊕ e, e ~ N(0, weight^-1), linearised where the factor is; from b,
-        // x_a = x_b ⊕ (z ⊕ e)^-1.
-        Mat3 d_x, d_e;
-        if (forward) {
-          composeJacobians(f.lin_a, f.z, &d_x, nullptr);
-          composeJacobians(compose(f.lin_a, f.z), Vec3::Zero(), nullptr, &d_e);
-        } else {
-          Mat3 d_inv, d_z;
-          composeJacobians(f.lin_b, inverse(f.z), &d_x, &d_inv);
-          composeJacobians(f.z, Vec3::Zero(), nullptr, &d_z);
-          d_e = d_inv * inverseJacobian(f.z) * d_z;
-        }
-        const PathBound nv{d_x * bu.phi, d_x * bu.cov * d_x.transpose() + d_e * f.weight.inverse() * d_e.transpose()};
-        const double spread = nv.cov(0, 0) + nv.cov(1, 1);
-        const auto known = anchor_paths_.find(v);
-        if (known != anchor_paths_.end() && known->second.cov(0, 0) + known->second.cov(1, 1) <= spread) continue;
-        anchor_paths_[v] = nv;
-        open.push({spread, v, e.links + 1});
+    anchor_open_.push({0.0, from, 0});
+  }
+  // Every path bounds the relative pose: the tightest is looked for (Dijkstra on the spread of
+  // the accumulated position noise), over paths of at most kAnchorPathLinks factors, and only as
+  // far as the poses asked need (a settled pose's path does not depend on when it was asked).
+  while (!anchor_settled_.count(p) && !anchor_open_.empty() && anchor_settled_.size() < kAnchorPathPoses) {
+    const PathEntry e = anchor_open_.top();
+    anchor_open_.pop();
+    if (!anchor_settled_.insert(e.pose).second || e.links >= kAnchorPathLinks) continue;
+    const PathBound bu = anchor_paths_.at(e.pose);  // a copy: the map grows below
+    for (const int k : factors_of_pose_[static_cast<size_t>(e.pose)]) {
+      const Factor& f = factors_[static_cast<size_t>(k)];
+      const bool forward = f.a == e.pose;
+      const int v = forward ? f.b : f.a;
+      if (v >= m || anchor_settled_.count(v)) continue;
+      // x_b = x_a ⊕ z ⊕ e, e ~ N(0, weight^-1), linearised where the factor is; from b,
+      // x_a = x_b ⊕ (z ⊕ e)^-1.
+      Mat3 d_x, d_e;
+      if (forward) {
+        composeJacobians(f.lin_a, f.z, &d_x, nullptr);
+        composeJacobians(compose(f.lin_a, f.z), Vec3::Zero(), nullptr, &d_e);
+      } else {
+        Mat3 d_inv, d_z;
+        composeJacobians(f.lin_b, inverse(f.z), &d_x, &d_inv);
+        composeJacobians(f.z, Vec3::Zero(), nullptr, &d_z);
+        d_e = d_inv * inverseJacobian(f.z) * d_z;
       }
+      const PathBound nv{d_x * bu.phi, d_x * bu.cov * d_x.transpose() + d_e * f.weight.inverse() * d_e.transpose()};
+      const double spread = nv.cov(0, 0) + nv.cov(1, 1);
+      const auto known = anchor_paths_.find(v);
+      if (known != anchor_paths_.end() && known->second.cov(0, 0) + known->second.cov(1, 1) <= spread) continue;
+      anchor_paths_[v] = nv;
+      anchor_open_.push({spread, v, e.links + 1});
     }
   }
+  // Settled, or the best path found before the search ran out (a bound all the same).
   const auto it = anchor_paths_.find(p);
   return it == anchor_paths_.end() ? nullptr : &it->second;
 }

@@ -18,8 +18,11 @@
 // the first linearisation's error.
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <memory>
+#include <queue>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "urbanslam/esdf/EnvelopeCholesky.h"
@@ -270,6 +273,13 @@ class Esdf {
   size_t anchor_factors_ = 0;       // factors_.size() when anchor_ was looked for ...
   int anchor_base_ = -1;            // ... and chain_base_ then
   std::unordered_map<int, PathBound> anchor_paths_;  // from anchor_paths_from_, within the factored poses
+  struct PathEntry {
+    double spread;
+    int pose, links;
+    bool operator>(const PathEntry& o) const { return spread > o.spread; }
+  };
+  std::priority_queue<PathEntry, std::vector<PathEntry>, std::greater<PathEntry>> anchor_open_;  // the path search, resumed
+  std::unordered_set<int> anchor_settled_;                                                      // when a pose is asked
   int anchor_paths_from_ = -1, anchor_paths_base_ = -1;
   std::vector<std::vector<int>> factors_of_pose_;  // the factors touching each pose (anchorPath's graph) ...
   size_t factors_indexed_ = 0;                     // ... for factors_[0, this)
