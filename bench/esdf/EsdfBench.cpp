@@ -251,17 +251,42 @@ void runBackend(const std::vector<long>& sizes) {
 
 }  // namespace
 
+namespace {
+constexpr const char* kUsage =
+    "usage: esdf_bench [--no-full-above N] [--ordering amd|metis|auto|natural] [--backend N]...\n"
+    "                  [--final-passes P] [--min-gap F] [--incremental-passes P] [--heading-recovery RAD]\n"
+    "                  [--heading-steps N] [--no-headings-first] SIZE...\n"
+    "       esdf_bench --write-graph N PREFIX\n"
+    "The ESDF's per-step cost against the length of a synthetic city-grid drive (default sizes\n"
+    "1000 10000 100000 1000000); --backend N also runs the pose-graph back end on a drive of N poses.\n";
+
+// A drive length: a whole number of at least 100 poses (the runs look 50 poses back), else exit 2.
+long poses(const char* text, const char* what) {
+  char* end = nullptr;
+  const long n = std::strtol(text, &end, 10);
+  if (end == text || *end != '\0' || n < 100) {
+    std::fprintf(stderr, "esdf_bench: %s '%s' is not a number of poses of at least 100\n%s", what, text, kUsage);
+    std::exit(2);
+  }
+  return n;
+}
+}  // namespace
+
 int main(int argc, char** argv) {
   std::vector<long> sizes, backend_sizes;
   long no_full_above = 100000000;
   for (int a = 1; a < argc; ++a) {
+    if (!std::strcmp(argv[a], "--help") || !std::strcmp(argv[a], "-h")) {
+      std::printf("%s", kUsage);
+      return 0;
+    }
     if (!std::strcmp(argv[a], "--no-full-above") && a + 1 < argc)
       no_full_above = std::atol(argv[++a]);
     else if (!std::strcmp(argv[a], "--write-graph") && a + 2 < argc) {
-      writeGraph(std::atol(argv[a + 1]), argv[a + 2]);
+      writeGraph(poses(argv[a + 1], "--write-graph"), argv[a + 2]);
       return 0;
     } else if (!std::strcmp(argv[a], "--backend") && a + 1 < argc)
-      backend_sizes.push_back(std::atol(argv[++a]));
+      backend_sizes.push_back(poses(argv[++a], "--backend"));
     else if (!std::strcmp(argv[a], "--final-passes") && a + 1 < argc)
       g_final_passes = std::atoi(argv[++a]);
     else if (!std::strcmp(argv[a], "--min-gap") && a + 1 < argc)
@@ -280,8 +305,12 @@ int main(int argc, char** argv) {
                    : o == "auto"    ? esdf::FillReducingOrdering::Auto
                    : o == "natural" ? esdf::FillReducingOrdering::Natural
                                     : esdf::FillReducingOrdering::Amd;
-    } else
-      sizes.push_back(std::atol(argv[a]));
+    } else if (argv[a][0] == '-') {
+      std::fprintf(stderr, "esdf_bench: unknown option or missing value: %s\n%s", argv[a], kUsage);
+      return 2;
+    } else {
+      sizes.push_back(poses(argv[a], "size"));
+    }
   }
   if (sizes.empty() && backend_sizes.empty()) sizes = {1000, 10000, 100000, 1000000};
   std::printf("%9s %8s | %8s %8s %9s | %8s %8s %9s | %9s | %10s %12s %10s %10s %10s\n", "poses", "closures", "aug_p50", "aug_p99",
