@@ -216,10 +216,11 @@ int main(int argc, char** argv) {
     else if (k == "--bearing-sigma-deg")
       args.bearing_sigma_deg = std::stod(val());
     else {
-      std::cerr << "usage: alignment_bench [--data DIR] [--pairs N] [--seed S] [--methods a,b] "
-                   "[--datasets a,b] [--range-sigma M] [--gate-initial M] [--crf name=value ...] [--bearing-sigma-deg D] [--no-covariance] "
-                   "[--verbose] [--json OUT]\n";
-      return 2;
+      const bool help = k == "--help" || k == "-h";
+      (help ? std::cout : std::cerr) << "usage: alignment_bench [--data DIR] [--pairs N] [--seed S] [--methods a,b] "
+                                        "[--datasets a,b] [--range-sigma M] [--gate-initial M] [--crf name=value ...] [--bearing-sigma-deg D] [--no-covariance] "
+                                        "[--verbose] [--json OUT]\n";
+      return help ? 0 : 2;
     }
   }
   std::mt19937 rng(args.seed);

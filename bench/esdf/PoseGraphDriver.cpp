@@ -21,10 +21,25 @@
 
 using namespace urbanslam;
 
+namespace {
+constexpr const char* kUsage =
+    "usage: esdf_pose_graph [--every N] [--innov CHI2] [--window W] [--passes P] [--no-relin] [--gate]\n"
+    "                       [--metis | --auto] [--conservative] [--gap F] [--heading RAD] [--heading-steps N]\n"
+    "                       [--no-headings-first] FILE...\n"
+    "       esdf_pose_graph --eval EDGES_FILE POSES_FILE\n"
+    "       esdf_pose_graph --init IN OUT\n"
+    "       esdf_pose_graph --error REFERENCE ESTIMATE\n"
+    "Runs the ESDF back end on pose-graph files and prints one line per file (chi2, time, recoveries).\n";
+}  // namespace
+
 int main(int argc, char** argv) {
   esdf::PoseGraphBackendOptions o;
   int rc = 0;
   for (int a = 1; a < argc; ++a) {
+    if (!std::strcmp(argv[a], "--help") || !std::strcmp(argv[a], "-h")) {
+      std::printf("%s", kUsage);
+      return 0;
+    }
     auto next = [&]() { return a + 1 < argc ? argv[++a] : (std::fprintf(stderr, "missing value\n"), std::exit(2), ""); };
     if (!std::strcmp(argv[a], "--eval") && a + 2 < argc) {
       const esdf::PoseGraph edges = esdf::readPoseGraph(argv[a + 1]);
@@ -84,6 +99,9 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[a], "--no-headings-first")) {
       o.reinitialise_from_headings = false;
       o.filter.commit_heading_branch = false;
+    } else if (argv[a][0] == '-') {
+      std::fprintf(stderr, "esdf_pose_graph: unknown option or missing values: %s\n%s", argv[a], kUsage);
+      return 2;
     } else {
       try {
         common::Stopwatch sw;
@@ -98,7 +116,7 @@ int main(int argc, char** argv) {
             common::percentile(r.step_ms, 50), common::percentile(r.step_ms, 99));
       } catch (const std::exception& e) {
         std::fprintf(stderr, "%s: %s\n", argv[a], e.what());
-        rc = 1;
+        rc = 2;  // a file that cannot be read as a pose graph; the others still run
       }
     }
   }

@@ -61,6 +61,12 @@ double cpuSeconds() {
 int main(int argc, char** argv) {
   urbanslam::common::keepFreedBuffers();  // as the urbanslam command does
   std::string city, log, ini = std::string(URBANSLAM_SOURCE_DIR) + "/ini/default.ini", out;
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
+      std::cout << "usage: scale_bench (--city CITY_INI | --log LOG) [--ini PIPELINE_INI] --out DIR\n"
+                   "The pipeline on a simulated city streamed from the simulator, or on a log; prints one JSON line.\n";
+      return 0;
+    }
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
     if (a == "--city")
