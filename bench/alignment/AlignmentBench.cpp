@@ -217,9 +217,10 @@ int main(int argc, char** argv) {
       args.bearing_sigma_deg = std::stod(val());
     else {
       const bool help = k == "--help" || k == "-h";
-      (help ? std::cout : std::cerr) << "usage: alignment_bench [--data DIR] [--pairs N] [--seed S] [--methods a,b] "
-                                        "[--datasets a,b] [--range-sigma M] [--gate-initial M] [--crf name=value ...] [--bearing-sigma-deg D] [--no-covariance] "
-                                        "[--verbose] [--json OUT]\n";
+      (help ? std::cout : std::cerr)
+          << "usage: alignment_bench [--data DIR] [--pairs N] [--seed S] [--methods a,b] "
+             "[--datasets a,b] [--range-sigma M] [--gate-initial M] [--crf name=value ...] [--bearing-sigma-deg D] [--no-covariance] "
+             "[--verbose] [--json OUT]\n";
       return help ? 0 : 2;
     }
   }
