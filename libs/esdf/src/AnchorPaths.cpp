@@ -1,5 +1,6 @@
 // Conservative covariances through the newest closure (Esdf::conservativeJoint): how a factored
-// pose is reached from the closure's factored end by the factors alone on the path between them.
+// pose is reached from the closure's factored end by the factors alone on the path between them,
+// and how one relative factor carries a pose and its noise to the pose at its other end.
 #include <Eigen/LU>
 
 #include "urbanslam/esdf/Esdf.h"
@@ -15,6 +16,20 @@ void Esdf::indexFactors() {
     factors_of_pose_[static_cast<size_t>(f.a)].push_back(static_cast<int>(factors_indexed_));
     factors_of_pose_[static_cast<size_t>(f.b)].push_back(static_cast<int>(factors_indexed_));
   }
+}
+
+void Esdf::factorStep(const Factor& f, bool from_a, Mat3* d_x, Mat3* d_e) {
+  // x_b = x_a ⊕ z ⊕ e, e ~ N(0, weight^-1) (the error ⊖z ⊕ (⊖x_a ⊕ x_b)), linearised where the
+  // factor is; from b, x_a = x_b ⊕ (z ⊕ e)^-1.
+  if (from_a) {
+    composeJacobians(f.lin_a, f.z, d_x, nullptr);
+    composeJacobians(compose(f.lin_a, f.z), Vec3::Zero(), nullptr, d_e);
+    return;
+  }
+  Mat3 d_inv, d_z;
+  composeJacobians(f.lin_b, inverse(f.z), d_x, &d_inv);
+  composeJacobians(f.z, Vec3::Zero(), nullptr, &d_z);
+  *d_e = d_inv * inverseJacobian(f.z) * d_z;
 }
 
 const Esdf::PathBound* Esdf::anchorPath(int p) {
@@ -42,18 +57,8 @@ const Esdf::PathBound* Esdf::anchorPath(int p) {
       const bool forward = f.a == e.pose;
       const int v = forward ? f.b : f.a;
       if (v >= m || anchor_settled_.count(v)) continue;
-      // x_b = x_a ⊕ z ⊕ e, e ~ N(0, weight^-1), linearised where the factor is; from b,
-      // x_a = x_b ⊕ (z ⊕ e)^-1.
       Mat3 d_x, d_e;
-      if (forward) {
-        composeJacobians(f.lin_a, f.z, &d_x, nullptr);
-        composeJacobians(compose(f.lin_a, f.z), Vec3::Zero(), nullptr, &d_e);
-      } else {
-        Mat3 d_inv, d_z;
-        composeJacobians(f.lin_b, inverse(f.z), &d_x, &d_inv);
-        composeJacobians(f.z, Vec3::Zero(), nullptr, &d_z);
-        d_e = d_inv * inverseJacobian(f.z) * d_z;
-      }
+      factorStep(f, forward, &d_x, &d_e);
       const PathBound nv{d_x * bu.phi, d_x * bu.cov * d_x.transpose() + d_e * f.weight.inverse() * d_e.transpose()};
       const double spread = nv.cov(0, 0) + nv.cov(1, 1);
       const auto known = anchor_paths_.find(v);

@@ -500,11 +500,8 @@ const Esdf::ChainAnchor& Esdf::chainAnchor() {
     if (std::max(f.a, f.b) < m) break;
     // (b = a + 1 from a = m - 1 is the chain's own first link.)
     if (f.kind != Factor::Kind::Relative || f.a >= m || f.b < m || f.b == f.a + 1) continue;
-    // x_b = x_a ⊕ z ⊕ e with e ~ N(0, weight^-1) (the error ⊖z⊕(⊖x_a⊕x_b)), linearised where the
-    // factor is.
     Mat3 d_a, d_e;
-    composeJacobians(f.lin_a, f.z, &d_a, nullptr);
-    composeJacobians(compose(f.lin_a, f.z), Vec3::Zero(), nullptr, &d_e);
+    factorStep(f, true, &d_a, &d_e);
     anchor_.a = f.a;
     anchor_.b = f.b;
     anchor_.phi = d_a;

@@ -239,8 +239,8 @@ class Esdf {
   // A factored pose p as reached from the anchor's factored end a through the factors alone on
   // the path between them (AnchorPaths.cpp): x_p = phi x_a + w, Cov w = cov. The relative pose
   // of p and a chain pose through that path and the closure bounds the exact one (a subset of
-  // the factors holds less information), with no solve over the map. nullptr: p lies more than
-  // kAnchorPathLinks factors from a.
+  // the factors holds less information), with no solve over the map. nullptr: no path of at most
+  // kAnchorPathLinks factors reached p before the search settled kAnchorPathPoses poses.
   struct PathBound {
     Mat3 phi = Mat3::Identity();
     Mat3 cov = Mat3::Zero();
@@ -248,6 +248,9 @@ class Esdf {
   static constexpr int kAnchorPathLinks = 64;
   static constexpr size_t kAnchorPathPoses = 4096;  // the path search settles at most this many poses
   const PathBound* anchorPath(int p);
+  // A relative factor from its end a (from_a) or b to the other: d_x the Jacobian of the other
+  // pose in this one, d_e in the factor's noise (AnchorPaths.cpp).
+  static void factorStep(const Factor& f, bool from_a, Mat3* d_x, Mat3* d_e);
   void indexFactors();
   void markChanged() { ++values_stamp_; }
 
