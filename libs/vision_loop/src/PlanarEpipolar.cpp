@@ -1,7 +1,9 @@
 #include "urbanslam/vision_loop/PlanarEpipolar.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace urbanslam::vision_loop {
 
@@ -145,6 +147,30 @@ PlanarEpipolarFit fitPlanarEpipolar(const std::vector<Eigen::Vector2d>& a, const
   fit.cov = sigma * sigma * lu.inverse();
   fit.converged = fit.cov.allFinite();
   return fit;
+}
+
+double sceneDepthPerBaseline(const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b, double bearing_rad,
+                             double heading_rad) {
+  const size_t n = std::min(a.size(), b.size());
+  if (n == 0) return std::numeric_limits<double>::infinity();
+  // X_a = λ_a d_a = c + λ_b R' d_b (X_b = R (X_a - c)): two unknowns, three equations.
+  const Eigen::Vector3d c(-std::sin(bearing_rad), 0, std::cos(bearing_rad));
+  const Eigen::Matrix3d rt = rotationY(heading_rad).transpose();
+  std::vector<double> depth(n);
+  for (size_t i = 0; i < n; ++i) {
+    Eigen::Matrix<double, 3, 2> m;
+    m.col(0) = homogeneous(a[i]);
+    m.col(1) = -(rt * homogeneous(b[i]));
+    const Eigen::Matrix2d normal = m.transpose() * m;
+    const double det = normal.determinant();
+    depth[i] = std::numeric_limits<double>::infinity();
+    // Parallel rays (no parallax) meet nowhere: the scene point is as far as the baseline allows.
+    if (!(det > 1e-12 * normal.trace() * normal.trace())) continue;
+    const Eigen::Vector2d lambda = normal.inverse() * (m.transpose() * c);
+    if (lambda(0) > 0 && lambda(1) > 0) depth[i] = lambda(0);  // z of λ_a d_a: d_a's z is 1
+  }
+  std::nth_element(depth.begin(), depth.begin() + static_cast<long>(n / 4), depth.end());
+  return depth[n / 4];
 }
 
 }  // namespace urbanslam::vision_loop

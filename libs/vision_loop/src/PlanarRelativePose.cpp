@@ -74,6 +74,7 @@ PlanarRelativePose planarRelativePose(const std::vector<cv::Point2f>& a, const s
   x = Eigen::Vector2d(fit.bearing_rad, fit.heading_rad);
   r.bearing_rad = x(0);
   r.heading_rad = x(1);
+  r.depth_per_baseline = sceneDepthPerBaseline(na, nb, x(0), x(1));
   if (o.covariance == PoseCovariance::FirstOrder) {
     r.cov = fit.cov;
     r.valid = true;

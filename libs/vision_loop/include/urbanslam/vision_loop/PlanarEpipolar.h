@@ -43,4 +43,14 @@ struct PlanarEpipolarFit {
 PlanarEpipolarFit fitPlanarEpipolar(const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b, double bearing_rad,
                                     double heading_rad, double min_sigma = 0, int max_iterations = 50);
 
+// How far the scene the two images share lies, per metre between the cameras: the lower quartile,
+// over the correspondences, of the depth along camera a's optical axis at which the two rays meet
+// (least squares) for a unit baseline along (β, θ). A monocular pair fixes the scene only up to
+// the baseline's length, so the depth at a baseline b is b times this. The nearer points have
+// the most parallax: an error of the heading (which trades off against the bearing in the
+// epipolar constraint) moves their depths least. A correspondence whose rays meet behind either
+// camera, or do not converge, counts as infinitely far; infinity for no correspondence.
+double sceneDepthPerBaseline(const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b, double bearing_rad,
+                             double heading_rad);
+
 }  // namespace urbanslam::vision_loop

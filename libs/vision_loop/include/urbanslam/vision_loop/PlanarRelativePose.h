@@ -15,6 +15,7 @@
 // points give a wide spread), and, as RANSAC runs again, a facade pattern that offers two
 // consistent sets of matches. (The fit's own first-order covariance is consistent on Gaussian
 // pixel noise but not there: PlanarEpipolarTest, bench/camera/RESULTS.md.)
+#include <limits>
 #include <string>
 
 #include <Eigen/Core>
@@ -51,6 +52,9 @@ struct PlanarRelativePose {
   double bearing_rad = 0;  // direction of camera b's position in camera a's frame (x forward, y left, counter-clockwise)
   double heading_rad = 0;  // heading of camera b minus heading of camera a (counter-clockwise)
   Eigen::Matrix2d cov = Eigen::Matrix2d::Identity();  // of (bearing, heading)
+  // The inliers' depth in camera a per metre of baseline (their lower quartile: PlanarEpipolar.h,
+  // sceneDepthPerBaseline): the same images taken b metres apart show a scene b times this deep.
+  double depth_per_baseline = std::numeric_limits<double>::infinity();
   int matches = 0, inliers = 0;
 };
 
