@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "urbanslam/esdf/PoseOps.h"
@@ -62,6 +63,26 @@ TEST(CameraFactor, WeighsTheCameraBearingAndHeadingNotTheRange) {
     const Vec3 xj_r = vehicleAt(Vec3((range + 1) * std::cos(bearing), (range + 1) * std::sin(bearing), c.z()));
     EXPECT_LT(chi2(f, xi, xj_r), 1e-4);
   }
+}
+
+// The scene's depth at the nearest the estimate lets the cameras be: the cameras' distance (not
+// the vehicles': a side camera 1 m ahead of the origin of vehicles facing opposite ways) less
+// three sigma of the relative position's worst direction, times the images' depth per metre.
+TEST(CameraFactor, NearestSceneDepthIsTheClosestBaselineTheEstimateAllowsTimesTheImagesDepth) {
+  CameraMeasurement m;
+  m.mount = common::Pose2{1.0, 0.0, M_PI / 2};
+  m.relative.valid = true;
+  m.relative.depth_per_baseline = 4.0;                                 // a facade 40 m away from cameras 10 m apart
+  const Vec3 xi(0, 0, 0), xj(30, 0, M_PI);                             // cameras at (1, 0) and (29, 0): 28 m apart
+  Eigen::Matrix3d cov = Eigen::Vector3d(4.0, 1.0, 0.01).asDiagonal();  // 2 m along x, 1 m along y
+  EXPECT_NEAR(nearestSceneDepth(m, xi, xj, cov), (28.0 - 3 * 2.0) * 4.0, 1e-9);
+  cov(0, 0) = 1.0;
+  cov(1, 1) = 9.0;  // the worst direction, whichever it is
+  EXPECT_NEAR(nearestSceneDepth(m, xi, xj, cov), (28.0 - 3 * 3.0) * 4.0, 1e-9);
+  // An estimate that lets them coincide says nothing, even of a scene at infinity.
+  cov(1, 1) = 100.0;
+  m.relative.depth_per_baseline = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(nearestSceneDepth(m, xi, xj, cov), 0.0);
 }
 
 TEST(CameraFactor, PinholeOfADownscaledImageProjectsTheSameRays) {

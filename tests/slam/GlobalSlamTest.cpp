@@ -78,3 +78,32 @@ TEST(GlobalSlam, AClosureAwaitingConfirmationMakesTheNextKeyframesSearchFarFromT
   for (size_t k : {201, 202, 203}) EXPECT_TRUE(!none.count(k) || none.at(k).empty()) << k;
   EXPECT_EQ(other->stats.closures_accepted, 0u);
 }
+
+// A camera-only proposal whose images, at the distance the estimate puts between the cameras,
+// would show a scene beyond max_scene_depth_m is refused before the gate (a copy of a facade 200
+// m further along the street), and the same images between keyframes 5 m apart are not.
+TEST(GlobalSlam, ACameraClosureWhoseSceneWouldLieBeyondTheCamerasReachIsRefused) {
+  ::Run r;
+  r.options.loop_closure.max_scene_depth_m = 150;
+  r.options.loop_closure.confirm_window = 0;
+  r.global = std::make_unique<slam::GlobalSlam>(r.options, r.map, r.stats, r.observers);
+  slam::KeyframeConstraint c;
+  c.z = {1.0, 0, 0};
+  c.cov = Eigen::Vector3d(1e-4, 1e-4, 1e-6).asDiagonal();  // 1 cm per metre: 0.14 m after 200 m
+  for (size_t k = 0; k <= 205; ++k) r.global->addKeyframe({k, static_cast<double>(k), {}, false, true, {}}, io::CompactScan(), c);
+  slam::CameraMeasurement m;
+  m.mount = common::Pose2{1.0, 0.0, M_PI / 2};  // looking left; the vehicle drives along x
+  m.relative.valid = true;
+  m.relative.bearing_rad = -M_PI / 2;  // camera b to the right of camera a's view: ahead along x
+  m.relative.heading_rad = 0;
+  m.relative.cov = Eigen::Vector2d(1e-4, 1e-4).asDiagonal();
+  m.relative.depth_per_baseline = 2.0;                                                // a facade 10 m away seen from 5 m apart
+  r.global->proposeImageClosure(5, 205, 1.0, m, std::chrono::steady_clock::now());    // 200 m: 400 m deep
+  r.global->proposeImageClosure(200, 205, 1.0, m, std::chrono::steady_clock::now());  // 5 m: 10 m deep
+  const auto& closures = r.global->closures();
+  ASSERT_EQ(closures.size(), 2u);
+  EXPECT_EQ(closures[0].reason, slam::ClosureReason::SceneDepth);
+  EXPECT_FALSE(closures[0].accepted);
+  EXPECT_NE(closures[1].reason, slam::ClosureReason::SceneDepth);
+  EXPECT_TRUE(closures[1].accepted) << slam::reasonName(closures[1].reason);
+}

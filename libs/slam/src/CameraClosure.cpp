@@ -1,6 +1,8 @@
 #include "urbanslam/slam/CameraClosure.h"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 
 #include "urbanslam/esdf/PoseOps.h"
@@ -41,6 +43,16 @@ esdf::RelativeFactor cameraFactor(const CameraMeasurement& m, const esdf::Vec3& 
   f.omega = inv.transpose() * fc.omega * inv;
   f.omega = 0.5 * (f.omega + f.omega.transpose());
   return f;
+}
+
+double nearestSceneDepth(const CameraMeasurement& m, const esdf::Vec3& x_i, const esdf::Vec3& x_j, const Eigen::Matrix3d& relative_cov) {
+  const esdf::Vec3 mount = esdf::toVec(m.mount);
+  const esdf::Vec3 c = esdf::between(esdf::compose(x_i, mount), esdf::compose(x_j, mount));
+  // The cameras' relative position spreads as the vehicles' does (the mount is rigid; the
+  // heading's share, the mount's lever arm times its sigma, is centimetres against metres).
+  const double sigma = std::sqrt(std::max(0.0, relative_cov.topLeftCorner<2, 2>().eigenvalues().real().maxCoeff()));
+  const double baseline = std::hypot(c.x(), c.y()) - 3 * sigma;
+  return baseline > 0 ? baseline * m.relative.depth_per_baseline : 0.0;
 }
 
 }  // namespace urbanslam::slam

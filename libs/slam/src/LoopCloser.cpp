@@ -49,6 +49,8 @@ const char* reasonName(ClosureReason reason) {
       return "no_overlap";
     case ClosureReason::Submaps:
       return "submaps";
+    case ClosureReason::SceneDepth:
+      return "scene_depth";
   }
   return "";
 }

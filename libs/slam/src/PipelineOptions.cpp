@@ -126,6 +126,9 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
         "free-space test: a beam without a return (or beyond max_range_m) saw free space this far; 0: says nothing");
   s.add("free_space_margin_m", o.loop_closure.free_space_margin_m, 0.0, 10.0, "m",
         "a point is in the other scan's free space when this much (+5 % of the range) in front of where its beam ended");
+  s.add("max_scene_depth_m", o.loop_closure.max_scene_depth_m, 1.0, 1e6, "m",
+        "a closure measured by the camera alone is refused when the scene its two images share would lie farther than this, the "
+        "cameras as close as the estimate allows (3 sigma)");
   s.add("min_constraint_ratio", o.loop_closure.min_constraint_ratio, 0.0, 1.0, "",
         "alignment accepted only when its weakest translation direction has this share of the strongest's information (corridors slide)");
   s.add("covariance_scale", o.loop_closure.covariance_scale, 0.1, 1000.0, "", "inflation of the alignment covariance");

@@ -28,4 +28,11 @@ vision_loop::PinholeCamera pinholeFor(const io::CameraCalibration& c, int image_
 // camera-frame error moved by the mount's adjoint (exact to first order in the error).
 esdf::RelativeFactor cameraFactor(const CameraMeasurement& m, const esdf::Vec3& x_i, const esdf::Vec3& x_j);
 
+// The nearest the scene both images show can lie, by the estimate: the distance between the two
+// cameras (x_i ⊕ mount, x_j ⊕ mount) less three standard deviations of the relative position
+// (`relative_cov`, of ⊖x_i ⊕ x_j; its worst direction), at least 0, times the depth per metre of
+// baseline that the images give (PlanarRelativePose::depth_per_baseline). 0 when the estimate
+// allows the cameras to coincide.
+double nearestSceneDepth(const CameraMeasurement& m, const esdf::Vec3& x_i, const esdf::Vec3& x_j, const Eigen::Matrix3d& relative_cov);
+
 }  // namespace urbanslam::slam

@@ -41,6 +41,7 @@ enum class ClosureReason {
   LoopClosureDisabled,  // an image proposal with [loop_closure] enabled = false
   NoOverlap,            // nowhere the gate admits could the scans share min_matched_fraction (not aligned)
   Submaps,              // the two visits' path submaps have another alignment nearly as good (a repeated street)
+  SceneDepth,           // camera alone: at the estimated distance the shared scene would lie beyond max_scene_depth_m
 };
 // Its name in loop_closures.csv and in observer events ("" for None).
 const char* reasonName(ClosureReason reason);

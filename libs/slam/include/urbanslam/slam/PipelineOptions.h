@@ -120,6 +120,14 @@ struct LoopClosureOptions {
   double submap_check_path_m = 30;
   double free_space_margin_m = 0.3;   // a point conflicts this far (+5 % of the range) inside free space
   double free_space_no_return_m = 0;  // a beam without a return saw free space this far (0: unknown)
+  // A closure measured by the camera alone (no scans) is refused when the scene its two images
+  // share would lie farther than this at the shortest distance between the cameras that the
+  // estimate allows (3 sigma): two copies of a facade design far apart along a street look like
+  // one facade seen from two nearby places, and only the distance tells them apart. The depth is
+  // the lower quartile of the matched features' (the near facades of a street, 10-25 m in the
+  // simulated cities); the bound leaves a factor of two for that depth's own error, where copies
+  // 55-240 m apart would put their scenes 85 m and farther away (bench/camera/RESULTS.md).
+  double max_scene_depth_m = 60;
   double covariance_scale = 4.0;
   double chi2_gate_probability = 0.99;  // innovation gate (3 dof); 0.99 measured better than 0.999 on Intel
   // A closure goes into the filter only once a second one, within this many keyframes, agrees
