@@ -4,8 +4,11 @@
 # ATE against the simulator's truth, as metres and as a share of the distance driven, the
 # closures accepted and how many of them join two views of the same place (true positions
 # within 25 m: a camera closure measures bearing and heading, so `eval`'s whole-pose check,
-# `eval_false`, does not apply to it; a laser closure may join scans further apart), and the
-# real-time factor. AREA_KM2 and ROUTE_KM give both runs another city size and drive length
+# `eval_false`, does not apply to it; a laser closure may join scans further apart), the false
+# ones by what each sensor measures (`false`: for the camera, accepted image closures at another
+# place or whose bearing, times the true distance between the cameras, or heading disagrees with
+# the truth's by more than 0.5 m or 5°, the camera mount read from the city ini; for the laser,
+# `eval_false`), and the real-time factor. AREA_KM2 and ROUTE_KM give both runs another city size and drive length
 # (default: the inis' own, 1 km² and 3 km).
 #
 #   bash bench/camera/run_camera.sh [BUILD_DIR] [OUT_DIR]
@@ -16,7 +19,7 @@ OUT=${2:-out/bench-camera}
 U=$BUILD/apps/urbanslam/urbanslam
 [[ -x $U ]] || { echo "missing $U (build first)" >&2; exit 2; }
 mkdir -p "$OUT"
-printf '%-8s %9s %10s %8s %7s %9s %10s %10s %6s\n' run keyframes driven_m ate_m ate_pct accepted same_place eval_false rtf
+printf '%-8s %9s %10s %8s %7s %9s %10s %6s %10s %6s\n' run keyframes driven_m ate_m ate_pct accepted same_place false eval_false rtf
 for spec in camera:ini/city-camera.ini laser:ini/city-1km2.ini; do
   name=${spec%%:*}
   ini=${spec#*:}
@@ -26,9 +29,9 @@ for spec in camera:ini/city-camera.ini laser:ini/city-1km2.ini; do
   fi
   "$U" run --simulate "$ini" --out "$OUT/$name" --quiet --json > "$OUT/$name.json"
   "$U" eval "$OUT/$name" --reference "$OUT/$name/reference.tum" --json > "$OUT/$name.eval.json"
-  python3 - "$OUT/$name" "$name" <<'PY'
+  python3 - "$OUT/$name" "$name" "$ini" <<'PY'
 import csv, json, math, sys
-run, name = sys.argv[1], sys.argv[2]
+run, name, city_ini = sys.argv[1], sys.argv[2], sys.argv[3]
 stats = json.load(open(run + '.json'))
 ev = json.load(open(run + '.eval.json'))
 ref = {}
@@ -37,13 +40,44 @@ for l in open(run + '/reference.tum'):
     v = l.split(); ref[round(float(v[0]), 6)] = (float(v[1]), float(v[2]))
 pts = [ref[k] for k in sorted(ref)]
 driven = sum(math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in zip(pts, pts[1:]))
-accepted = same = 0
+# The camera on the vehicle ([camera] x_m, y_m, yaw_deg of the city ini).
+mount, section = [0.0, 0.0, 0.0], None
+for line in open(city_ini):
+    line = line.split(';')[0].strip()
+    if line.startswith('['):
+        section = line
+    elif section == '[camera]' and '=' in line:
+        key, value = (t.strip() for t in line.split('=', 1))
+        if key in ('x_m', 'y_m', 'yaw_deg'):
+            mount[('x_m', 'y_m', 'yaw_deg').index(key)] = float(value) if key != 'yaw_deg' else math.radians(float(value))
+def compose(a, b):
+    c, s = math.cos(a[2]), math.sin(a[2])
+    return (a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], a[2] + b[2])
+def inverse(a):
+    c, s = math.cos(a[2]), math.sin(a[2])
+    return (-c * a[0] - s * a[1], s * a[0] - c * a[1], -a[2])
+def wrap(x):
+    return math.atan2(math.sin(x), math.cos(x))
+heading = {}
+for l in open(run + '/reference.tum'):
+    if l.startswith('#') or not l.strip(): continue
+    v = [float(t) for t in l.split()]; heading[round(v[0], 6)] = 2 * math.atan2(v[6], v[7])
+accepted = same = camera_false = 0
 for r in csv.DictReader(open(run + '/loop_closures.csv')):
     if r['accepted'] != '1': continue
     accepted += 1
-    a, b = ref.get(round(float(r['from_time']), 6)), ref.get(round(float(r['to_time']), 6))
-    same += a is not None and b is not None and math.hypot(a[0] - b[0], a[1] - b[1]) < 25
-print('%-8s %9d %10.0f %8.2f %6.2f%% %9d %10d %10d %6.1f' % (name, stats['counts']['keyframes'], driven, ev['ate_rmse_m'],
-      100 * ev['ate_rmse_m'] / driven, accepted, same, ev['loops_false'], stats['timing']['real_time_factor']))
+    ta, tb = round(float(r['from_time']), 6), round(float(r['to_time']), 6)
+    a, b = ref.get(ta), ref.get(tb)
+    here = a is not None and b is not None and math.hypot(a[0] - b[0], a[1] - b[1]) < 25
+    same += here
+    if r['detector'] != 'image' or a is None or b is None: continue
+    # What the camera measures: the bearing of camera j from camera i and the heading change.
+    truth = compose(inverse(compose((a[0], a[1], heading[ta]), mount)), compose((b[0], b[1], heading[tb]), mount))
+    seen = compose(compose(inverse(mount), (float(r['x']), float(r['y']), float(r['phi']))), mount)
+    lateral = math.hypot(truth[0], truth[1]) * abs(math.sin(math.atan2(seen[1], seen[0]) - math.atan2(truth[1], truth[0])))
+    camera_false += not here or lateral > 0.5 or abs(wrap(seen[2] - truth[2])) > math.radians(5)
+false = camera_false if name == 'camera' else ev['loops_false']
+print('%-8s %9d %10.0f %8.2f %6.2f%% %9d %10d %6d %10d %6.1f' % (name, stats['counts']['keyframes'], driven, ev['ate_rmse_m'],
+      100 * ev['ate_rmse_m'] / driven, accepted, same, false, ev['loops_false'], stats['timing']['real_time_factor']))
 PY
 done
