@@ -201,3 +201,31 @@ TEST(PlanarRelativePose, EveryCovarianceMethodGivesThePlanarFitAndTheBootstrapSp
     EXPECT_LT(r, 1.6);
   }
 }
+
+// The floors add their variances to the covariance of every method, and nothing to the pose.
+TEST(PlanarRelativePose, FloorsAddTheirVariancesToEveryMethodsCovariance) {
+  std::mt19937 rng(4);
+  const PinholeCamera k;
+  const Pair p = project(1.5, 0.1, 2.0, 80, 1.0 / k.fx, rng);
+  std::vector<cv::Point2f> a, b;
+  for (size_t i = 0; i < p.a.size(); ++i) {
+    a.emplace_back(static_cast<float>(k.cx + k.fx * p.a[i].x()), static_cast<float>(k.cy + k.fy * p.a[i].y()));
+    b.emplace_back(static_cast<float>(k.cx + k.fx * p.b[i].x()), static_cast<float>(k.cy + k.fy * p.b[i].y()));
+  }
+  for (const PoseCovariance method : {PoseCovariance::FirstOrder, PoseCovariance::PlanarBootstrap, PoseCovariance::FivePointBootstrap}) {
+    PlanarRelativePoseOptions o;
+    o.ransac_threshold_px = 3;
+    o.covariance = method;
+    const PlanarRelativePose plain = planarRelativePose(a, b, k, o);
+    o.floor_bearing_rad = 0.02;
+    o.floor_heading_rad = 0.005;
+    const PlanarRelativePose floored = planarRelativePose(a, b, k, o);
+    ASSERT_TRUE(plain.valid && floored.valid);
+    EXPECT_EQ(floored.bearing_rad, plain.bearing_rad);
+    EXPECT_EQ(floored.heading_rad, plain.heading_rad);
+    const Eigen::Matrix2d added = floored.cov - plain.cov;
+    EXPECT_NEAR(added(0, 0), 0.02 * 0.02, 1e-12);
+    EXPECT_NEAR(added(1, 1), 0.005 * 0.005, 1e-12);
+    EXPECT_NEAR(added(0, 1), 0.0, 1e-12);
+  }
+}

@@ -75,8 +75,10 @@ PlanarRelativePose planarRelativePose(const std::vector<cv::Point2f>& a, const s
   r.bearing_rad = x(0);
   r.heading_rad = x(1);
   r.depth_per_baseline = sceneDepthPerBaseline(na, nb, x(0), x(1));
+  const Eigen::Matrix2d floor =
+      Eigen::Vector2d(o.floor_bearing_rad * o.floor_bearing_rad, o.floor_heading_rad * o.floor_heading_rad).asDiagonal();
   if (o.covariance == PoseCovariance::FirstOrder) {
-    r.cov = fit.cov;
+    r.cov = fit.cov + floor;
     r.valid = true;
     return r;
   }
@@ -130,7 +132,7 @@ PlanarRelativePose planarRelativePose(const std::vector<cv::Point2f>& a, const s
     r.failure_reason = "unstable under resampling";
     return r;
   }
-  r.cov = s / n;
+  r.cov = s / n + floor;
   r.valid = true;
   return r;
 }

@@ -43,6 +43,10 @@ struct PlanarRelativePoseOptions {
   double min_residual_px = 0.1;  // floor on the residuals' robust standard deviation (the planar fit's weights)
   int bootstrap_samples = 40;    // resampled inlier sets for the covariance
   PoseCovariance covariance = PoseCovariance::FivePointBootstrap;
+  // Added to the covariance of every method: the error the residuals do not show (how the
+  // scene's texture and the rendering or lens place the features), one standard deviation each
+  // of bearing and heading, independent of the pair. 0: none.
+  double floor_bearing_rad = 0, floor_heading_rad = 0;
   unsigned seed = 1;  // of the resampling (the result is reproducible)
 };
 
