@@ -70,5 +70,32 @@ TEST(MapAccuracy, LoopRecallCountsRevisitedScansJoinedByAClosure) {
   EXPECT_NEAR(r.recall, 0.75, 1e-12);
 }
 
+TEST(MapAccuracy, RevisitRecallCountsRevisitsOfEnoughPathOnceEach) {
+  // The truth drives along x at 10 m/s from t = 0. Three revisits (scans 0.1 s apart): 100-110 s
+  // (100 m, closed once in its middle), 200-210 s (100 m, its only closure rejected) and 300-303 s
+  // (30 m: too short to count, though unclosed). A gap of more than a second splits a revisit.
+  std::vector<io::StampedPose> path;
+  for (int k = 0; k <= 4000; ++k) path.push_back({0.1 * k, {1.0 * k, 0.0, 0.0}});
+  std::vector<TrueLoop> truth;
+  for (double t0 : {100.0, 200.0, 300.0})
+    for (double t = t0; t <= t0 + (t0 == 300.0 ? 3.0 : 10.0) + 1e-9; t += 0.1) truth.push_back({t - 90.0, t});
+  std::vector<LoopRow> closures(2);
+  closures[0] = {1, 9, 15.0, 105.0, true, {}};
+  closures[1] = {2, 12, 115.0, 205.0, false, {}};
+  const RevisitRecall r = revisitRecall(closures, truth, path, 50.0, 1.0, 2.0);
+  EXPECT_EQ(r.revisits, 2u);
+  EXPECT_EQ(r.closed, 1u);
+  ASSERT_EQ(r.unclosed.size(), 1u);
+  EXPECT_NEAR(r.unclosed[0].t_start, 200.0, 1e-9);
+  EXPECT_NEAR(r.unclosed[0].t_end, 210.0, 1e-9);
+  EXPECT_NEAR(r.unclosed[0].path_m, 100.0, 1.0);  // the truth's samples within the revisit's span
+  // With 25 m enough, the short one counts too (unclosed), and a closure at 301 s closes it.
+  EXPECT_EQ(revisitRecall(closures, truth, path, 25.0).revisits, 3u);
+  closures.push_back({3, 14, 211.0, 301.0, true, {}});
+  const RevisitRecall all = revisitRecall(closures, truth, path, 25.0);
+  EXPECT_EQ(all.closed, 2u);
+  EXPECT_EQ(all.unclosed.size(), 1u);
+}
+
 }  // namespace
 }  // namespace urbanslam::evaluation

@@ -136,7 +136,10 @@ std::vector<TrueLoop> readTrueLoopsCsv(const std::string& path) {
   return out;
 }
 
-LoopRecall loopRecall(const std::vector<LoopRow>& closures, const std::vector<TrueLoop>& truth, double tolerance_s) {
+namespace {
+// Each revisited scan (its time in ms) and whether an accepted closure joins one of its pairs.
+std::unordered_map<long long, bool> closedScans(const std::vector<LoopRow>& closures, const std::vector<TrueLoop>& truth,
+                                                double tolerance_s) {
   // The accepted closures by their later time, to find those near a revisited scan quickly.
   std::vector<std::pair<double, double>> accepted;  // (later time, earlier time)
   for (const auto& c : closures)
@@ -154,6 +157,47 @@ LoopRecall loopRecall(const std::vector<LoopRow>& closures, const std::vector<Tr
         break;
       }
   }
+  return scans;
+}
+}  // namespace
+
+RevisitRecall revisitRecall(const std::vector<LoopRow>& closures, const std::vector<TrueLoop>& truth,
+                            const std::vector<io::StampedPose>& truth_path, double min_path_m, double max_gap_s, double tolerance_s) {
+  const auto scans = closedScans(closures, truth, tolerance_s);
+  std::vector<std::pair<long long, bool>> ordered(scans.begin(), scans.end());
+  std::sort(ordered.begin(), ordered.end());
+  // The path the truth drove between two times.
+  const auto pathBetween = [&](double t0, double t1) {
+    const auto at = [](const io::StampedPose& p, double t) { return p.timestamp < t; };
+    auto it = std::lower_bound(truth_path.begin(), truth_path.end(), t0, at);
+    double length = 0;
+    for (; it != truth_path.end() && std::next(it) != truth_path.end() && std::next(it)->timestamp <= t1; ++it)
+      length += std::hypot(std::next(it)->pose.x - it->pose.x, std::next(it)->pose.y - it->pose.y);
+    return length;
+  };
+  RevisitRecall r;
+  for (size_t i = 0; i < ordered.size();) {
+    Revisit v;
+    v.t_start = v.t_end = 1e-3 * static_cast<double>(ordered[i].first);
+    size_t j = i;
+    for (; j < ordered.size() && 1e-3 * static_cast<double>(ordered[j].first) - v.t_end <= max_gap_s; ++j) {
+      v.t_end = 1e-3 * static_cast<double>(ordered[j].first);
+      v.closed = v.closed || ordered[j].second;
+    }
+    i = j;
+    v.path_m = pathBetween(v.t_start, v.t_end);
+    if (v.path_m < min_path_m) continue;
+    ++r.revisits;
+    if (v.closed)
+      ++r.closed;
+    else
+      r.unclosed.push_back(v);
+  }
+  return r;
+}
+
+LoopRecall loopRecall(const std::vector<LoopRow>& closures, const std::vector<TrueLoop>& truth, double tolerance_s) {
+  const auto scans = closedScans(closures, truth, tolerance_s);
   LoopRecall r;
   r.revisited_scans = scans.size();
   for (const auto& [k, closed] : scans) r.closed_scans += closed ? 1 : 0;

@@ -89,12 +89,28 @@ void evaluateAgainstSimulation(const fs::path& run, const fs::path& sim, const c
   m["beyond_1_m"] = acc.beyond_1_m;
   j["map"] = std::move(m);
   if (fs::exists(run / "loop_closures.csv")) {
-    const auto r = loopRecall(readLoopClosuresCsv((run / "loop_closures.csv").string()), readTrueLoopsCsv((sim / "loops.csv").string()));
+    const auto closures = readLoopClosuresCsv((run / "loop_closures.csv").string());
+    const auto loops = readTrueLoopsCsv((sim / "loops.csv").string());
+    const auto r = loopRecall(closures, loops);
     common::Json l = common::Json::object();
     l["revisited_scans"] = r.revisited_scans;
     l["closed_scans"] = r.closed_scans;
     l["recall"] = r.recall;
     j["loops_recall"] = std::move(l);
+    const auto v = revisitRecall(closures, loops, io::readTum((sim / "truth.tum").string()));
+    common::Json rv = common::Json::object();
+    rv["revisits"] = v.revisits;
+    rv["closed"] = v.closed;
+    common::Json unclosed = common::Json::array();
+    for (const auto& u : v.unclosed) {
+      common::Json e = common::Json::object();
+      e["t_start"] = u.t_start;
+      e["t_end"] = u.t_end;
+      e["path_m"] = u.path_m;
+      unclosed.push(std::move(e));
+    }
+    rv["unclosed"] = std::move(unclosed);
+    j["revisits_50m"] = std::move(rv);
   }
 }
 

@@ -47,4 +47,21 @@ struct LoopRecall {
 struct LoopRow;
 LoopRecall loopRecall(const std::vector<LoopRow>& closures, const std::vector<TrueLoop>& truth, double tolerance_s = 2.0);
 
+// True revisits closed, counted per revisit rather than per scan: the revisited scans (t_new) in
+// runs with no gap over max_gap_s, each as long as the path the truth drove along it
+// (`truth_path`, by time). A revisit of at least min_path_m is closed when an accepted closure
+// joins one of its pairs (as loopRecall). Whatever the drift when it began, a closed revisit was
+// found, by the estimate or by appearance; an unclosed one is a loop the map never tied.
+struct Revisit {
+  double t_start = 0, t_end = 0, path_m = 0;
+  bool closed = false;
+};
+struct RevisitRecall {
+  size_t revisits = 0, closed = 0;
+  std::vector<Revisit> unclosed;
+};
+RevisitRecall revisitRecall(const std::vector<LoopRow>& closures, const std::vector<TrueLoop>& truth,
+                            const std::vector<io::StampedPose>& truth_path, double min_path_m = 50.0, double max_gap_s = 1.0,
+                            double tolerance_s = 2.0);
+
 }  // namespace urbanslam::evaluation
