@@ -40,7 +40,9 @@ int evalCommand(const Argv& args) {
                "    also map (distance of every point of RUN_DIR/map.ply, or without it of the keyframe scans of\n"
                "    map.simplemap, carried by the ATE's alignment, to the nearest true wall of walls.csv: source,\n"
                "    mean, median, p95, within_0_1_m, beyond_1_m)\n"
-               "    and loops_recall (revisited scans of loops.csv joined by an accepted closure within 2 s of both times).\n"
+               "    loops_recall (revisited scans of loops.csv joined by an accepted closure within 2 s of both times)\n"
+               "    and revisits_50m (revisits: runs of revisited scans with no gap over 1 s and at least 50 m of true path;\n"
+               "    closed: those an accepted closure joined; unclosed: t_start, t_end and path_m of the others).\n"
                "Plots: RUN_DIR/eval_trajectory.png, RUN_DIR/eval_error.png.");
   ap.addPositional("RUN_DIR", "output folder of urbanslam run");
   ap.addOption("relations", "FILE", "Freiburg relations file (t1 t2 x y z roll pitch yaw)");
