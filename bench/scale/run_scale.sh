@@ -12,7 +12,9 @@
 # Prints one table: keyframes, the front end's step p50/p99/max and p99 per decade of map size,
 # global SLAM's latency (closure -> corrected map, p50/p99) and most keyframes waiting for it,
 # peak RSS, real-time factor (wall clock, and on one core: CPU time of both threads), ATE, map
-# accuracy (p95), closures accepted/false and the share of true revisits closed.
+# accuracy (p95), closures accepted/false, the share of revisited scans closed (recall) and the
+# revisits of at least 50 m of path that a closure joined, of all such revisits (eval's
+# revisits_50m).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 BUILD=${1:-build}
@@ -45,9 +47,9 @@ done
 python3 - "$OUT" "${rows[@]}" <<'PY'
 import json, os, sys
 out, names = sys.argv[1], sys.argv[2:]
-print("%-14s %9s %7s %7s %7s %28s %9s %9s %7s %7s %6s %7s %7s %7s %6s %6s %6s" % ("run", "keyframes", "p50_ms", "p99_ms", "max_ms",
+print("%-14s %9s %7s %7s %7s %28s %9s %9s %7s %7s %6s %7s %7s %7s %6s %6s %6s %8s" % ("run", "keyframes", "p50_ms", "p99_ms", "max_ms",
       "p99_ms by keyframes 1e2/3/4/5/6", "lat_p50_s", "lat_p99_s", "backlog", "rss_mb", "rtf", "rtf_1cpu", "ate_m", "map_p95",
-      "loops", "false", "recall"))
+      "loops", "false", "recall", "revisits"))
 for n in names:
     r = json.load(open(os.path.join(out, n + ".json")))
     t, c = r["timing"], r["counts"]
@@ -57,9 +59,11 @@ for n in names:
     p = os.path.join(out, n + ".eval.json")
     if os.path.exists(p): e = json.load(open(p))
     f = lambda v, fmt: fmt % v if v is not None else "-"
-    print("%-14s %9d %7.1f %7.1f %7.1f %28s %9.1f %9.1f %7d %7.0f %6.1f %7.1f %7s %7s %6d %6s %6s" % (n, r["keyframes"], t["step_ms_p50"],
+    rv = e.get("revisits_50m")
+    revisits = "%d/%d" % (rv["closed"], rv["revisits"]) if rv else "-"
+    print("%-14s %9d %7.1f %7.1f %7.1f %28s %9.1f %9.1f %7d %7.0f %6.1f %7.1f %7s %7s %6d %6s %6s %8s" % (n, r["keyframes"], t["step_ms_p50"],
           t["step_ms_p99"], t["step_ms_max"], by, t["global_latency_ms_p50"] / 1e3, t["global_latency_ms_p99"] / 1e3,
           t["global_backlog_max"], t["peak_rss_mb"], t["real_time_factor"], r["real_time_factor_one_core"], f(e.get("ate_rmse_m"), "%.2f"),
           f(e.get("map", {}).get("p95_m"), "%.2f"), c["loop_closures_accepted"], f(e.get("loops_false"), "%d"),
-          f(e.get("loops_recall", {}).get("recall"), "%.2f")))
+          f(e.get("loops_recall", {}).get("recall"), "%.2f"), revisits))
 PY
