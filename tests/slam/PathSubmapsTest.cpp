@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "../alignment/SyntheticScan.h"
+#include "urbanslam/alignment/FreeSpace.h"
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/esdf/PoseOps.h"
 #include "urbanslam/slam/LoopCloser.h"
@@ -145,4 +146,16 @@ TEST(PathSubmaps, AFarClosureIsMeasuredByTheSubmaps) {
   const common::Pose2 es = common::between(truth, scans.measurement), em = common::between(truth, submaps.measurement);
   EXPECT_LT(std::hypot(em.x, em.y), 0.05);
   EXPECT_LE(std::hypot(em.x, em.y), std::hypot(es.x, es.y) + 0.01);
+  // The submaps' measurement enters only where the two scans agree on free space there: they do
+  // at the submaps' alignment, and would not one building further along (the alias a street of
+  // one design offers), where the closure keeps the scans' own measurement.
+  alignment::FreeSpaceOptions fo;
+  fo.margin_m = o.free_space_margin_m;
+  fo.no_return_free_m = o.free_space_no_return_m;
+  const auto conflict = [&](const common::Pose2& z) {
+    return alignment::mutualFreeSpaceConflict(map->scan(kEarlier), map->scan(kCurrent), z, fo);
+  };
+  EXPECT_LE(conflict(c.measurement), o.max_free_space_conflict);
+  EXPECT_NEAR(submaps.free_space_conflict, conflict(c.measurement), 1e-12);
+  EXPECT_GT(conflict(common::compose(common::Pose2{12, 0, 0}, c.measurement)), 2 * o.max_free_space_conflict);
 }

@@ -262,7 +262,19 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_
       r.reason = ClosureReason::Submaps;
       return r;
     }
-    if (c.aligned) r.measurement = c.measurement;
+    if (c.aligned) {
+      // The submaps' measurement replaces the scans' only where the two scans agree on free space
+      // there too: along a street of one repeated design (window bays metres apart) the submaps
+      // can settle one period away from where the scans fitted without conflict.
+      alignment::FreeSpaceOptions fo;
+      fo.margin_m = options_.free_space_margin_m;
+      fo.no_return_free_m = options_.free_space_no_return_m;
+      const double conflict = alignment::mutualFreeSpaceConflict(map.scan(earlier), map.scan(current), c.measurement, fo);
+      if (conflict <= options_.max_free_space_conflict) {
+        r.measurement = c.measurement;
+        r.free_space_conflict = conflict;
+      }
+    }
   }
   // Innovation gate, then the information-form update.
   const esdf::Mat3 cov = options_.covariance_scale * a.cov;
