@@ -1,5 +1,7 @@
 #include "urbanslam/esdf/PoseOps.h"
 
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 
 namespace urbanslam::esdf {
@@ -57,6 +59,8 @@ Mat3 betweenCovariance(const Vec3& a, const Vec3& b, const Eigen::Matrix<double,
   j << ja, jb;
   return j * joint * j.transpose();
 }
+
+double largestPositionSigma(const Mat3& cov) { return std::sqrt(std::max(0.0, cov.topLeftCorner<2, 2>().eigenvalues().real().maxCoeff())); }
 
 Vec3 relativePoseError(const Vec3& a, const Vec3& b, const Vec3& z) { return relativePoseError(a, b, z, nullptr, nullptr); }
 

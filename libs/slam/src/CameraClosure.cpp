@@ -1,8 +1,6 @@
 #include "urbanslam/slam/CameraClosure.h"
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
-#include <algorithm>
 #include <cmath>
 
 #include "urbanslam/esdf/PoseOps.h"
@@ -50,8 +48,7 @@ double nearestSceneDepth(const CameraMeasurement& m, const esdf::Vec3& x_i, cons
   const esdf::Vec3 c = esdf::between(esdf::compose(x_i, mount), esdf::compose(x_j, mount));
   // The cameras' relative position spreads as the vehicles' does (the mount is rigid; the
   // heading's share, the mount's lever arm times its sigma, is centimetres against metres).
-  const double sigma = std::sqrt(std::max(0.0, relative_cov.topLeftCorner<2, 2>().eigenvalues().real().maxCoeff()));
-  const double baseline = std::hypot(c.x(), c.y()) - 3 * sigma;
+  const double baseline = std::hypot(c.x(), c.y()) - 3 * esdf::largestPositionSigma(relative_cov);
   return baseline > 0 ? baseline * m.relative.depth_per_baseline : 0.0;
 }
 

@@ -1,6 +1,5 @@
 #include "urbanslam/slam/GlobalSlam.h"
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
@@ -259,28 +258,8 @@ void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double scor
     if (scans) {
       r = closer_.tryClose(f, map_, earlier, current, !confirm, &detection);
     } else {
-      const esdf::Vec3 xi = f.mean(static_cast<int>(earlier)), xj = f.mean(static_cast<int>(current));
-      const esdf::RelativeFactor factor = cameraFactor(*camera, xi, xj);
-      // A monocular pair fixes its scene up to the baseline: at the distance the estimate puts
-      // between the cameras, the scene must lie within the camera's reach.
-      const Eigen::Matrix3d s =
-          f.relativeCovariance(static_cast<int>(earlier), static_cast<int>(current), esdf::CovarianceMode::Conservative);
-      const double depth = nearestSceneDepth(*camera, xi, xj, s);
-      if (depth > options_.loop_closure.max_scene_depth_m) {
-        const auto& kf = map_.keyframes();
-        r.from = earlier;
-        r.to = current;
-        r.from_time = kf[earlier].timestamp;
-        r.to_time = kf[current].timestamp;
-        r.detector = detection.detector;
-        r.score = score;
-        r.measurement = esdf::toPose(factor.z);
-        r.information = factor.omega;
-        r.prior_sigma_m = std::sqrt(std::max(0.0, s.topLeftCorner<2, 2>().eigenvalues().real().maxCoeff()));
-        r.reason = ClosureReason::SceneDepth;
-      } else {
-        r = closer_.tryCloseMeasured(f, map_, earlier, current, factor.z, factor.omega, !confirm, detection);
-      }
+      const esdf::RelativeFactor factor = cameraFactor(*camera, f.mean(static_cast<int>(earlier)), f.mean(static_cast<int>(current)));
+      r = closer_.tryCloseMeasured(f, map_, earlier, current, factor.z, factor.omega, !confirm, detection, &*camera);
     }
     ++stats_.closures_tried;
     const ClosureReason reason = r.reason;

@@ -32,6 +32,8 @@ Vec3 between(const Vec3& a, const Vec3& b);
 void betweenJacobians(const Vec3& a, const Vec3& b, Mat3* ja, Mat3* jb);
 // Covariance of ⊖a⊕b to first order, from the joint covariance of (a, b) (a's block first).
 Mat3 betweenCovariance(const Vec3& a, const Vec3& b, const Eigen::Matrix<double, 6, 6>& joint);
+// Standard deviation of a pose covariance's position part along its worst direction.
+double largestPositionSigma(const Mat3& cov);
 
 // Difference of two poses in the state chart: a - b with the heading difference wrapped.
 inline Vec3 poseDifference(const Vec3& a, const Vec3& b) { return {a.x() - b.x(), a.y() - b.y(), common::wrapToPi(a.z() - b.z())}; }

@@ -16,6 +16,7 @@
 #include "urbanslam/common/BinaryStream.h"
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/io/LaserScan.h"
+#include "urbanslam/slam/CameraClosure.h"
 #include "urbanslam/slam/KeyframeGrid.h"
 #include "urbanslam/slam/PipelineOptions.h"
 
@@ -100,9 +101,13 @@ class LoopCloser {
   LoopClosureRecord tryClose(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current, bool commit = true,
                              const Detection* detection = nullptr);
   // Gating (and with `commit` the update) of a relative-pose factor measured by another sensor
-  // (the camera: CameraClosure.h) in place of a scan alignment.
+  // in place of a scan alignment. With `camera` (the images that measured it: CameraClosure.h),
+  // first the scene's depth: a monocular pair fixes its scene up to the baseline, and at the
+  // distance the estimate puts between the cameras it must lie within max_scene_depth_m
+  // (nearestSceneDepth; reason SceneDepth, not gated).
   LoopClosureRecord tryCloseMeasured(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current, const esdf::Vec3& z,
-                                     const Eigen::Matrix3d& information, bool commit, const Detection& detection);
+                                     const Eigen::Matrix3d& information, bool commit, const Detection& detection,
+                                     const CameraMeasurement* camera = nullptr);
 
   // The checks of a closure that need no estimate, for two scans aligned from `guess` by
   // `method`: the alignment's residual and matched share, the ambiguity restarts as far as
