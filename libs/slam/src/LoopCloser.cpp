@@ -1,6 +1,5 @@
 #include "urbanslam/slam/LoopCloser.h"
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
@@ -17,9 +16,12 @@
 namespace urbanslam::slam {
 
 namespace {
-// Standard deviation of a covariance's position part along its worst direction.
-double largestPositionSigma(const Eigen::Matrix3d& cov) {
-  return std::sqrt(std::max(0.0, cov.topLeftCorner<2, 2>().eigenvalues().real().maxCoeff()));
+// The free-space test of two scans as [loop_closure] configures it (alignment/FreeSpace.h).
+alignment::FreeSpaceOptions freeSpaceOptions(const LoopClosureOptions& o) {
+  alignment::FreeSpaceOptions fo;
+  fo.margin_m = o.free_space_margin_m;
+  fo.no_return_free_m = o.free_space_no_return_m;
+  return fo;
 }
 }  // namespace
 
@@ -84,7 +86,7 @@ std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const Map& map
   // Initial set: earlier keyframes within the search radius, widened by the current pose's own
   // 3-sigma position uncertainty (conservative covariance: no refactorisation).
   const esdf::Mat3 c = filter.marginalCovariance(static_cast<int>(current), esdf::CovarianceMode::Conservative);
-  const double sigma = largestPositionSigma(c);
+  const double sigma = esdf::largestPositionSigma(c);
   const double radius = options_.search_radius_m + 3 * sigma;
   std::vector<size_t> near;
   grid.query(cur.pose.x, cur.pose.y, radius, near);
@@ -110,8 +112,8 @@ std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const Map& map
   // have tied it to the keyframes around). Beyond appearance_min_sigma_m, more than alignment
   // from the estimate's guess reaches, the nearest keyframes are as likely wrong as any within
   // reach.
-  const bool far = !initial.empty() &&
-                   largestPositionSigma(relativeCovariance(filter, initial.front().second, current)) > options_.appearance_min_sigma_m;
+  const bool far = !initial.empty() && esdf::largestPositionSigma(relativeCovariance(filter, initial.front().second, current)) >
+                                           options_.appearance_min_sigma_m;
   // The keyframes nearest the estimate, nearest in Mahalanobis distance first (the 30 nearest
   // tested: bounded covariance work per keyframe). Far from the map they are searched at every
   // n-th keyframe only: the next keyframe's nearest are the same wrong guesses shifted by a
@@ -201,10 +203,7 @@ alignment::AlignmentResult LoopCloser::verifyAlignment(const io::LaserScan& earl
     r.reason = ClosureReason::Ambiguous;
     return a;
   }
-  alignment::FreeSpaceOptions fo;
-  fo.margin_m = options_.free_space_margin_m;
-  fo.no_return_free_m = options_.free_space_no_return_m;
-  r.free_space_conflict = alignment::mutualFreeSpaceConflict(earlier_scan, current_scan, a.transform, fo);
+  r.free_space_conflict = alignment::mutualFreeSpaceConflict(earlier_scan, current_scan, a.transform, freeSpaceOptions(options_));
   if (r.free_space_conflict > options_.max_free_space_conflict) r.reason = ClosureReason::FreeSpace;
   return a;
 }
@@ -222,7 +221,7 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_
   // Alignment from the current estimate of the relative pose.
   const esdf::Vec3 xi = filter.mean(static_cast<int>(earlier)), xk = filter.mean(static_cast<int>(current));
   const Eigen::Matrix3d s = relativeCovariance(filter, earlier, current);
-  r.prior_sigma_m = largestPositionSigma(s);
+  r.prior_sigma_m = esdf::largestPositionSigma(s);
   alignment::Method method = alignment::Method::CrfIcp;
   if (options_.method == LoopClosureOptions::Method::Auto) {
     // A well-known relative pose needs only the fast local refinement (PL-ICP); a poorly known
@@ -241,12 +240,13 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_
   // (Trying PL-ICP first on an uncertain guess was measured worse: it lands in wrong local
   // minima that pass the residual test — ATE 2.96 m vs 0.26 m on Intel.)
   // The map keeps its scans compact (and maybe on disk): expanded once for this candidate.
+  const io::LaserScan earlier_scan = map.scan(earlier), current_scan = map.scan(current);
   const common::Pose2 guess = esdf::toPose(esdf::between(xi, xk));
   // Where the innovation gate admits a measurement: the relative pose's own uncertainty (the
   // alignment's, centimetres, is left out).
   const alignment::PoseRegion admitted{guess, s, chi2_3dof_gate_};
-  const alignment::AlignmentResult a = verifyAlignment(map.scan(earlier), map.scan(current), guess, method, 3 * r.prior_sigma_m, r,
-                                                       options_.view_test ? &admitted : nullptr);
+  const alignment::AlignmentResult a =
+      verifyAlignment(earlier_scan, current_scan, guess, method, 3 * r.prior_sigma_m, r, options_.view_test ? &admitted : nullptr);
   if (!detection) r.score = a.matchedFraction();
   if (r.reason != ClosureReason::None) return r;
   // A closure far beyond what the estimate knew (found by appearance or from a wide prior) is
@@ -266,10 +266,7 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_
       // The submaps' measurement replaces the scans' only where the two scans agree on free space
       // there too: along a street of one repeated design (window bays metres apart) the submaps
       // can settle one period away from where the scans fitted without conflict.
-      alignment::FreeSpaceOptions fo;
-      fo.margin_m = options_.free_space_margin_m;
-      fo.no_return_free_m = options_.free_space_no_return_m;
-      const double conflict = alignment::mutualFreeSpaceConflict(map.scan(earlier), map.scan(current), c.measurement, fo);
+      const double conflict = alignment::mutualFreeSpaceConflict(earlier_scan, current_scan, c.measurement, freeSpaceOptions(options_));
       if (conflict <= options_.max_free_space_conflict) {
         r.measurement = c.measurement;
         r.free_space_conflict = conflict;
@@ -294,7 +291,8 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_
 }
 
 LoopClosureRecord LoopCloser::tryCloseMeasured(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current, const esdf::Vec3& z,
-                                               const Eigen::Matrix3d& information, bool commit, const Detection& detection) {
+                                               const Eigen::Matrix3d& information, bool commit, const Detection& detection,
+                                               const CameraMeasurement* camera) {
   const std::vector<Keyframe>& keyframes = map.keyframes();
   LoopClosureRecord r;
   r.from = earlier;
@@ -303,9 +301,15 @@ LoopClosureRecord LoopCloser::tryCloseMeasured(esdf::Esdf& filter, const Map& ma
   r.to_time = keyframes[current].timestamp;
   r.detector = detection.detector;
   r.score = detection.score;
-  r.prior_sigma_m = largestPositionSigma(relativeCovariance(filter, earlier, current));
+  const Eigen::Matrix3d s = relativeCovariance(filter, earlier, current);
+  r.prior_sigma_m = esdf::largestPositionSigma(s);
   r.measurement = esdf::toPose(z);
   r.information = information;
+  if (camera && nearestSceneDepth(*camera, filter.mean(static_cast<int>(earlier)), filter.mean(static_cast<int>(current)), s) >
+                    options_.max_scene_depth_m) {
+    r.reason = ClosureReason::SceneDepth;
+    return r;
+  }
   const esdf::GateResult gate =
       commit ? filter.observeRelative(static_cast<int>(earlier), static_cast<int>(current), z, information, true).gate
              : filter.gateRelative(static_cast<int>(earlier), static_cast<int>(current), z, information);
