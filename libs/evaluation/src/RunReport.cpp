@@ -61,8 +61,10 @@ common::Json poseJson(const common::Pose2& p) {
   return j;
 }
 
-// The map against the simulated city's walls, and the share of true revisits closed.
-void evaluateAgainstSimulation(const fs::path& run, const fs::path& sim, const common::Pose2& to_truth, common::Json& j) {
+// The map against the simulated city's walls, and the share of true revisits closed. `truth`: the
+// drive's truth.tum, already read as the run's reference.
+void evaluateAgainstSimulation(const fs::path& run, const fs::path& sim, const std::vector<io::StampedPose>& truth,
+                               const common::Pose2& to_truth, common::Json& j) {
   // The map as the run exported it (map.ply: moving things left out), or else every point of
   // the keyframes' scans.
   const fs::path ply = run / "map.ply", simplemap = run / "map.simplemap";
@@ -97,7 +99,7 @@ void evaluateAgainstSimulation(const fs::path& run, const fs::path& sim, const c
     l["closed_scans"] = r.closed_scans;
     l["recall"] = r.recall;
     j["loops_recall"] = std::move(l);
-    const auto v = revisitRecall(closures, loops, io::readTum((sim / "truth.tum").string()));
+    const auto v = revisitRecall(closures, loops, truth);
     common::Json rv = common::Json::object();
     rv["revisits"] = v.revisits;
     rv["closed"] = v.closed;
@@ -229,7 +231,7 @@ RunReport evaluateRun(const RunReportOptions& o) {
       throw common::InputError(reference_path + ": no reference pose falls inside the run's time span (" + traj_path.string() +
                                "): wrong dataset?");
     j["reference"] = reference_path;
-    if (with_truth) evaluateAgainstSimulation(dir, truth_dir, tm.alignment, j);
+    if (with_truth) evaluateAgainstSimulation(dir, truth_dir, reference, tm.alignment, j);
     j["positions_only"] = positions_only;
     j["matched"] = tm.matched;
     j["ate_rmse_m"] = tm.ate_rmse_m;
