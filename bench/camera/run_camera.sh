@@ -34,10 +34,10 @@ import csv, json, math, sys
 run, name, city_ini = sys.argv[1], sys.argv[2], sys.argv[3]
 stats = json.load(open(run + '.json'))
 ev = json.load(open(run + '.eval.json'))
-ref = {}
+ref = {}  # time -> (x, y, heading)
 for l in open(run + '/reference.tum'):
     if l.startswith('#') or not l.strip(): continue
-    v = l.split(); ref[round(float(v[0]), 6)] = (float(v[1]), float(v[2]))
+    v = [float(t) for t in l.split()]; ref[round(v[0], 6)] = (v[1], v[2], 2 * math.atan2(v[6], v[7]))
 pts = [ref[k] for k in sorted(ref)]
 driven = sum(math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in zip(pts, pts[1:]))
 # The camera on the vehicle ([camera] x_m, y_m, yaw_deg of the city ini).
@@ -58,10 +58,6 @@ def inverse(a):
     return (-c * a[0] - s * a[1], s * a[0] - c * a[1], -a[2])
 def wrap(x):
     return math.atan2(math.sin(x), math.cos(x))
-heading = {}
-for l in open(run + '/reference.tum'):
-    if l.startswith('#') or not l.strip(): continue
-    v = [float(t) for t in l.split()]; heading[round(v[0], 6)] = 2 * math.atan2(v[6], v[7])
 accepted = same = camera_false = 0
 for r in csv.DictReader(open(run + '/loop_closures.csv')):
     if r['accepted'] != '1': continue
@@ -72,7 +68,7 @@ for r in csv.DictReader(open(run + '/loop_closures.csv')):
     same += here
     if r['detector'] != 'image' or a is None or b is None: continue
     # What the camera measures: the bearing of camera j from camera i and the heading change.
-    truth = compose(inverse(compose((a[0], a[1], heading[ta]), mount)), compose((b[0], b[1], heading[tb]), mount))
+    truth = compose(inverse(compose(a, mount)), compose(b, mount))
     seen = compose(compose(inverse(mount), (float(r['x']), float(r['y']), float(r['phi']))), mount)
     lateral = math.hypot(truth[0], truth[1]) * abs(math.sin(math.atan2(seen[1], seen[0]) - math.atan2(truth[1], truth[0])))
     camera_false += not here or lateral > 0.5 or abs(wrap(seen[2] - truth[2])) > math.radians(5)

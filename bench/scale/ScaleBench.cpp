@@ -58,13 +58,14 @@ double cpuSeconds() {
 
 }  // namespace
 
+constexpr const char* kUsage = "usage: scale_bench (--city CITY_INI | --log LOG) [--ini PIPELINE_INI] --out DIR\n";
+
 int main(int argc, char** argv) {
   urbanslam::common::keepFreedBuffers();  // as the urbanslam command does
   std::string city, log, ini = std::string(URBANSLAM_SOURCE_DIR) + "/ini/default.ini", out;
   for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
-      std::cout << "usage: scale_bench (--city CITY_INI | --log LOG) [--ini PIPELINE_INI] --out DIR\n"
-                   "The pipeline on a simulated city streamed from the simulator, or on a log; prints one JSON line.\n";
+      std::cout << kUsage << "The pipeline on a simulated city streamed from the simulator, or on a log; prints one JSON line.\n";
       return 0;
     }
   for (int i = 1; i + 1 < argc; i += 2) {
@@ -79,7 +80,7 @@ int main(int argc, char** argv) {
       out = argv[i + 1];
   }
   if (out.empty() || city.empty() == log.empty()) {
-    std::cerr << "usage: scale_bench (--city CITY_INI | --log LOG) [--ini PIPELINE_INI] --out DIR\n";
+    std::cerr << kUsage;
     return 2;
   }
   try {
