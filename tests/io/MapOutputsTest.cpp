@@ -95,26 +95,37 @@ TEST(MapOutputs, PlyReadBackByMrpt) {
   }
 }
 
-TEST(MapOutputs, PcdAndXyzHaveOneLinePerPoint) {
+// PCD as PCL reads a binary one: the header's lines up to DATA, then three floats per point.
+TEST(MapOutputs, PcdHoldsThePointsBinaryAndXyzOneLinePerPoint) {
   const Excerpt e = loadExcerpt();
   const auto pts = io::mapPoints(e.posed(), 3);
   const auto d = test::scratchDir("pcd");
   io::writePcd((d / "m.pcd").string(), pts);
   io::writeXyz((d / "m.xyz").string(), pts);
-  std::ifstream pcd(d / "m.pcd");
+  std::ifstream pcd(d / "m.pcd", std::ios::binary);
   std::string line;
-  size_t declared = 0, data = 0;
-  bool in_data = false;
+  size_t declared = 0;
+  std::vector<std::string> keys;
   while (std::getline(pcd, line)) {
-    if (in_data)
-      ++data;
-    else if (line.rfind("POINTS ", 0) == 0)
-      declared = std::stoul(line.substr(7));
-    else if (line == "DATA ascii")
-      in_data = true;
+    if (line.empty() || line[0] == '#') continue;
+    keys.push_back(line.substr(0, line.find(' ')));
+    if (keys.back() == "POINTS") declared = std::stoul(line.substr(7));
+    if (keys.back() == "DATA") {
+      EXPECT_EQ(line, "DATA binary");
+      break;
+    }
   }
+  EXPECT_EQ(keys,
+            (std::vector<std::string>{"VERSION", "FIELDS", "SIZE", "TYPE", "COUNT", "WIDTH", "HEIGHT", "VIEWPOINT", "POINTS", "DATA"}));
   EXPECT_EQ(declared, pts.size());
-  EXPECT_EQ(data, pts.size());
+  std::vector<float> body(3 * pts.size() + 1);
+  pcd.read(reinterpret_cast<char*>(body.data()), static_cast<std::streamsize>(body.size() * sizeof(float)));
+  ASSERT_EQ(static_cast<size_t>(pcd.gcount()), 3 * pts.size() * sizeof(float));  // nothing after the last point
+  for (size_t i = 0; i < pts.size(); i += 101) {
+    EXPECT_EQ(body[3 * i], pts[i].x);
+    EXPECT_EQ(body[3 * i + 1], pts[i].y);
+    EXPECT_EQ(body[3 * i + 2], pts[i].z);
+  }
   std::ifstream xyz(d / "m.xyz");
   size_t n = 0;
   double x, y, z;

@@ -3,10 +3,12 @@
 #include <mrpt/img/CImage.h>
 #include <mrpt/maps/COccupancyGridMap2D.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <tuple>
 #include <utility>
 
 #include "MrptConversions.h"
@@ -16,6 +18,12 @@
 
 namespace urbanslam::io {
 
+namespace {
+// A block of tiles is drawn from one grid: at most this many cells a side besides its scans' rays
+// (two 2000-cell tiles), which bounds the grid's memory while most scans go into one block.
+constexpr int kBlockCells = 4000;
+}  // namespace
+
 std::vector<GridTile> writeOccupancyGridTiles(const std::string& dir, const std::vector<PosedScan>& scans, const OccupancyGridOptions& o,
                                               int tile_cells) {
   if (!(o.resolution_m > 0) || tile_cells < 1) throw common::InputError(dir + ": bad grid tile options");
@@ -24,15 +32,21 @@ std::vector<GridTile> writeOccupancyGridTiles(const std::string& dir, const std:
   const double side = t * r;
   std::filesystem::create_directories(dir);
 
-  // Which scans each tile takes: those whose rays can reach it. A ray ends where MRPT's
+  // Which scans each block of tiles takes: those whose rays can reach it. A ray ends where MRPT's
   // insertion ends it: a return at its range (at most the insertion range), a beam without one
   // at half the last return's range (half the insertion range before the first), so the box of
   // the sensor and every ray's end, grown by a metre for the cells' rounding, holds every cell
-  // the scan changes. Bounded by the insertion range, so a tile's grid (the tile grown by twice that
-  // range) holds every ray of the scans it takes without MRPT growing it.
+  // the scan changes. Tiles are drawn a block of them at a time, from one grid that holds every
+  // ray of the block's scans (so MRPT never grows it): a scan is inserted once per block it
+  // reaches, not once per tile, and the grid reaches only as far as those rays do.
+  const long block = std::max(1, kBlockCells / t);  // tiles per block side
+  const auto blockOf = [block](long tile) { return tile >= 0 ? tile / block : -((-tile + block - 1) / block); };
+  struct Box {
+    double x0, y0, x1, y1;
+  };
+  std::vector<Box> boxes(scans.size());
   std::map<std::pair<long, long>, std::vector<size_t>> takes;
   const double reach = kGridInsertionRangeM;
-  double widest_pad = 0;
   {
     LaserScan buffer;
     for (size_t k = 0; k < scans.size(); ++k) {
@@ -60,57 +74,73 @@ std::vector<GridTile> writeOccupancyGridTiles(const std::string& dir, const std:
       // A metre for the cells' rounding, and a beam's width at the insertion range (MRPT spreads
       // the beams over the aperture its own way).
       const double pad = 1.0 + reach * std::fabs(s.angle_increment_rad);
-      widest_pad = std::max(widest_pad, pad);
-      for (long i = static_cast<long>(std::floor((x0 - pad) / side)); i <= static_cast<long>(std::floor((x1 + pad) / side)); ++i)
-        for (long j = static_cast<long>(std::floor((y0 - pad) / side)); j <= static_cast<long>(std::floor((y1 + pad) / side)); ++j)
+      boxes[k] = {x0 - pad, y0 - pad, x1 + pad, y1 + pad};
+      for (long i = blockOf(static_cast<long>(std::floor(boxes[k].x0 / side)));
+           i <= blockOf(static_cast<long>(std::floor(boxes[k].x1 / side))); ++i)
+        for (long j = blockOf(static_cast<long>(std::floor(boxes[k].y0 / side)));
+             j <= blockOf(static_cast<long>(std::floor(boxes[k].y1 / side))); ++j)
           takes[{i, j}].push_back(k);
     }
   }
-  // The tile's grid, in whole cells on the same lattice as the tile: the sensor of a scan it takes
-  // is within the reach and the pad of it, so every ray ends within twice the reach and the pad
-  // (and 2 m more, beyond MRPT's own resizing margin of 15 cells).
-  const double margin = std::ceil((2 * reach + widest_pad + 2.0) / r) * r;
 
   std::vector<GridTile> written;
   LaserScan buffer;
-  for (const auto& [ij, members] : takes) {
-    const double x0 = ij.first * side, y0 = ij.second * side;
-    mrpt::maps::COccupancyGridMap2D grid(static_cast<float>(x0 - margin), static_cast<float>(x0 + side + margin),
-                                         static_cast<float>(y0 - margin), static_cast<float>(y0 + side + margin), static_cast<float>(r));
-    detail::configureGridInsertion(grid);
+  // One grid for every block: its cells are reused, not allocated and faulted in again.
+  mrpt::maps::COccupancyGridMap2D grid;
+  detail::configureGridInsertion(grid);
+  mrpt::img::CImage tile(t, t, mrpt::img::CH_GRAY);
+  for (const auto& [bij, members] : takes) {
+    const double bx0 = bij.first * block * side, by0 = bij.second * block * side;
+    const double bx1 = bx0 + block * side, by1 = by0 + block * side;
+    // The block and every member's rays, 2 m more (beyond MRPT's own resizing margin of 15
+    // cells), in whole cells on the tiles' lattice.
+    double x0 = bx0, y0 = by0, x1 = bx1, y1 = by1;
+    for (const size_t k : members) {
+      x0 = std::min(x0, boxes[k].x0 - 2.0);
+      y0 = std::min(y0, boxes[k].y0 - 2.0);
+      x1 = std::max(x1, boxes[k].x1 + 2.0);
+      y1 = std::max(y1, boxes[k].y1 + 2.0);
+    }
+    const auto cells = [r](double d) { return std::ceil(d / r) * r; };
+    grid.setSize(static_cast<float>(bx0 - cells(bx0 - x0)), static_cast<float>(bx1 + cells(x1 - bx1)),
+                 static_cast<float>(by0 - cells(by0 - y0)), static_cast<float>(by1 + cells(y1 - by1)), static_cast<float>(r));
     for (const size_t k : members) {
       const auto obs = detail::toMrptScan(scans[k].get(buffer));
       const mrpt::poses::CPose3D robot(scans[k].pose.x, scans[k].pose.y, 0, scans[k].pose.phi, 0, 0);
       grid.insertObservation(*obs, robot);
     }
-    // The tile's cells as MRPT draws a grid (first row = largest y, MRPT's cell-to-grey table).
-    const int cx0 = grid.x2idx(x0 + 0.5 * r), cy0 = grid.y2idx(y0 + 0.5 * r);
-    mrpt::img::CImage tile(t, t, mrpt::img::CH_GRAY);
-    bool known = false;
-    for (int row = 0; row < t; ++row) {
-      const auto* cells = grid.getRow(cy0 + t - 1 - row) + cx0;
-      auto* pixels = tile(0, row);
-      for (int c = 0; c < t; ++c) {
-        known = known || cells[c] != 0;  // log-odds 0: never observed
-        pixels[c] = mrpt::maps::COccupancyGridMap2D::l2p_255(cells[c]);
+    for (long ti = 0; ti < block; ++ti)
+      for (long tj = 0; tj < block; ++tj) {
+        const double tx0 = bx0 + ti * side, ty0 = by0 + tj * side;
+        // The tile's cells as MRPT draws a grid (first row = largest y, MRPT's cell-to-grey table).
+        const int cx0 = grid.x2idx(tx0 + 0.5 * r), cy0 = grid.y2idx(ty0 + 0.5 * r);
+        bool known = false;
+        for (int row = 0; row < t; ++row) {
+          const auto* cells = grid.getRow(cy0 + t - 1 - row) + cx0;
+          auto* pixels = tile(0, row);
+          for (int c = 0; c < t; ++c) {
+            known = known || cells[c] != 0;  // log-odds 0: never observed
+            pixels[c] = mrpt::maps::COccupancyGridMap2D::l2p_255(cells[c]);
+          }
+        }
+        if (!known) continue;
+        GridTile g;
+        g.i = static_cast<int>(bij.first * block + ti);
+        g.j = static_cast<int>(bij.second * block + tj);
+        char name[64];
+        std::snprintf(name, sizeof name, "tile_%d_%d", g.i, g.j);
+        g.png = std::string(name) + ".png";
+        g.origin_x_m = tx0;
+        g.origin_y_m = ty0;
+        const std::string base = (std::filesystem::path(dir) / name).string();
+        common::writeAtomically(base + ".png", [&](const std::string& tmp) {
+          if (!tile.saveToFile(tmp)) throw common::InputError(base + ".png: cannot write");
+        });
+        detail::writeMapServerYaml(base + ".yaml", g.png, r, tx0, ty0, o);
+        written.push_back(g);
       }
-    }
-    if (!known) continue;
-    GridTile g;
-    g.i = static_cast<int>(ij.first);
-    g.j = static_cast<int>(ij.second);
-    char name[64];
-    std::snprintf(name, sizeof name, "tile_%d_%d", g.i, g.j);
-    g.png = std::string(name) + ".png";
-    g.origin_x_m = x0;
-    g.origin_y_m = y0;
-    const std::string base = (std::filesystem::path(dir) / name).string();
-    common::writeAtomically(base + ".png", [&](const std::string& tmp) {
-      if (!tile.saveToFile(tmp)) throw common::InputError(base + ".png: cannot write");
-    });
-    detail::writeMapServerYaml(base + ".yaml", g.png, r, x0, y0, o);
-    written.push_back(g);
   }
+  std::sort(written.begin(), written.end(), [](const GridTile& a, const GridTile& b) { return std::tie(a.i, a.j) < std::tie(b.i, b.j); });
   common::AtomicFile index((std::filesystem::path(dir) / "tiles.csv").string());
   index.stream() << "i,j,png,origin_x_m,origin_y_m,width_cells,height_cells,resolution_m\n";
   char line[256];

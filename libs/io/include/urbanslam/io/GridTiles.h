@@ -1,6 +1,6 @@
 #pragma once
 // The occupancy grid of a map too large for one image, written as square tiles at full
-// resolution, one at a time: memory is bounded by one tile and its surroundings whatever the
+// resolution, a block of tiles at a time: memory is bounded by one block and its surroundings whatever the
 // map's size. Each tile is a PNG + YAML pair in the ROS map_server convention (so any one of
 // them loads on its own) and `tiles.csv` lists them.
 //

@@ -53,7 +53,7 @@ size_t countMapPoints(const std::vector<PosedScan>& scans, int decimation = 1, c
 
 enum class PlyEncoding { Ascii, BinaryLittleEndian };
 void writePly(const std::string& path, const std::vector<MapPoint>& pts, PlyEncoding encoding);
-void writePcd(const std::string& path, const std::vector<MapPoint>& pts);  // PCD v0.7, ASCII
+void writePcd(const std::string& path, const std::vector<MapPoint>& pts);  // PCD v0.7, binary (as PCL writes it)
 void writeXyz(const std::string& path, const std::vector<MapPoint>& pts);  // "x y z" per line
 // The same files for mapPoints(scans, decimation, mask), streamed scan by scan.
 void writePly(const std::string& path, const std::vector<PosedScan>& scans, int decimation, PlyEncoding encoding,
