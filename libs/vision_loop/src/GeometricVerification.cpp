@@ -31,6 +31,8 @@ PointMatches matchFeatures(const ImageFeatures& a, const ImageFeatures& b, Descr
     if (best_for_b[j] < 0) continue;
     out.a.push_back(a.keypoints[best_for_b[j]].pt);
     out.b.push_back(b.keypoints[j].pt);
+    out.ia.push_back(best_for_b[j]);
+    out.ib.push_back(j);
   }
   return out;
 }

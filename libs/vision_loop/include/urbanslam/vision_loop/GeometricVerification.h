@@ -27,6 +27,7 @@ struct VerificationResult {
 // (its best), as pixel positions in each image.
 struct PointMatches {
   std::vector<cv::Point2f> a, b;
+  std::vector<int> ia, ib;  // the keypoints they are, in a and in b
 };
 PointMatches matchFeatures(const ImageFeatures& a, const ImageFeatures& b, DescriptorType type, double ratio);
 
