@@ -3,11 +3,13 @@
 # 1 km² city and drive (ini/city-camera.ini is ini/city-1km2.ini seen by a left-looking camera):
 # ATE against the simulator's truth, as metres and as a share of the distance driven, the
 # closures accepted and how many of them join two views of the same place (true positions
-# within 25 m: a camera closure measures bearing and heading, so `eval`'s whole-pose check,
-# `eval_false`, does not apply to it; a laser closure may join scans further apart), the false
-# ones by what each sensor measures (`false`: for the camera, accepted image closures at another
-# place or whose bearing, times the true distance between the cameras, or heading disagrees with
-# the truth's by more than 0.5 m or 5°, the camera mount read from the city ini; for the laser,
+# within 25 m; a laser closure may join scans further apart), how many of the camera's measured
+# the full pose (`full_pose`: its features given depth by a neighbouring image; the others
+# measured bearing and heading only, so `eval`'s whole-pose check, `eval_false`, does not apply to
+# them), the false ones by what each closure measures (`false`: for the camera, accepted image
+# closures at another place, or whose full pose is more than 0.5 m or 5° off the truth's, or, for
+# bearing and heading only, whose bearing, times the true distance between the cameras, or
+# heading is more than 0.5 m or 5° off, the camera mount read from the city ini; for the laser,
 # `eval_false`), and the real-time factor. AREA_KM2 and ROUTE_KM give both runs another city size and drive length
 # (default: the inis' own, 1 km² and 3 km).
 #
@@ -19,7 +21,7 @@ OUT=${2:-out/bench-camera}
 U=$BUILD/apps/urbanslam/urbanslam
 [[ -x $U ]] || { echo "missing $U (build first)" >&2; exit 2; }
 mkdir -p "$OUT"
-printf '%-8s %9s %10s %8s %7s %9s %10s %6s %10s %6s\n' run keyframes driven_m ate_m ate_pct accepted same_place false eval_false rtf
+printf '%-8s %9s %10s %8s %7s %9s %10s %9s %6s %10s %6s\n' run keyframes driven_m ate_m ate_pct accepted same_place full_pose false eval_false rtf
 for spec in camera:ini/city-camera.ini laser:ini/city-1km2.ini; do
   name=${spec%%:*}
   ini=${spec#*:}
@@ -58,7 +60,7 @@ def inverse(a):
     return (-c * a[0] - s * a[1], s * a[0] - c * a[1], -a[2])
 def wrap(x):
     return math.atan2(math.sin(x), math.cos(x))
-accepted = same = camera_false = 0
+accepted = same = full_pose = camera_false = 0
 for r in csv.DictReader(open(run + '/loop_closures.csv')):
     if r['accepted'] != '1': continue
     accepted += 1
@@ -67,13 +69,19 @@ for r in csv.DictReader(open(run + '/loop_closures.csv')):
     here = a is not None and b is not None and math.hypot(a[0] - b[0], a[1] - b[1]) < 25
     same += here
     if r['detector'] != 'image' or a is None or b is None: continue
-    # What the camera measures: the bearing of camera j from camera i and the heading change.
+    if r['bearing_only'] != '1':
+        # The full pose, as eval judges it.
+        full_pose += 1
+        rel, z = compose(inverse(a), b), (float(r['x']), float(r['y']), float(r['phi']))
+        camera_false += not here or math.hypot(rel[0] - z[0], rel[1] - z[1]) > 0.5 or abs(wrap(rel[2] - z[2])) > math.radians(5)
+        continue
+    # Bearing and heading: the bearing of camera j from camera i and the heading change.
     truth = compose(inverse(compose(a, mount)), compose(b, mount))
     seen = compose(compose(inverse(mount), (float(r['x']), float(r['y']), float(r['phi']))), mount)
     lateral = math.hypot(truth[0], truth[1]) * abs(math.sin(math.atan2(seen[1], seen[0]) - math.atan2(truth[1], truth[0])))
     camera_false += not here or lateral > 0.5 or abs(wrap(seen[2] - truth[2])) > math.radians(5)
 false = camera_false if name == 'camera' else ev['loops_false']
-print('%-8s %9d %10.0f %8.2f %6.2f%% %9d %10d %6d %10d %6.1f' % (name, stats['counts']['keyframes'], driven, ev['ate_rmse_m'],
-      100 * ev['ate_rmse_m'] / driven, accepted, same, false, ev['loops_false'], stats['timing']['real_time_factor']))
+print('%-8s %9d %10.0f %8.2f %6.2f%% %9d %10d %9d %6d %10d %6.1f' % (name, stats['counts']['keyframes'], driven, ev['ate_rmse_m'],
+      100 * ev['ate_rmse_m'] / driven, accepted, same, full_pose, false, ev['loops_false'], stats['timing']['real_time_factor']))
 PY
 done

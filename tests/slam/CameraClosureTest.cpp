@@ -7,6 +7,8 @@
 #include <limits>
 #include <random>
 
+#include <Eigen/LU>
+
 #include "urbanslam/esdf/PoseOps.h"
 #include "urbanslam/slam/CameraClosure.h"
 
@@ -62,6 +64,43 @@ TEST(CameraFactor, WeighsTheCameraBearingAndHeadingNotTheRange) {
     // next to nothing (the odometry carries the scale).
     const Vec3 xj_r = vehicleAt(Vec3((range + 1) * std::cos(bearing), (range + 1) * std::sin(bearing), c.z()));
     EXPECT_LT(chi2(f, xi, xj_r), 1e-4);
+  }
+}
+
+// A full camera pose (the length measured too) becomes a full-pose factor on the vehicles: zero at
+// the poses that give that camera pose, whatever the estimate; camera j displaced costs its error
+// in the measured pose's frame weighed by Σ⁻¹, along the baseline as much as across it.
+TEST(CameraFactor, AFullCameraPoseWeighsTheRangeToo) {
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const Eigen::Matrix3d cov = Eigen::Vector3d(0.05 * 0.05, 0.02 * 0.02, 0.002 * 0.002).asDiagonal();
+  for (int trial = 0; trial < 50; ++trial) {
+    const Vec3 mount(1.0 + 0.5 * u(rng), 0.4 * u(rng), M_PI / 2 + 0.3 * u(rng));
+    const Vec3 xi(30 * u(rng), 30 * u(rng), M_PI * u(rng));
+    const Vec3 xj = esdf::compose(xi, Vec3(8 + 10 * u(rng), 6 * u(rng), 0.5 * u(rng)));
+    const Vec3 ci = esdf::compose(xi, mount), c = esdf::between(ci, esdf::compose(xj, mount));
+    CameraMeasurement m;
+    m.mount = esdf::toPose(mount);
+    m.relative.valid = true;
+    m.relative.bearing_rad = std::atan2(c.y(), c.x());
+    m.relative.heading_rad = c.z();
+    m.metric.valid = true;
+    m.metric.pose = esdf::toPose(c);
+    m.metric.cov = cov;
+    // The estimate does not enter: any x_i, x_j give the same factor.
+    const esdf::RelativeFactor f = cameraFactor(m, xi, xj), g = cameraFactor(m, Vec3(0, 0, 0), Vec3(100, 0, 0));
+    EXPECT_LT((f.z - g.z).norm(), 1e-12);
+    EXPECT_LT((f.omega - g.omega).norm(), 1e-9 * f.omega.norm());
+    EXPECT_LT(chi2(f, xi, xj), 1e-12);
+    const auto vehicleAt = [&](const Vec3& camera_rel) { return esdf::compose(esdf::compose(ci, camera_rel), esdf::inverse(mount)); };
+    // Camera j a centimetre further along the baseline (the bearing-heading factor barely sees
+    // it): its error in the measured camera pose's frame, weighed by the covariance.
+    const double range = std::hypot(c.x(), c.y());
+    const Vec3 moved = c + Vec3(c.x() / range * 0.01, c.y() / range * 0.01, 0.0);
+    const Vec3 e = esdf::between(c, moved);
+    EXPECT_NEAR(chi2(f, xi, vehicleAt(moved)), e.dot(cov.inverse() * e), 0.02 * e.dot(cov.inverse() * e));
+    const Vec3 xj_h = vehicleAt(c + Vec3(0, 0, 0.001));
+    EXPECT_NEAR(chi2(f, xi, xj_h), 0.25, 0.02 * 0.25);
   }
 }
 

@@ -79,6 +79,42 @@ TEST(GlobalSlam, AClosureAwaitingConfirmationMakesTheNextKeyframesSearchFarFromT
   EXPECT_EQ(other->stats.closures_accepted, 0u);
 }
 
+// A camera closure's full pose goes in only where the estimate knows the pair within
+// appearance_min_sigma_m (a copy of a facade design tens of metres along the street cannot then
+// pass the gate with its length); beyond, its bearing and heading only.
+TEST(GlobalSlam, AFullCameraPoseIsUsedOnlyWhereTheEstimateTellsAFacadeFromItsCopy) {
+  ::Run r;
+  r.options.loop_closure.confirm_window = 0;
+  r.options.loop_closure.appearance_min_sigma_m = 3.0;
+  r.global = std::make_unique<slam::GlobalSlam>(r.options, r.map, r.stats, r.observers);
+  slam::KeyframeConstraint c;
+  c.z = {1.0, 0, 0};
+  c.cov = Eigen::Vector3d(0.09, 0.09, 1e-6).asDiagonal();  // 0.3 m a step: 0.7 m over 5 steps, 4.2 m over 200
+  for (size_t k = 0; k <= 205; ++k) r.global->addKeyframe({k, static_cast<double>(k), {}, false, true, {}}, io::CompactScan(), c);
+  const auto measured = [](double along_m) {
+    slam::CameraMeasurement m;
+    m.mount = common::Pose2{1.0, 0.0, M_PI / 2};  // looking left; the vehicle drives along x
+    m.relative.valid = true;
+    m.relative.bearing_rad = -M_PI / 2;  // camera b to the right of camera a's view: ahead along x
+    m.relative.cov = Eigen::Vector2d(1e-4, 1e-4).asDiagonal();
+    m.relative.depth_per_baseline = 0.01;
+    m.metric.valid = true;
+    m.metric.pose = common::Pose2{0.0, -along_m, 0.0};
+    m.metric.cov = Eigen::Vector3d(1e-4, 1e-4, 1e-6).asDiagonal();
+    return m;
+  };
+  r.global->proposeImageClosure(200, 205, 1.0, measured(5.0), std::chrono::steady_clock::now());
+  r.global->proposeImageClosure(5, 205, 1.0, measured(200.0), std::chrono::steady_clock::now());
+  const auto& closures = r.global->closures();
+  ASSERT_EQ(closures.size(), 2u);
+  EXPECT_TRUE(closures[0].accepted) << slam::reasonName(closures[0].reason);
+  EXPECT_FALSE(closures[0].bearing_only);
+  // The vehicle-frame measurement is the camera's pose carried through the mount: 5 m along x.
+  EXPECT_NEAR(closures[0].measurement.x, 5.0, 1e-9);
+  EXPECT_NEAR(closures[0].measurement.y, 0.0, 1e-9);
+  EXPECT_TRUE(closures[1].bearing_only);
+}
+
 // A camera-only proposal whose images, at the distance the estimate puts between the cameras,
 // would show a scene beyond max_scene_depth_m is refused before the gate (a copy of a facade 200
 // m further along the street), and the same images between keyframes 5 m apart are not.

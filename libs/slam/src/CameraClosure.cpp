@@ -20,15 +20,21 @@ vision_loop::PinholeCamera pinholeFor(const io::CameraCalibration& c, int image_
 
 esdf::RelativeFactor cameraFactor(const CameraMeasurement& m, const esdf::Vec3& x_i, const esdf::Vec3& x_j) {
   const esdf::Vec3 mount = esdf::toVec(m.mount);
-  const esdf::Vec3 c = esdf::between(esdf::compose(x_i, mount), esdf::compose(x_j, mount));
-  // Where the estimate puts camera j from camera i; at least a metre, so that a revisit the
-  // estimate puts on the same spot does not turn the bearing into an unbounded lateral stiffness.
-  const double range = std::max(1.0, std::hypot(c.x(), c.y()));
-  esdf::BearingHeading bh;
-  bh.bearing_rad = m.relative.bearing_rad;
-  bh.heading_rad = m.relative.heading_rad;
-  bh.information = m.relative.cov.inverse();
-  const esdf::RelativeFactor fc = esdf::relativeFactor(bh, range, esdf::weakRangeSigma(range));
+  esdf::RelativeFactor fc;  // in the cameras' frame
+  if (m.metric.valid) {
+    fc.z = esdf::toVec(m.metric.pose);
+    fc.omega = m.metric.cov.inverse();
+  } else {
+    const esdf::Vec3 c = esdf::between(esdf::compose(x_i, mount), esdf::compose(x_j, mount));
+    // Where the estimate puts camera j from camera i; at least a metre, so that a revisit the
+    // estimate puts on the same spot does not turn the bearing into an unbounded lateral stiffness.
+    const double range = std::max(1.0, std::hypot(c.x(), c.y()));
+    esdf::BearingHeading bh;
+    bh.bearing_rad = m.relative.bearing_rad;
+    bh.heading_rad = m.relative.heading_rad;
+    bh.information = m.relative.cov.inverse();
+    fc = esdf::relativeFactor(bh, range, esdf::weakRangeSigma(range));
+  }
   // m ⊕ e ⊕ ⊖m = Adj(m) e to first order: [R(φm) (y_m, -x_m)'; 0 1].
   const double cs = std::cos(mount.z()), sn = std::sin(mount.z());
   esdf::Mat3 adj;

@@ -304,6 +304,7 @@ LoopClosureRecord LoopCloser::tryCloseMeasured(esdf::Esdf& filter, const Map& ma
   const Eigen::Matrix3d s = relativeCovariance(filter, earlier, current);
   r.prior_sigma_m = esdf::largestPositionSigma(s);
   r.measurement = esdf::toPose(z);
+  r.bearing_only = camera && !camera->metric.valid;
   r.information = information;
   if (camera && nearestSceneDepth(*camera, filter.mean(static_cast<int>(earlier)), filter.mean(static_cast<int>(current)), s) >
                     options_.max_scene_depth_m) {

@@ -4,6 +4,7 @@
 #include <opencv2/core.hpp>
 
 #include "urbanslam/common/Timing.h"
+#include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/slam/Pipeline.h"
 #include "urbanslam/vision_loop/LoopDetector.h"
 #include "urbanslam/vision_loop/PlanarRelativePose.h"
@@ -86,10 +87,53 @@ void Pipeline::attachImage(const AssignedImage& assigned, std::optional<Prepared
   image_cameras_.push_back({im.calibration, im.width});
   if (!r.detected()) return;
   const auto id = [](size_t i) { return static_cast<vision_loop::ImageId>(i); };
-  global_.proposeImageClosure(image_keyframes_[r.match], assigned.keyframe, r.normalized_score,
-                              measureCamera(image_cameras_[r.match], image_detector_->features(id(r.match)), image_cameras_[r.query],
-                                            image_detector_->features(id(r.query))),
-                              handed_over);
+  std::optional<CameraMeasurement> camera = measureCamera(image_cameras_[r.match], image_detector_->features(id(r.match)),
+                                                          image_cameras_[r.query], image_detector_->features(id(r.query)));
+  if (camera && camera->relative.valid) measureLength(r.match, r.query, *camera);
+  global_.proposeImageClosure(image_keyframes_[r.match], assigned.keyframe, r.normalized_score, camera, handed_over);
+}
+
+void Pipeline::measureLength(size_t earlier_image, size_t current_image, CameraMeasurement& m) {
+  esdf::Esdf* filter = map_.filter();
+  if (!options_.image_loop.metric_pose || !filter) return;
+  // The earlier keyframe's neighbour in the same visit: the next image, else the previous, of a
+  // keyframe at most two away, taken by the same camera.
+  const size_t a = image_keyframes_[earlier_image];
+  const auto usable = [&](size_t n) {
+    return n < image_keyframes_.size() && n != current_image && image_cameras_[n].width == image_cameras_[earlier_image].width &&
+           image_cameras_[n].calibration == image_cameras_[earlier_image].calibration &&
+           (image_keyframes_[n] > a ? image_keyframes_[n] - a : a - image_keyframes_[n]) <= 2;
+  };
+  const size_t n = usable(earlier_image + 1)                        ? earlier_image + 1
+                   : earlier_image > 0 && usable(earlier_image - 1) ? earlier_image - 1
+                                                                    : current_image;
+  if (n == current_image) return;
+  // The baseline from the estimate of the two keyframes, its uncertainty along the baseline from
+  // their relative covariance (the odometry between them, mostly).
+  const auto& kf = map_.keyframes();
+  const common::Pose2 ca = common::compose(kf[a].pose, m.mount), cn = common::compose(kf[image_keyframes_[n]].pose, m.mount);
+  const double baseline = std::hypot(cn.x - ca.x, cn.y - ca.y);
+  if (!(baseline > 0)) return;
+  const common::Pose2 rel = common::between(kf[a].pose, kf[image_keyframes_[n]].pose);
+  const Eigen::Matrix3d cov =
+      filter->relativeCovariance(static_cast<int>(a), static_cast<int>(image_keyframes_[n]), esdf::CovarianceMode::Conservative);
+  const double len = std::max(1e-9, std::hypot(rel.x, rel.y));
+  const Eigen::Vector2d dir(rel.x / len, rel.y / len);
+  const double sigma = std::sqrt(std::max(0.0, dir.dot(cov.topLeftCorner<2, 2>() * dir)));
+  const auto& o = options_.image_loop;
+  vision_loop::MetricRelativePoseOptions mo;
+  mo.ratio = o.ratio;
+  mo.floor_forward_m = o.metric_floor_forward_m;
+  mo.floor_left_m = o.metric_floor_left_m;
+  mo.floor_heading_rad = o.metric_floor_heading_deg * M_PI / 180;
+  const auto id = [](size_t i) { return static_cast<vision_loop::ImageId>(i); };
+  const auto& fa = image_detector_->features(id(earlier_image));
+  const auto type = image_detector_->vocabulary().descriptorType();
+  const vision_loop::PinholeCamera k =
+      pinholeFor(*image_cameras_[earlier_image].calibration, image_cameras_[earlier_image].width, fa.image_size.width);
+  const vision_loop::StereoPoints stereo =
+      vision_loop::triangulateWithSecondImage(fa, image_detector_->features(id(n)), type, k, baseline, sigma, mo);
+  m.metric = vision_loop::metricRelativePose(stereo, fa, image_detector_->features(id(current_image)), type, k, mo);
 }
 
 std::optional<CameraMeasurement> Pipeline::measureCamera(const ImageCamera& a, const vision_loop::ImageFeatures& fa, const ImageCamera& b,

@@ -139,9 +139,10 @@ void writeRecord(BinaryWriter& w, const LoopClosureRecord& c) {
   w.f64(c.gate_threshold);
   w.f64(c.free_space_conflict);
   w.f64(c.prior_sigma_m);
+  w.boolean(c.bearing_only);
 }
 
-LoopClosureRecord readRecord(BinaryReader& r, size_t keyframes) {
+LoopClosureRecord readRecord(BinaryReader& r, size_t keyframes, std::uint32_t format_version) {
   LoopClosureRecord c;
   c.from = r.size();
   c.to = r.size();
@@ -162,6 +163,11 @@ LoopClosureRecord readRecord(BinaryReader& r, size_t keyframes) {
   c.gate_threshold = r.f64();
   c.free_space_conflict = r.f64();
   c.prior_sigma_m = r.f64();
+  // Before version 6 every camera closure measured bearing and heading only: those are the image
+  // detections that no scan alignment measured (no alignment residual).
+  c.bearing_only = format_version >= 6 ? r.boolean()
+                                       : c.detector == "image" && c.rms_m == 0 && c.reason != ClosureReason::CameraGeometry &&
+                                             c.reason != ClosureReason::NoScans;
   return c;
 }
 
@@ -531,14 +537,14 @@ void GlobalSlam::writeState(BinaryWriter& w) const {
   w.size(last_full_size_);
 }
 
-void GlobalSlam::readState(BinaryReader& r) {
+void GlobalSlam::readState(BinaryReader& r, std::uint32_t format_version) {
   closer_.readState(r);
   const size_t n = map_.size();
   constexpr size_t kRecordBytes = 2 * 8 + 2 * 8 + 8 + 8 + 2 + 24 + 72 + 5 * 8;
   pending_.clear();
-  for (size_t i = 0, count = r.count(kRecordBytes); i < count; ++i) pending_.push_back(readRecord(r, n));
+  for (size_t i = 0, count = r.count(kRecordBytes); i < count; ++i) pending_.push_back(readRecord(r, n, format_version));
   closures_.clear();
-  for (size_t i = 0, count = r.count(kRecordBytes); i < count; ++i) closures_.push_back(readRecord(r, n));
+  for (size_t i = 0, count = r.count(kRecordBytes); i < count; ++i) closures_.push_back(readRecord(r, n, format_version));
   dirty_since_recovery_ = r.boolean();
   last_full_size_ = r.size();
   // The classifier's keyframe features are not saved: a function of each keyframe's scan,
@@ -655,7 +661,7 @@ void Pipeline::readState(BinaryReader& r, std::uint32_t format_version) {
   }
   {
     BinaryReader s = r.section(kGlobalTag);
-    global_.readState(s);
+    global_.readState(s, format_version);
     s.expectEnd();
   }
   {

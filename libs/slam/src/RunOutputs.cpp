@@ -101,12 +101,13 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   {
     common::AtomicFile f(path("loop_closures.csv"));
     f.stream() << "from_keyframe,to_keyframe,from_time,to_time,detector,score,accepted,reason,x,y,phi,rms_m,mahalanobis2,gate_threshold,"
-                  "free_space_conflict,prior_sigma_m\n";
+                  "free_space_conflict,prior_sigma_m,bearing_only\n";
     char buf[512];
     for (const auto& c : p.loopClosures()) {
-      std::snprintf(buf, sizeof buf, "%zu,%zu,%.6f,%.6f,%s,%.6g,%d,%s,%.6f,%.6f,%.6f,%.6g,%.6g,%.6g,%.4f,%.4g\n", c.from, c.to, c.from_time,
-                    c.to_time, c.detector.c_str(), c.score, c.accepted ? 1 : 0, reasonName(c.reason), c.measurement.x, c.measurement.y,
-                    c.measurement.phi, c.rms_m, c.mahalanobis2, c.gate_threshold, c.free_space_conflict, c.prior_sigma_m);
+      std::snprintf(buf, sizeof buf, "%zu,%zu,%.6f,%.6f,%s,%.6g,%d,%s,%.6f,%.6f,%.6f,%.6g,%.6g,%.6g,%.4f,%.4g,%d\n", c.from, c.to,
+                    c.from_time, c.to_time, c.detector.c_str(), c.score, c.accepted ? 1 : 0, reasonName(c.reason), c.measurement.x,
+                    c.measurement.y, c.measurement.phi, c.rms_m, c.mahalanobis2, c.gate_threshold, c.free_space_conflict, c.prior_sigma_m,
+                    c.bearing_only ? 1 : 0);
       f.stream() << buf;
     }
     f.commit();

@@ -21,6 +21,14 @@ void declareImageLoopOptions(common::OptionsSchema& s, ImageLoopOptions& o) {
   s.add("ratio", o.ratio, 0.1, 1.0, "", "Lowe's ratio test for descriptor matches");
   s.add("ransac_threshold_px", o.ransac_threshold_px, 0.1, 100.0, "px", "max distance to the epipolar line");
   s.add("min_inliers", o.min_inliers, 8, 100000, "matches", "fundamental-matrix inliers needed to accept");
+  s.add("metric_pose", o.metric_pose,
+        "a camera closure measures the full planar pose when the earlier keyframe's neighbouring image gives its features a depth "
+        "(the odometry between them the scale) and the estimate knows the pair within [loop_closure] appearance_min_sigma_m; "
+        "else bearing and heading only");
+  s.add("metric_floor_forward_m", o.metric_floor_forward_m, 0.0, 100.0, "m",
+        "floor on the full pose's standard deviation along the camera's axis (added in quadrature)");
+  s.add("metric_floor_left_m", o.metric_floor_left_m, 0.0, 100.0, "m", "... across it");
+  s.add("metric_floor_heading_deg", o.metric_floor_heading_deg, 0.0, 180.0, "deg", "... and of its heading");
 }
 
 FeatureOptions featureOptions(const ImageLoopOptions& o, DescriptorType type) {

@@ -1,20 +1,25 @@
 #pragma once
-// A Tree of Words proposal measured by the camera alone (thesis ch. 6): the planar relative pose
-// of the two images (vision_loop/PlanarRelativePose.h: the heading change and the bearing of the
-// second camera seen from the first) turned into a relative-pose factor between the two
-// keyframes' vehicle poses. A single camera does not see the length of the translation: the
-// factor is placed at the current estimate's range with a weak range (esdf/BearingHeading.h), so
-// the scale comes from the odometry and from other closures seen from other bearings.
+// A Tree of Words proposal measured by the camera alone (thesis ch. 6), turned into a
+// relative-pose factor between the two keyframes' vehicle poses:
+//  * the full planar pose of the second camera seen from the first, when the earlier keyframe's
+//    neighbouring image gave its features a depth (vision_loop/MetricRelativePose.h: motion
+//    stereo with the odometry's baseline, then perspective-n-point);
+//  * else bearing and heading only (vision_loop/PlanarRelativePose.h): a single pair does not see
+//    the length of the translation, so the factor is placed at the current estimate's range with
+//    a weak range (esdf/BearingHeading.h), and the scale comes from the odometry and from other
+//    closures seen from other bearings.
 #include <optional>
 
 #include "urbanslam/esdf/BearingHeading.h"
 #include "urbanslam/io/Measurements.h"
+#include "urbanslam/vision_loop/MetricRelativePose.h"
 #include "urbanslam/vision_loop/PlanarRelativePose.h"
 
 namespace urbanslam::slam {
 
 struct CameraMeasurement {
   vision_loop::PlanarRelativePose relative;  // camera j seen from camera i
+  vision_loop::MetricRelativePose metric;    // the same with its length, when measured (valid)
   common::Pose2 mount;                       // the camera on the vehicle
 };
 
@@ -22,8 +27,8 @@ struct CameraMeasurement {
 // as delivered, the features may come from a downscaled copy (`width_px` wide).
 vision_loop::PinholeCamera pinholeFor(const io::CameraCalibration& c, int image_width_px, int features_width_px);
 
-// The factor on the vehicle poses x_i, x_j equivalent to the camera's bearing and heading between
-// the cameras x_i ⊕ mount and x_j ⊕ mount: z and Ω for Esdf::observeRelative (error ⊖z ⊕ (⊖x_i ⊕ x_j)).
+// The factor on the vehicle poses x_i, x_j equivalent to the camera's full pose (when valid) or its
+// bearing and heading between the cameras x_i ⊕ mount and x_j ⊕ mount: z and Ω for Esdf::observeRelative (error ⊖z ⊕ (⊖x_i ⊕ x_j)).
 // The camera-frame factor c = ⊖m ⊕ r ⊕ m is carried to r = m ⊕ c ⊕ ⊖m, whose error is the
 // camera-frame error moved by the mount's adjoint (exact to first order in the error).
 esdf::RelativeFactor cameraFactor(const CameraMeasurement& m, const esdf::Vec3& x_i, const esdf::Vec3& x_j);

@@ -65,7 +65,7 @@ class GlobalSlam {
   // full recovery is owed. Read after the map: the laser detector's keyframe features are
   // recomputed from the map's scans. PipelineState.cpp.
   void writeState(common::BinaryWriter& w) const;
-  void readState(common::BinaryReader& r);
+  void readState(common::BinaryReader& r, std::uint32_t format_version);
 
  private:
   enum class Admission { Rejected, Pending, Accepted };

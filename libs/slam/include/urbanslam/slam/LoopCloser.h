@@ -60,6 +60,9 @@ struct LoopClosureRecord {
   double rms_m = 0, mahalanobis2 = 0, gate_threshold = 0;
   double free_space_conflict = 0;  // alignment::mutualFreeSpaceConflict at the measurement
   double prior_sigma_m = 0;        // largest std. deviation of the relative position before the closure
+  // A camera closure that measured bearing and heading only: its translation's length is the
+  // estimate's (CameraClosure.h). Scan alignments and full camera poses measure all three.
+  bool bearing_only = false;
 };
 
 // Appearance similarity of a pair of keyframes (the laser classifier's margin above its
@@ -124,10 +127,10 @@ class LoopCloser {
   // reuses them). The scorer is code: whoever set it sets it again.
   void writeState(common::BinaryWriter& w) const;
   void readState(common::BinaryReader& r);
-
- private:
+  // Covariance of the relative pose ⊖x_i ⊕ x_k (conservative), kept for the current keyframe k.
   Eigen::Matrix3d relativeCovariance(esdf::Esdf& filter, size_t i, size_t k);
 
+ private:
   LoopClosureOptions options_;
   CandidateScorer scorer_;
   double chi2_2dof_;

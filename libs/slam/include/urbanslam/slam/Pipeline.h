@@ -137,6 +137,9 @@ class Pipeline {
   // invalid when the images give none.
   std::optional<CameraMeasurement> measureCamera(const ImageCamera& a, const vision_loop::ImageFeatures& fa, const ImageCamera& b,
                                                  const vision_loop::ImageFeatures& fb) const;
+  // The same closure's full pose (m.metric), when an image next to the earlier one (database ids)
+  // gives its features a depth ([image_loop] metric_pose).
+  void measureLength(size_t earlier_image, size_t current_image, CameraMeasurement& m);
 
   PipelineOptions options_;
   std::vector<PipelineObserver*> observers_;

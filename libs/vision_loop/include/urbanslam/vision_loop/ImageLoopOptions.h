@@ -17,7 +17,7 @@ struct ImageLoopOptions {
   std::string vocabulary;  // empty: share/vision_loop/sift_k10_L4.usvoc
   int max_features = 500;
   int max_image_side_px = 1024;
-  int min_image_side_px = 320;  // smaller images are upscaled before detection
+  int min_image_side_px = 320;        // smaller images are upscaled before detection
   double min_normalized_score = 0.3;  // α
   int exclude_recent_frames = 10;
   int temporal_consistency = 0;
@@ -30,6 +30,14 @@ struct ImageLoopOptions {
   double ratio = 0.8;
   double ransac_threshold_px = 3.0;
   int min_inliers = 20;
+  // A camera closure's full planar pose (MetricRelativePose.h) when the earlier keyframe's
+  // neighbouring image gives its features a depth; else bearing and heading only. The floors:
+  // what the covariance does not show, calibrated on a held-out simulated city
+  // (bench/vision_loop/run_eval.sh).
+  bool metric_pose = true;
+  double metric_floor_forward_m = 0.022;
+  double metric_floor_left_m = 0.012;
+  double metric_floor_heading_deg = 0.2;
 };
 
 // Adds the keys to the schema's current section.
