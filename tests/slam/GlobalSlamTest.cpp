@@ -56,6 +56,15 @@ std::unique_ptr<Run> drive(double late_range_m) {
   return r;
 }
 
+// Global SLAM over keyframes 0..205 a metre apart along x, each step with this covariance.
+void driveStraight(::Run& r, const Eigen::Matrix3d& step_cov) {
+  r.global = std::make_unique<slam::GlobalSlam>(r.options, r.map, r.stats, r.observers);
+  slam::KeyframeConstraint c;
+  c.z = {1.0, 0, 0};
+  c.cov = step_cov;
+  for (size_t k = 0; k <= 205; ++k) r.global->addKeyframe({k, static_cast<double>(k), {}, false, true, {}}, io::CompactScan(), c);
+}
+
 }  // namespace
 
 TEST(GlobalSlam, AClosureAwaitingConfirmationMakesTheNextKeyframesSearchFarFromTheMap) {
@@ -86,11 +95,7 @@ TEST(GlobalSlam, AFullCameraPoseIsUsedOnlyWhereTheEstimateTellsAFacadeFromItsCop
   ::Run r;
   r.options.loop_closure.confirm_window = 0;
   r.options.loop_closure.appearance_min_sigma_m = 3.0;
-  r.global = std::make_unique<slam::GlobalSlam>(r.options, r.map, r.stats, r.observers);
-  slam::KeyframeConstraint c;
-  c.z = {1.0, 0, 0};
-  c.cov = Eigen::Vector3d(0.09, 0.09, 1e-6).asDiagonal();  // 0.3 m a step: 0.7 m over 5 steps, 4.2 m over 200
-  for (size_t k = 0; k <= 205; ++k) r.global->addKeyframe({k, static_cast<double>(k), {}, false, true, {}}, io::CompactScan(), c);
+  driveStraight(r, Eigen::Vector3d(0.09, 0.09, 1e-6).asDiagonal());  // 0.3 m a step: 0.7 m over 5 steps, 4.2 m over 200
   const auto measured = [](double along_m) {
     slam::CameraMeasurement m;
     m.mount = common::Pose2{1.0, 0.0, M_PI / 2};  // looking left; the vehicle drives along x
@@ -122,11 +127,7 @@ TEST(GlobalSlam, ACameraClosureWhoseSceneWouldLieBeyondTheCamerasReachIsRefused)
   ::Run r;
   r.options.loop_closure.max_scene_depth_m = 150;
   r.options.loop_closure.confirm_window = 0;
-  r.global = std::make_unique<slam::GlobalSlam>(r.options, r.map, r.stats, r.observers);
-  slam::KeyframeConstraint c;
-  c.z = {1.0, 0, 0};
-  c.cov = Eigen::Vector3d(1e-4, 1e-4, 1e-6).asDiagonal();  // 1 cm per metre: 0.14 m after 200 m
-  for (size_t k = 0; k <= 205; ++k) r.global->addKeyframe({k, static_cast<double>(k), {}, false, true, {}}, io::CompactScan(), c);
+  driveStraight(r, Eigen::Vector3d(1e-4, 1e-4, 1e-6).asDiagonal());  // 1 cm per metre: 0.14 m after 200 m
   slam::CameraMeasurement m;
   m.mount = common::Pose2{1.0, 0.0, M_PI / 2};  // looking left; the vehicle drives along x
   m.relative.valid = true;

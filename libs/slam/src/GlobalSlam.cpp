@@ -239,6 +239,11 @@ void GlobalSlam::recoverAll() {
   for (auto* o : observers_) o->onPosesUpdated(e);
 }
 
+bool GlobalSlam::allowsFullCameraPose(size_t earlier, size_t current) {
+  esdf::Esdf* f = map_.filter();
+  return f && esdf::largestPositionSigma(closer_.relativeCovariance(*f, earlier, current)) <= options_.loop_closure.appearance_min_sigma_m;
+}
+
 void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double score, const std::optional<CameraMeasurement>& camera,
                                      SteadyTime handed_over) {
   ++stats_.image_proposals;
@@ -258,13 +263,8 @@ void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double scor
     if (scans) {
       r = closer_.tryClose(f, map_, earlier, current, !confirm, &detection);
     } else {
-      // The full pose only where the estimate can tell a facade from a copy of its design further
-      // along the street (tens of metres): a copy's bearing and heading are the place's own, so
-      // a bearing-heading closure to it holds, but its length would pull the map onto the copy.
       CameraMeasurement m = *camera;
-      if (m.metric.valid &&
-          esdf::largestPositionSigma(closer_.relativeCovariance(f, earlier, current)) > options_.loop_closure.appearance_min_sigma_m)
-        m.metric.valid = false;
+      if (m.metric.valid && !allowsFullCameraPose(earlier, current)) m.metric.valid = false;
       const esdf::RelativeFactor factor = cameraFactor(m, f.mean(static_cast<int>(earlier)), f.mean(static_cast<int>(current)));
       r = closer_.tryCloseMeasured(f, map_, earlier, current, factor.z, factor.omega, !confirm, detection, &m);
     }

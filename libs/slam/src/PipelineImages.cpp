@@ -89,7 +89,10 @@ void Pipeline::attachImage(const AssignedImage& assigned, std::optional<Prepared
   const auto id = [](size_t i) { return static_cast<vision_loop::ImageId>(i); };
   std::optional<CameraMeasurement> camera = measureCamera(image_cameras_[r.match], image_detector_->features(id(r.match)),
                                                           image_cameras_[r.query], image_detector_->features(id(r.query)));
-  if (camera && camera->relative.valid) measureLength(r.match, r.query, *camera);
+  // The full pose is measured only where global SLAM would use it (a tenth of the proposals of a
+  // camera run: most come after drift), as it costs two more feature matchings and a PnP.
+  if (camera && camera->relative.valid && global_.allowsFullCameraPose(image_keyframes_[r.match], assigned.keyframe))
+    measureLength(r.match, r.query, *camera);
   global_.proposeImageClosure(image_keyframes_[r.match], assigned.keyframe, r.normalized_score, camera, handed_over);
 }
 

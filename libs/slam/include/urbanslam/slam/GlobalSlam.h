@@ -44,6 +44,12 @@ class GlobalSlam {
   // Loop closures of keyframe `current` with earlier ones, when [loop_closure] asks for it now.
   // `handed_over`: when local SLAM handed the keyframe over, for the correction's latency.
   void closeLoops(size_t current, SteadyTime handed_over);
+  // Whether a camera closure between the two keyframes may measure the full pose: where the
+  // estimate knows their relative position within [loop_closure] appearance_min_sigma_m (largest
+  // sigma), so that a copy of a facade design tens of metres along the street cannot pass the
+  // gate with its length (a copy's bearing and heading are the place's own: a bearing-heading
+  // closure to it holds). Beyond, bearing and heading only.
+  bool allowsFullCameraPose(size_t earlier, size_t current);
   // A Tree of Words proposal between two keyframes, through alignment, gating and confirmation
   // when both have scans, else through gating and confirmation with the camera's relative pose
   // (`camera`: when both images are calibrated; invalid when the images gave none); otherwise
