@@ -157,8 +157,9 @@ MetricRelativePose metricRelativePose(const StereoPoints& stereo, const ImageFea
     const double step = std::max(1e-5, std::sqrt(stereo.direction_cov(k, k)));
     const double bearing = stereo.bearing_rad + (k == 0 ? step : 0), heading = stereo.heading_rad + (k == 1 ? step : 0);
     std::vector<PlanarPnpPoint> moved = points;
+    // A point whose rays no longer meet there keeps its position (intersect leaves it untouched).
     for (size_t i = 0; i < moved.size(); ++i)
-      intersect(stereo.seen_a[used[i]], stereo.seen_a2[used[i]], bearing, heading, stereo.baseline_m, &moved[i].x_a);  // kept if not
+      intersect(stereo.seen_a[used[i]], stereo.seen_a2[used[i]], bearing, heading, stereo.baseline_m, &moved[i].x_a);
     const PlanarPnpFit f = fitPlanarPnp(moved, fit.pose, pixel);
     if (!f.converged) {
       r.failure_reason = "unstable under the second image's direction";
