@@ -14,25 +14,14 @@ namespace {
 
 Eigen::Vector2d normalised(const cv::Point2f& p, const PinholeCamera& k) { return {(p.x - k.cx) / k.fx, (p.y - k.cy) / k.fy}; }
 
-// The point where the rays of a (through xa) and of a2 (through x2) come closest, in a's frame:
-// the midpoint of their closest points. a2 sits at baseline * (-sin β, 0, cos β), turned by θ
-// (PlanarEpipolar.h). False when the rays are parallel or meet behind either camera.
+// The point where the rays of a (through xa) and of a2 (through x2) come closest, in a's frame
+// (PlanarEpipolar.h, meetRays). False when the rays are parallel or meet behind either camera.
 bool intersect(const Eigen::Vector2d& xa, const Eigen::Vector2d& x2, double bearing, double heading, double baseline, Eigen::Vector3d* out,
                double* parallax = nullptr) {
-  const Eigen::Vector3d c(-baseline * std::sin(bearing), 0, baseline * std::cos(bearing));
-  Eigen::Matrix3d rt;  // R_y(θ)'
-  rt << std::cos(heading), 0, -std::sin(heading), 0, 1, 0, std::sin(heading), 0, std::cos(heading);
-  const Eigen::Vector3d da(xa.x(), xa.y(), 1.0), d2 = rt * Eigen::Vector3d(x2.x(), x2.y(), 1.0);
-  Eigen::Matrix<double, 3, 2> m;
-  m.col(0) = da;
-  m.col(1) = -d2;
-  const Eigen::Matrix2d normal = m.transpose() * m;
-  const double det = normal.determinant();
-  if (!(det > 1e-12 * normal.trace() * normal.trace())) return false;
-  const Eigen::Vector2d lambda = normal.inverse() * (m.transpose() * c);
-  if (!(lambda(0) > 0 && lambda(1) > 0)) return false;
-  *out = 0.5 * (lambda(0) * da + c + lambda(1) * d2);
-  if (parallax) *parallax = std::acos(std::clamp(da.normalized().dot(d2.normalized()), -1.0, 1.0));
+  const auto meeting = meetRays(xa, x2, bearing, heading, baseline);
+  if (!meeting || !(meeting->depth_a > 0 && meeting->along_b > 0)) return false;
+  *out = meeting->midpoint;
+  if (parallax) *parallax = meeting->parallax_rad;
   return true;
 }
 

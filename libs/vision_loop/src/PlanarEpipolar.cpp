@@ -149,25 +149,35 @@ PlanarEpipolarFit fitPlanarEpipolar(const std::vector<Eigen::Vector2d>& a, const
   return fit;
 }
 
+std::optional<RayMeeting> meetRays(const Eigen::Vector2d& xa, const Eigen::Vector2d& xb, double bearing_rad, double heading_rad,
+                                   double baseline) {
+  // X_a = λ_a d_a = c + λ_b R' d_b (X_b = R (X_a - c)): two unknowns, three equations.
+  const Eigen::Vector3d c(-baseline * std::sin(bearing_rad), 0, baseline * std::cos(bearing_rad));
+  const Eigen::Vector3d da = homogeneous(xa), db = rotationY(heading_rad).transpose() * homogeneous(xb);
+  Eigen::Matrix<double, 3, 2> m;
+  m.col(0) = da;
+  m.col(1) = -db;
+  const Eigen::Matrix2d normal = m.transpose() * m;
+  const double det = normal.determinant();
+  if (!(det > 1e-12 * normal.trace() * normal.trace())) return std::nullopt;
+  const Eigen::Vector2d lambda = normal.inverse() * (m.transpose() * c);
+  RayMeeting r;
+  r.depth_a = lambda(0);  // z of λ_a d_a: d_a's z is 1
+  r.along_b = lambda(1);
+  r.midpoint = 0.5 * (lambda(0) * da + c + lambda(1) * db);
+  r.parallax_rad = std::acos(std::clamp(da.normalized().dot(db.normalized()), -1.0, 1.0));
+  return r;
+}
+
 double sceneDepthPerBaseline(const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b, double bearing_rad,
                              double heading_rad) {
   const size_t n = std::min(a.size(), b.size());
   if (n == 0) return std::numeric_limits<double>::infinity();
-  // X_a = λ_a d_a = c + λ_b R' d_b (X_b = R (X_a - c)): two unknowns, three equations.
-  const Eigen::Vector3d c(-std::sin(bearing_rad), 0, std::cos(bearing_rad));
-  const Eigen::Matrix3d rt = rotationY(heading_rad).transpose();
-  std::vector<double> depth(n);
+  std::vector<double> depth(n, std::numeric_limits<double>::infinity());
   for (size_t i = 0; i < n; ++i) {
-    Eigen::Matrix<double, 3, 2> m;
-    m.col(0) = homogeneous(a[i]);
-    m.col(1) = -(rt * homogeneous(b[i]));
-    const Eigen::Matrix2d normal = m.transpose() * m;
-    const double det = normal.determinant();
-    depth[i] = std::numeric_limits<double>::infinity();
     // Parallel rays (no parallax) meet nowhere: the scene point is as far as the baseline allows.
-    if (!(det > 1e-12 * normal.trace() * normal.trace())) continue;
-    const Eigen::Vector2d lambda = normal.inverse() * (m.transpose() * c);
-    if (lambda(0) > 0 && lambda(1) > 0) depth[i] = lambda(0);  // z of λ_a d_a: d_a's z is 1
+    const auto meeting = meetRays(a[i], b[i], bearing_rad, heading_rad, 1.0);
+    if (meeting && meeting->depth_a > 0 && meeting->along_b > 0) depth[i] = meeting->depth_a;
   }
   std::nth_element(depth.begin(), depth.begin() + static_cast<long>(n / 4), depth.end());
   return depth[n / 4];

@@ -12,6 +12,7 @@
 // covariance is the first-order one, σ² (J'WJ)⁻¹, with the pixel noise σ estimated from the
 // residuals. With two parameters instead of the essential matrix's five, the level camera's
 // constraint is used, not only read off.
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -42,6 +43,19 @@ struct PlanarEpipolarFit {
 // (normalised units), so that a perfect fit of few points does not claim exactness.
 PlanarEpipolarFit fitPlanarEpipolar(const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b, double bearing_rad,
                                     double heading_rad, double min_sigma = 0, int max_iterations = 50);
+
+// Where the ray of camera a through xa and the ray of camera b through xb (normalised image
+// coordinates) come closest, b sitting at `baseline` along (β, θ) as above: the two rays'
+// parameters (X = depth_a (xa, 1) on a's ray, c + along_b R' (xb, 1) on b's), the midpoint of the
+// two closest points and the angle between the rays, in a's frame. Nothing when the rays are
+// parallel; a point behind a camera has a parameter of 0 or less.
+struct RayMeeting {
+  double depth_a = 0, along_b = 0;
+  Eigen::Vector3d midpoint = Eigen::Vector3d::Zero();
+  double parallax_rad = 0;
+};
+std::optional<RayMeeting> meetRays(const Eigen::Vector2d& xa, const Eigen::Vector2d& xb, double bearing_rad, double heading_rad,
+                                   double baseline);
 
 // How far the scene the two images share lies, per metre between the cameras: the lower quartile,
 // over the correspondences, of the depth along camera a's optical axis at which the two rays meet
