@@ -61,6 +61,8 @@ int trainLaserLoopCommand(const Argv& args) {
   // Off by default: measured worse on held-out logs (SubmapScan.h).
   ap.addOption("submap-window", "M", "features of a virtual 360° scan from the scans of the last M metres of odometry (0: each scan alone)",
                "0");
+  ap.addOption("features", "all|thesis",
+               "what the stumps may compare: every feature and descriptor distance (all), or the thesis's twenty features (thesis)", "all");
   ap.addOption("factor", "F", "strong-classifier factor stored in the model (eq. 3.30)", "0.5");
   ap.addOption("seed", "N", "random seed for pair sampling and fold split", "1");
   ap.addFlag("quiet", "no progress bars");
@@ -81,6 +83,9 @@ int trainLaserLoopCommand(const Argv& args) {
   if (lo.submap_window_m < 0) throw common::InputError("--submap-window must be >= 0");
   if (!(lo.params.r_max_m > 0) || !(lo.params.g_max_dist_m > 0) || lo.params.g_min_size < 0)
     throw common::InputError("--r-max and --g-max-dist must be > 0, --g-min-size >= 0");
+  const std::string feature_set = ap.option("features");
+  if (feature_set != "all" && feature_set != "thesis") throw common::InputError("--features must be all or thesis");
+  const int comparisons = feature_set == "all" ? laser_loop::kComparisonCount : laser_loop::kThesisFeatureCount;
   const laser_loop::PairRules rules = pairRulesFrom(ap);
   const int folds = static_cast<int>(ap.optionInt("folds"));
   const int t_max = static_cast<int>(ap.optionInt("t-max"));
@@ -115,7 +120,7 @@ int trainLaserLoopCommand(const Argv& args) {
       std::cerr << path << ": " << s.scans.size() << " scans, " << np << " positive and " << p.size() - np << " negative pairs\n";
     pairs.insert(pairs.end(), p.begin(), p.end());
   }
-  const laser_loop::PairTable table = laser_loop::makePairTable(sets, pairs);
+  const laser_loop::PairTable table = laser_loop::makePairTable(sets, pairs, comparisons);
   size_t n_pos = 0;
   for (auto y : table.y) n_pos += y;
   if (n_pos == 0 || n_pos == table.size())

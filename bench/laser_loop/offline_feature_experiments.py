@@ -28,7 +28,7 @@ _cache = {}
 def load(name):
     if name not in _cache:
         rows = list(csv.DictReader(open(f'{FEAT_DIR}/feat-{name}/features.csv')))
-        keys = [k for k in rows[0] if k not in ('log', 'scan', 'timestamp', 'x', 'y', 'phi')]
+        keys = [k for k in rows[0] if k not in ('log', 'scan', 'timestamp', 'x', 'y', 'phi')][:20]  # the thesis's twenty
         F = [[float(r[k]) for k in keys] for r in rows]
         P = [(float(r['x']), float(r['y']), float(r['phi'])) for r in rows]
         R = []

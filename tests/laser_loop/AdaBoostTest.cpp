@@ -72,7 +72,7 @@ TEST(AdaBoost, FollowsAlgorithm1ExactlyByHand) {
   const auto& r1 = trainer.rounds()[0];
   const std::vector<double> w1 = {0.125, 0.125, 0.125, 0.125, 0.25, 0.25};
   for (size_t i = 0; i < 6; ++i) EXPECT_DOUBLE_EQ(r1.normalised_weights[i], w1[i]) << i;
-  EXPECT_EQ(r1.chosen.stump.feature, 0);
+  EXPECT_EQ(r1.chosen.stump.comparison, 0);
   EXPECT_EQ(r1.chosen.stump.polarity, 1);
   EXPECT_DOUBLE_EQ(r1.chosen.stump.threshold, 0.4);
   EXPECT_DOUBLE_EQ(r1.error, 0.125);
@@ -85,7 +85,7 @@ TEST(AdaBoost, FollowsAlgorithm1ExactlyByHand) {
   const auto& r2 = trainer.rounds()[1];
   const std::vector<double> w2 = {1.0 / 14, 1.0 / 14, 1.0 / 14, 0.5, 1.0 / 7, 1.0 / 7};
   for (size_t i = 0; i < 6; ++i) EXPECT_NEAR(r2.normalised_weights[i], w2[i], 1e-15) << i;
-  EXPECT_EQ(r2.chosen.stump.feature, 0);
+  EXPECT_EQ(r2.chosen.stump.comparison, 0);
   EXPECT_EQ(r2.chosen.stump.polarity, -1);
   EXPECT_NEAR(r2.chosen.stump.threshold, 0.85, 1e-15);
   EXPECT_NEAR(r2.error, 3.0 / 14, 1e-15);

@@ -6,6 +6,7 @@
 #include "TestPaths.h"
 #include "urbanslam/common/Error.h"
 #include "urbanslam/laser_loop/ClassifierModel.h"
+#include "urbanslam/laser_loop/Comparisons.h"
 
 using namespace urbanslam;
 using namespace urbanslam::laser_loop;
@@ -34,6 +35,8 @@ std::string modelWith(const std::string& from, const std::string& to) {
   return t.replace(at, from.size(), to);
 }
 
+std::string featuresLine() { return "features " + std::to_string(kFeatureCount); }
+
 std::string errorOf(const std::string& text) {
   try {
     parseModel(text, "m.model");
@@ -61,7 +64,7 @@ TEST(ClassifierModel, SaveLoadRoundTripIsExact) {
   EXPECT_EQ(r.provenance, m.provenance);
   ASSERT_EQ(r.classifier.size(), 2u);
   for (size_t i = 0; i < 2; ++i) {
-    EXPECT_EQ(r.classifier.stumps()[i].stump.feature, m.classifier.stumps()[i].stump.feature);
+    EXPECT_EQ(r.classifier.stumps()[i].stump.comparison, m.classifier.stumps()[i].stump.comparison);
     EXPECT_EQ(r.classifier.stumps()[i].stump.threshold, m.classifier.stumps()[i].stump.threshold);  // bit-exact
     EXPECT_EQ(r.classifier.stumps()[i].stump.polarity, m.classifier.stumps()[i].stump.polarity);
     EXPECT_EQ(r.classifier.stumps()[i].alpha, m.classifier.stumps()[i].alpha);
@@ -88,12 +91,41 @@ TEST(ClassifierModel, MalformedFilesGiveClearErrors) {
   EXPECT_NE(errorOf(modelWith("r_max_m 27.5\n", "")).find("missing required key(s): r_max_m"), std::string::npos);
   EXPECT_NE(errorOf(modelWith("factor", "fudge")).find("unknown key 'fudge'"), std::string::npos);
   EXPECT_NE(errorOf(modelWith("stumps 2", "stumps 3")).find("'stumps 3' declared but 2 stump lines"), std::string::npos);
-  EXPECT_NE(errorOf(modelWith("stump area", "stump areal")).find("unknown feature 'areal'"), std::string::npos);
+  EXPECT_NE(errorOf(modelWith("stump area", "stump areal")).find("unknown feature or distance 'areal'"), std::string::npos);
   EXPECT_NE(errorOf(modelWith(" +1 ", " +2 ")).find("polarity must be +1 or -1"), std::string::npos);
-  EXPECT_NE(errorOf(modelWith("features 20 area", "features 20 size")).find("different feature set"), std::string::npos);
+  EXPECT_NE(errorOf(modelWith(featuresLine() + " area", featuresLine() + " size")).find("different feature set"), std::string::npos);
+  EXPECT_NE(errorOf(modelWith(featuresLine(), "features 500")).find("the model has 500 features"), std::string::npos);
   EXPECT_NE(errorOf(modelWith("end\n", "end\nstump area 1 +1 1\n")).find("text after 'end'"), std::string::npos);
   // The line number points at the culprit.
   EXPECT_NE(errorOf(modelWith("g_min_size 4", "g_min_size 4.5")).find("m.model:5:"), std::string::npos);
+}
+
+// Features are only appended, so a model that lists the thesis's twenty (written before the shape
+// descriptors existed) still loads; a stump on something its list lacks does not.
+TEST(ClassifierModel, OlderModelsListAPrefixOfTheFeatures) {
+  std::string thesis = "features " + std::to_string(kThesisFeatureCount);
+  for (int i = 0; i < kThesisFeatureCount; ++i) thesis += std::string(" ") + featureName(i);
+  std::string full = featuresLine();
+  for (int i = 0; i < kFeatureCount; ++i) full += std::string(" ") + featureName(i);
+  const ClassifierModel old = parseModel(modelWith(full, thesis), "m.model");
+  EXPECT_EQ(old.classifier.size(), 2u);
+  EXPECT_NE(errorOf(modelWith(full + "\nstumps 2\nstump area", thesis + "\nstumps 2\nstump range_q50")).find("does not list"),
+            std::string::npos);
+  EXPECT_NE(errorOf(modelWith(full + "\nstumps 2\nstump area", thesis + "\nstumps 2\nstump range_hist_l1")).find("does not list"),
+            std::string::npos);
+}
+
+// A distance stump (Comparisons.h) is saved by name and read back as the same comparison.
+TEST(ClassifierModel, DistanceStumpsRoundTrip) {
+  ClassifierModel m = sample();
+  m.classifier = StrongClassifier({{{kFeatureCount + static_cast<int>(Distance::RangeHistogramChi2), 0.25, 1}, 1.5},
+                                   {{kThesisFeatureCount + kShapeQuantiles, 3.0, -1}, 0.5}});
+  const std::string text = modelToText(m);
+  EXPECT_NE(text.find("stump range_hist_chi2 0.25 +1 1.5"), std::string::npos);
+  EXPECT_NE(text.find("stump range_q05 3 -1 0.5"), std::string::npos);
+  const ClassifierModel r = parseModel(text, "m.model");
+  EXPECT_EQ(r.classifier.stumps()[0].stump.comparison, kFeatureCount + 2);
+  EXPECT_EQ(r.classifier.stumps()[1].stump.comparison, kThesisFeatureCount + kShapeQuantiles);
 }
 
 TEST(ClassifierModel, MissingFileNamesThePath) {

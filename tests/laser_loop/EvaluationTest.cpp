@@ -108,6 +108,52 @@ TEST(TrainingPairs, LabelsFromCorrectedLogExcerpt) {
     }
 }
 
+// Distance stumps are screened from the descriptor's feature columns, in single precision: the
+// same votes as the pair scores in double precision.
+TEST(LoopDetector, ScreenAgreesWithPairScoresOnDistances) {
+  ClassifierModel m;
+  const int l1 = kFeatureCount + static_cast<int>(Distance::RangeHistogramL1);
+  const int chi2 = kFeatureCount + static_cast<int>(Distance::RangeHistogramChi2);
+  const int wq = kFeatureCount + static_cast<int>(Distance::RangeQuantileL1);
+  const int hist = kThesisFeatureCount + kShapeHistogram;
+  m.classifier = StrongClassifier({{{l1, 0.6, 1}, 1.0}, {{chi2, 0.2, 1}, 2.0}, {{wq, 9.0, -1}, 0.5}, {{hist + 3, 0.05, 1}, 0.7}});
+  LoopDetector det(m);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0, 1);
+  auto descriptor = [&]() {
+    FeatureVector f{};
+    f[0] = 1 + u(rng);  // a feature the model does not use
+    double sum = 0;
+    for (int k = 0; k < kHistogramBins; ++k) sum += f[hist + k] = u(rng) * u(rng);
+    for (int k = 0; k < kHistogramBins; ++k) f[hist + k] /= sum;
+    for (int k = 0; k < kRangeQuantiles; ++k) f[kThesisFeatureCount + kShapeQuantiles + k] = 2 * k + u(rng);
+    return f;
+  };
+  std::vector<FeatureVector> kept;
+  for (int i = 0; i < 3000; ++i) det.addKeyframe(kept.emplace_back(descriptor()));
+  const FeatureVector q = descriptor();
+  // The detector keeps only the features its model reads, and scores exactly as the classifier
+  // does on the whole vectors.
+  for (size_t i = 0; i < 50; ++i) {
+    EXPECT_EQ(det.score(q, i), m.classifier.score(q, kept[i]));
+    EXPECT_EQ(det.score(i, i + 1), m.classifier.score(kept[i], kept[i + 1]));
+    const FeatureVector back = det.keyframe(i);
+    EXPECT_EQ(back[hist + 3], kept[i][hist + 3]);
+    EXPECT_EQ(back[static_cast<size_t>(kThesisFeatureCount + kShapeQuantiles)], kept[i][kThesisFeatureCount + kShapeQuantiles]);
+    EXPECT_EQ(back[0], 0.0);  // not used by the model: not kept
+  }
+  EXPECT_THROW(det.keyframe(3000), std::out_of_range);
+  std::vector<float> s;
+  det.screen(q, s);
+  ASSERT_EQ(s.size(), 3000u);
+  std::set<double> seen;
+  for (size_t i = 0; i < s.size(); ++i) {
+    EXPECT_NEAR(s[i], det.score(q, i), 1e-6) << i;
+    seen.insert(std::round(det.score(q, i) * 1e6));
+  }
+  EXPECT_GE(seen.size(), 6u);  // the stumps vote differently across the keyframes
+}
+
 TEST(LoopDetector, ScreenAgreesWithPairScores) {
   ClassifierModel m;
   m.classifier = StrongClassifier({{{0, 1.0, 1}, 1.0}, {{1, 0.5, 1}, 2.0}, {{0, 3.0, -1}, 0.5}});

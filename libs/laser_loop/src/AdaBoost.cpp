@@ -22,9 +22,9 @@ AdaBoostTrainer::AdaBoostTrainer(const PairTable& data, std::vector<uint32_t> su
                              std::to_string(n_neg) + " negative)");
   w_.assign(data.size(), 0.0);
   for (uint32_t i : subset_) w_[i] = data.y[i] ? 1.0 / (2.0 * n_pos) : 1.0 / (2.0 * n_neg);
-  // c does not change between rounds, only the weights: sort once per feature.
-  order_.resize(kFeatureCount);
-  for (int f = 0; f < kFeatureCount; ++f) {
+  // c does not change between rounds, only the weights: sort once per comparison.
+  order_.resize(static_cast<size_t>(data.comparisons));
+  for (int f = 0; f < data.comparisons; ++f) {
     order_[f] = subset_;
     const auto& c = data.c[f];
     std::stable_sort(order_[f].begin(), order_[f].end(), [&c](uint32_t a, uint32_t b) { return c[a] < c[b]; });
@@ -39,17 +39,17 @@ bool AdaBoostTrainer::round() {
   double sum = 0;
   for (uint32_t i : subset_) sum += w_[i];
   for (uint32_t i : subset_) w_[i] /= sum;
-  // 3–4: best stump over all features (3.28); ties keep the lowest feature index.
+  // 3–4: best stump over all comparisons (3.28); ties keep the lowest index.
   StumpFit best;
   best.error = 2.0;
-  for (int f = 0; f < kFeatureCount; ++f) {
+  for (int f = 0; f < data_.comparisons; ++f) {
     const StumpFit fit = fitStump(data_, f, order_[f], w_);
     if (fit.error < best.error) best = fit;
   }
   // ε from the chosen stump's own decisions, exactly Σ W̃ |c − y|.
   double eps = 0;
   for (uint32_t i : subset_) {
-    const bool e = best.stump.match(data_.c[best.stump.feature][i]) != (data_.y[i] != 0);
+    const bool e = best.stump.match(data_.c[best.stump.comparison][i]) != (data_.y[i] != 0);
     if (e) eps += w_[i];
   }
   BoostRound r;
@@ -69,7 +69,7 @@ bool AdaBoostTrainer::round() {
   // 5: W_{t+1} = W̃_t β^{1 − e_i}: correctly classified pairs are scaled down.
   if (eps > 0) {
     for (uint32_t i : subset_) {
-      const bool e = best.stump.match(data_.c[best.stump.feature][i]) != (data_.y[i] != 0);
+      const bool e = best.stump.match(data_.c[best.stump.comparison][i]) != (data_.y[i] != 0);
       if (!e) w_[i] *= beta;
     }
   } else {

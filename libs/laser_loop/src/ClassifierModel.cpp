@@ -1,5 +1,7 @@
 #include "urbanslam/laser_loop/ClassifierModel.h"
 
+#include "urbanslam/laser_loop/Comparisons.h"
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -86,8 +88,8 @@ std::string modelToText(const ClassifierModel& m) {
   os << "\n";
   os << "stumps " << m.classifier.size() << "\n";
   for (const auto& s : m.classifier.stumps())
-    os << "stump " << featureName(s.stump.feature) << " " << num(s.stump.threshold) << " " << (s.stump.polarity > 0 ? "+1" : "-1") << " "
-       << num(s.alpha) << "\n";
+    os << "stump " << comparisonName(s.stump.comparison) << " " << num(s.stump.threshold) << " " << (s.stump.polarity > 0 ? "+1" : "-1")
+       << " " << num(s.alpha) << "\n";
   os << "end\n";
   return os.str();
 }
@@ -113,6 +115,7 @@ ClassifierModel parseModel(const std::string& text, const std::string& source) {
   std::string line;
   size_t ln = 0;
   bool have_magic = false, have_features = false, have_end = false;
+  int listed_features = 0;
   bool have_r = false, have_g = false, have_s = false, have_b = false, have_factor = false;
   long declared_stumps = -1;
   std::vector<WeightedStump> stumps;
@@ -193,13 +196,16 @@ ClassifierModel parseModel(const std::string& text, const std::string& source) {
     } else if (key == "features") {
       if (f.size() < 2) p.fail(ln, "'features' needs a count");
       const long n = p.integer(f[1], ln, "feature count");
-      if (n != kFeatureCount || f.size() != static_cast<size_t>(n) + 2)
+      // A model lists the features of the build that trained it. Features are only ever appended
+      // (the thesis's twenty first), so an older model's list is a prefix of this build's.
+      if (n < 1 || n > kFeatureCount || f.size() != static_cast<size_t>(n) + 2)
         p.fail(ln, "the model has " + f[1] + " features; this build computes " + std::to_string(kFeatureCount));
-      for (int i = 0; i < kFeatureCount; ++i)
+      for (int i = 0; i < n; ++i)
         if (f[static_cast<size_t>(i) + 2] != featureName(i))
           p.fail(ln, "feature " + std::to_string(i) + " is '" + f[static_cast<size_t>(i) + 2] + "', this build has '" + featureName(i) +
                          "' (a model from a different feature set)");
       have_features = true;
+      listed_features = static_cast<int>(n);
     } else if (key == "stumps") {
       need(2);
       declared_stumps = p.integer(f[1], ln, "stump count");
@@ -207,8 +213,8 @@ ClassifierModel parseModel(const std::string& text, const std::string& source) {
       if (declared_stumps < 0) p.fail(ln, "'stump' before 'stumps <count>'");
       need(5);
       WeightedStump s;
-      s.stump.feature = featureIndex(f[1]);
-      if (s.stump.feature < 0) p.fail(ln, "unknown feature '" + f[1] + "'");
+      s.stump.comparison = comparisonIndex(f[1]);
+      if (s.stump.comparison < 0) p.fail(ln, "unknown feature or distance '" + f[1] + "'");
       s.stump.threshold = p.number(f[2], ln, "threshold");
       if (f[3] == "+1" || f[3] == "1")
         s.stump.polarity = 1;
@@ -240,6 +246,16 @@ ClassifierModel parseModel(const std::string& text, const std::string& source) {
   if (static_cast<long>(stumps.size()) != declared_stumps)
     p.fail(ln, "'stumps " + std::to_string(declared_stumps) + "' declared but " + std::to_string(stumps.size()) + " stump lines found");
   if (stumps.empty()) p.fail(ln, "the model has no stumps");
+  for (const auto& s : stumps) {
+    const int k = s.stump.comparison;
+    int needs = k + 1;
+    if (k >= kFeatureCount) {
+      const FeatureRange r = distanceFeatures(static_cast<Distance>(k - kFeatureCount));
+      needs = r.begin + r.count;
+    }
+    if (needs > listed_features)
+      p.fail(ln, std::string("stump on '") + comparisonName(k) + "', which needs features the model's 'features' line does not list");
+  }
   m.classifier = StrongClassifier(std::move(stumps));
   return m;
 }

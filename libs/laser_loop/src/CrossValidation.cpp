@@ -44,7 +44,7 @@ CvCurve crossValidate(const PairTable& data, const CvOptions& opt) {
         if (t < stumps.size()) {
           const auto& s = stumps[t];
           total += s.alpha;
-          if (s.stump.match(data.c[s.stump.feature][i])) vote += s.alpha;
+          if (s.stump.match(data.c[s.stump.comparison][i])) vote += s.alpha;
           decided = vote >= opt.factor * total && total > 0;
         }
         if (data.y[i] && !decided) ++cv.missed[t];

@@ -8,26 +8,26 @@ namespace urbanslam::laser_loop {
 
 namespace {
 
-constexpr const char* kNames[kFeatureCount] = {"area",
-                                               "average_range",
-                                               "mean_centroid",
-                                               "clamped_centroid",
-                                               "close_area",
-                                               "close_distance",
-                                               "circularity_residual",
-                                               "circularity_radius",
-                                               "curvature_mean",
-                                               "curvature_std",
-                                               "distance",
-                                               "far_distance",
-                                               "group_count",
-                                               "group_mean_size",
-                                               "max_range_count",
-                                               "mean_angular_difference",
-                                               "mean_deviation",
-                                               "regularity",
-                                               "size",
-                                               "std_range"};
+constexpr const char* kNames[kThesisFeatureCount] = {"area",
+                                                     "average_range",
+                                                     "mean_centroid",
+                                                     "clamped_centroid",
+                                                     "close_area",
+                                                     "close_distance",
+                                                     "circularity_residual",
+                                                     "circularity_radius",
+                                                     "curvature_mean",
+                                                     "curvature_std",
+                                                     "distance",
+                                                     "far_distance",
+                                                     "group_count",
+                                                     "group_mean_size",
+                                                     "max_range_count",
+                                                     "mean_angular_difference",
+                                                     "mean_deviation",
+                                                     "regularity",
+                                                     "size",
+                                                     "std_range"};
 
 // The beams as unit vectors plus ranges: the hot path for regular scans reuses cached cos/sin
 // tables, merged scans compute them once.
@@ -68,6 +68,8 @@ FeatureVector compute(const Beams& b, const FeatureParams& p) {
   // Per-beam data in one pass: short flag, clamped point (far beams at r_max) and short point.
   thread_local std::vector<double> xs, ys;  // clamped points
   thread_local std::vector<uint8_t> sh;     // short beams
+  thread_local std::vector<double> rc;      // clamped ranges
+  rc.resize(n);
   xs.resize(n);
   ys.resize(n);
   sh.resize(n);
@@ -78,6 +80,7 @@ FeatureVector compute(const Beams& b, const FeatureParams& p) {
     const bool is_short = b.valid[i] && b.r[i] < rmax;
     const double r = is_short ? b.r[i] : rmax;
     sh[i] = is_short;
+    rc[i] = r;
     xs[i] = r * b.c[i];
     ys[i] = r * b.s[i];
     sum_clamped_r += r;
@@ -243,6 +246,7 @@ FeatureVector compute(const Beams& b, const FeatureParams& p) {
       f[int(Feature::CircularityRadius)] = degenerate ? 0.0 : std::sqrt(std::max(0.0, c0 + a * a + bb * bb));
     }
   }
+  computeShapeFeatures(rc.data(), xs.data(), ys.data(), sh.data(), n, rmax, f.data() + kThesisFeatureCount);
   if (p.log_features)
     for (double& v : f) v = std::copysign(std::log1p(std::fabs(v)), v);
   return f;
@@ -254,14 +258,17 @@ bool coversCircle(size_t n, double increment) { return static_cast<double>(n) * 
 
 const char* featureName(Feature f) {
   const int i = static_cast<int>(f);
-  return i >= 0 && i < kFeatureCount ? kNames[i] : "?";
+  if (i >= 0 && i < kThesisFeatureCount) return kNames[i];
+  return shapeFeatureName(i - kThesisFeatureCount);
 }
 
 int featureIndex(const std::string& name) {
   for (int i = 0; i < kFeatureCount; ++i)
-    if (name == kNames[i]) return i;
+    if (name == featureName(i)) return i;
   return -1;
 }
+
+bool coversFullCircle(const io::LaserScan& scan) { return scan.size() > 0 && coversCircle(scan.size(), scan.angle_increment_rad); }
 
 PolarScan toPolar(const io::LaserScan& scan) {
   PolarScan p;

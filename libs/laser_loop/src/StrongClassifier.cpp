@@ -6,15 +6,15 @@
 namespace urbanslam::laser_loop {
 
 StrongClassifier::StrongClassifier(std::vector<WeightedStump> stumps) : stumps_(std::move(stumps)) {
-  std::vector<int> slot(kFeatureCount, -1);
-  std::vector<std::vector<std::pair<double, double>>> plus, minus;  // (threshold, α) per feature
+  std::vector<int> slot(kComparisonCount, -1);
+  std::vector<std::vector<std::pair<double, double>>> plus, minus;  // (threshold, α) per comparison
   for (const auto& s : stumps_) {
     alpha_total_ += s.alpha;
-    int& k = slot[s.stump.feature];
+    int& k = slot[s.stump.comparison];
     if (k < 0) {
       k = static_cast<int>(votes_.size());
       votes_.push_back({});
-      votes_.back().feature = s.stump.feature;
+      votes_.back().comparison = s.stump.comparison;
       plus.emplace_back();
       minus.emplace_back();
     }
@@ -50,7 +50,9 @@ double StrongClassifier::score(const FeatureVector& a, const FeatureVector& b) c
   const double* thr = thr_.data();
   const double* alpha = alpha_.data();
   for (const auto& v : votes_) {
-    const double c = std::fabs(a[v.feature] - b[v.feature]);
+    // A feature's difference inline (the thesis's stumps, most of a model); distances by call.
+    const size_t k = static_cast<size_t>(v.comparison);
+    const double c = v.comparison < kFeatureCount ? std::fabs(a[k] - b[k]) : compare(a, b, v.comparison);
     // +1 stumps vote when c < threshold: all but the first i, i = #thresholds <= c.
     uint32_t i = 0;
     for (uint32_t k = 0; k < v.plus_count; ++k) i += thr[v.plus_begin + k] <= c;

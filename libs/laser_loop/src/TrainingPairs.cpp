@@ -205,9 +205,10 @@ std::vector<LabelledPair> samplePairs(const ScanSet& set, uint32_t set_index, co
   return out;
 }
 
-PairTable makePairTable(const std::vector<ScanSet>& sets, const std::vector<LabelledPair>& pairs) {
+PairTable makePairTable(const std::vector<ScanSet>& sets, const std::vector<LabelledPair>& pairs, int comparisons) {
   PairTable t;
-  for (int f = 0; f < kFeatureCount; ++f) t.c[f].reserve(pairs.size());
+  t.comparisons = comparisons;
+  for (int k = 0; k < comparisons; ++k) t.c[k].reserve(pairs.size());
   t.y.reserve(pairs.size());
   for (const auto& p : pairs) t.add(sets[p.set].scans[p.a].features, sets[p.set].scans[p.b].features, p.match);
   return t;

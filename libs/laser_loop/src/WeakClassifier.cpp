@@ -5,12 +5,12 @@
 namespace urbanslam::laser_loop {
 
 void PairTable::add(const FeatureVector& a, const FeatureVector& b, bool match) {
-  for (int f = 0; f < kFeatureCount; ++f) c[f].push_back(std::fabs(a[f] - b[f]));
+  for (int k = 0; k < comparisons; ++k) c[k].push_back(compare(a, b, k));
   y.push_back(match ? 1 : 0);
 }
 
-StumpFit fitStump(const PairTable& data, int feature, const std::vector<uint32_t>& order, const std::vector<double>& w) {
-  const auto& c = data.c[feature];
+StumpFit fitStump(const PairTable& data, int comparison, const std::vector<uint32_t>& order, const std::vector<double>& w) {
+  const auto& c = data.c[comparison];
   double w_pos = 0, w_neg = 0;
   for (uint32_t i : order) (data.y[i] ? w_pos : w_neg) += w[i];
   const double total = w_pos + w_neg;
@@ -36,8 +36,8 @@ StumpFit fitStump(const PairTable& data, int feature, const std::vector<uint32_t
       threshold = c[order[n - 1]] + 1.0;
     else
       threshold = c[order[k - 1]] + 0.5 * (c[order[k]] - c[order[k - 1]]);
-    if (err_plus < best.error) best = {{feature, threshold, 1}, err_plus};
-    if (err_minus < best.error) best = {{feature, threshold, -1}, err_minus};
+    if (err_plus < best.error) best = {{comparison, threshold, 1}, err_plus};
+    if (err_minus < best.error) best = {{comparison, threshold, -1}, err_minus};
   }
   return best;
 }

@@ -14,14 +14,15 @@
 //   submap_window_m 10                           (optional; absent: 0, each scan alone)
 //   factor 0.5
 //   provenance <key> <value to end of line>      (any number)
-//   features 20 area average_range ...
-//   stumps 2
+//   features 79 area average_range ... range_q95  (a prefix of this build's list: older models list 20)
+//   stumps 3
 //   stump area 1.25 +1 0.693147
 //   stump size 14.5 -1 0.405465
+//   stump range_quantile_l1 30.5 +1 1.2           (a distance, Comparisons.h)
 //   end
 //
-// Loading is strict: an unknown key, a missing required key, a feature set that differs from
-// this build's, a bad number, a stump count that does not match or a missing `end` (a truncated
+// Loading is strict: an unknown key, a missing required key, a feature list that is not a prefix
+// of this build's, a stump on a feature the list lacks, a bad number, a stump count that does not match or a missing `end` (a truncated
 // file) each throw common::InputError naming the file and line.
 #include <string>
 #include <utility>

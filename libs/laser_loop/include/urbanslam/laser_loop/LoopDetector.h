@@ -5,7 +5,8 @@
 //
 // Storage is one float column per feature the classifier uses, so screening a large map is a
 // streaming pass: each stump becomes "is the keyframe's feature within ±threshold of the
-// query's", evaluated on blocks of keyframes held in cache. screen() works in single precision;
+// query's", evaluated on blocks of keyframes held in cache. A distance stump (Comparisons.h)
+// reads a column of distances computed once per screen from its descriptor's feature columns. screen() works in single precision;
 // its decisions can differ from the double-precision score() only for a |Δf| within float
 // rounding of a threshold.
 #include <cstddef>
@@ -14,11 +15,14 @@
 
 #include "urbanslam/io/LaserScan.h"
 #include "urbanslam/laser_loop/ClassifierModel.h"
+#include "urbanslam/laser_loop/Comparisons.h"
 
 namespace urbanslam::laser_loop {
 
-// The trained default model, relative to the project home (the repo, or $URBANSLAM_HOME).
+// The trained default models, relative to the project home (the repo, or $URBANSLAM_HOME): one for
+// any laser, and one trained on lasers that see all around (share/laser_loop/README.md).
 constexpr const char* kDefaultModelPath = "share/laser_loop/default.model";
+constexpr const char* kDefault360ModelPath = "share/laser_loop/default-360.model";
 
 class LoopDetector {
  public:
@@ -38,15 +42,19 @@ class LoopDetector {
   FeatureVector features(const std::vector<io::LaserScan>& scans) const {
     return scans.size() == 1 ? features(scans[0]) : computeFeatures(mergeScans(scans, model_.params.beam_increment_deg), model_.params);
   }
-  // Stores a keyframe; ids are 0, 1, 2, ... in insertion order.
+  // Stores a keyframe; ids are 0, 1, 2, ... in insertion order. Only the features the model
+  // uses are kept (a thesis model: 20 of them), so a map of 10⁶ keyframes holds what it needs.
   size_t addKeyframe(const io::LaserScan& scan) { return addKeyframe(features(scan)); }
   size_t addKeyframe(const FeatureVector& f);
-  size_t size() const { return keyframes_.size(); }
-  const FeatureVector& keyframe(size_t id) const { return keyframes_.at(id); }
+  size_t size() const { return count_; }
+  // A stored keyframe's features: those the model uses, the others 0.
+  FeatureVector keyframe(size_t id) const;
   void reserve(size_t n);
 
   // Normalised vote Σα_t c_t / Σα_t of the pair (query, keyframe id), in [0, 1].
   double score(const FeatureVector& query, size_t id) const;
+  // The same for two stored keyframes (the query is keyframe query_id).
+  double score(size_t query_id, size_t id) const;
 
   struct Match {
     size_t id = 0;
@@ -61,7 +69,8 @@ class LoopDetector {
 
  private:
   struct CompiledStump {
-    int column = 0;
+    int column = 0;     // a feature's column, or
+    int distance = -1;  // >= 0: a distance's slot in distances_
     float threshold = 0;
     float alpha = 0;
     int polarity = 1;
@@ -70,9 +79,16 @@ class LoopDetector {
   double factor_ = 0.5;
   double alpha_total_ = 0;
   std::vector<int> used_features_;  // column c holds feature used_features_[c]
+  struct UsedDistance {
+    Distance distance;
+    std::vector<int> columns;  // its features' columns, in the descriptor's order
+  };
+  std::vector<UsedDistance> distances_;
   std::vector<CompiledStump> stumps_;
-  std::vector<std::vector<float>> columns_;
-  std::vector<FeatureVector> keyframes_;
+  std::vector<std::vector<float>> columns_;  // per used feature, single precision: the screen
+  std::vector<double> stored_;               // per keyframe, its used features in double: score
+  size_t count_ = 0;
+  void fillUsed(size_t id, FeatureVector& f) const;  // writes keyframe id's used features into f
 };
 
 }  // namespace urbanslam::laser_loop

@@ -1,7 +1,8 @@
 #pragma once
-// The 20 rotation-invariant scalar features of a laser scan (thesis §3.2.1, eqs 3.6–3.24). Each
-// is a pure function of one scan and the three gates r_max, g_max_dist and g_min_size; a loop
-// closure is then decided from the differences of two scans' features (WeakClassifier.h).
+// The 20 rotation-invariant scalar features of a laser scan (thesis §3.2.1, eqs 3.6–3.24), followed
+// by the shape descriptors of ShapeFeatures.h. Each is a pure function of one scan and the gates
+// r_max, g_max_dist and g_min_size; a loop closure is then decided from comparisons of two scans'
+// features (Comparisons.h, WeakClassifier.h).
 //
 // Conventions shared by all features (the thesis leaves them implicit):
 //  * A beam is "short" when it is a real return with r < r_max. No-return beams count as
@@ -19,6 +20,7 @@
 #include <vector>
 
 #include "urbanslam/io/LaserScan.h"
+#include "urbanslam/laser_loop/ShapeFeatures.h"
 
 namespace urbanslam::laser_loop {
 
@@ -63,11 +65,13 @@ enum class Feature : int {
   Size,                   // 3.22–3.23
   StdRange,               // 3.24
 };
-constexpr int kFeatureCount = 20;
+constexpr int kThesisFeatureCount = 20;
+// The thesis's twenty, then the shape descriptors of ShapeFeatures.h (index kThesisFeatureCount + i).
+constexpr int kFeatureCount = kThesisFeatureCount + kShapeFeatureCount;
 
 using FeatureVector = std::array<double, kFeatureCount>;
 
-// Stable names used in model files and CSV headers ("area", "average_range", ...).
+// Stable names used in model files and CSV headers ("area", "average_range", ..., "extent_major", ...).
 const char* featureName(Feature f);
 inline const char* featureName(int i) { return featureName(static_cast<Feature>(i)); }
 // Index of a feature name; -1 when unknown.
@@ -86,6 +90,8 @@ struct PolarScan {
 
 // From a LaserScan in the sensor frame. A scan is closed when N · increment reaches 360°.
 PolarScan toPolar(const io::LaserScan& scan);
+// Whether the scan's beams cover the full circle (N · increment within half a beam of 360°).
+bool coversFullCircle(const io::LaserScan& scan);
 
 // Several lasers of one vehicle (e.g. front + back) merged into one polar scan about the vehicle
 // origin: every return is moved into the vehicle frame, re-expressed as (range, bearing) and the

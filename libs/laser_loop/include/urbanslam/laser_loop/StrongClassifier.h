@@ -34,12 +34,12 @@ class StrongClassifier {
   bool match(const FeatureVector& a, const FeatureVector& b, double factor = 0.5) const { return score(a, b) >= factor; }
 
  private:
-  // score() form: per feature used, its stumps' thresholds sorted, with the α sums of the stumps
+  // score() form: per comparison used, its stumps' thresholds sorted, with the α sums of the stumps
   // that vote "match" above (polarity +1) or below (polarity −1) each cut. A vote is then one
-  // |Δf| and a branch-free count of thresholds per feature (stump outcomes are coin flips to a
+  // comparison and a branch-free count of thresholds per comparison (stump outcomes are coin flips to a
   // branch predictor), with everything in flat arrays.
   struct FeatureVotes {
-    int feature = 0;
+    int comparison = 0;
     uint32_t plus_begin = 0, plus_count = 0;    // into thr_; alpha_ has plus_count + 1 entries
     uint32_t minus_begin = 0, minus_count = 0;  // into thr_; alpha_ has minus_count + 1 entries
     uint32_t plus_alpha = 0, minus_alpha = 0;   // into alpha_

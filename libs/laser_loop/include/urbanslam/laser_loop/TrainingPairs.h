@@ -89,7 +89,7 @@ struct LabelledPair {
 // order. Deterministic for a given seed.
 std::vector<LabelledPair> samplePairs(const ScanSet& set, uint32_t set_index, const PairRules& rules);
 
-// The |Δf| table for AdaBoost (row i = pairs[i]).
-PairTable makePairTable(const std::vector<ScanSet>& sets, const std::vector<LabelledPair>& pairs);
+// The comparison table for AdaBoost (row i = pairs[i]), its first `comparisons` columns.
+PairTable makePairTable(const std::vector<ScanSet>& sets, const std::vector<LabelledPair>& pairs, int comparisons = kComparisonCount);
 
 }  // namespace urbanslam::laser_loop
