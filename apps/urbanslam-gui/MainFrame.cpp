@@ -440,8 +440,7 @@ void MainFrame::showError(const std::string& message) {
 
 bool MainFrame::openLog(const std::string& path) {
   try {
-    auto worker = std::make_unique<PipelineWorker>(path, options_.ini, slam::defaultLaserModelPath(options_.home),
-                                                   slam::defaultVocabularyPath(options_.home));
+    auto worker = std::make_unique<PipelineWorker>(path, options_.ini, options_.home);
     worker_.reset();  // the previous run's thread ends first
     localizer_.reset();
     worker_ = std::move(worker);

@@ -15,13 +15,13 @@ using test::waitFor;
 namespace {
 const std::string kLog = test::repoPath("rawlogs/intel-corrected-excerpt.log.gz");
 const std::string kIni = test::repoPath("ini/default.ini");
-// The classifier model the ini leaves to the default, found as the GUI finds it (in its home).
-const std::string kModel = slam::defaultLaserModelPath(test::repoPath(""));
+// The project home, whose shipped classifiers the ini leaves to the default (the GUI's home).
+const std::string kHome = test::repoPath("");
 
 }  // namespace
 
 TEST(PipelineWorker, StartsPausedAndStepsOneKeyframeAtATime) {
-  gui::PipelineWorker w(kLog, kIni, kModel);
+  gui::PipelineWorker w(kLog, kIni, kHome);
   std::this_thread::sleep_for(50ms);
   EXPECT_EQ(w.collector().snapshot().keyframes.size(), 0u);  // nothing runs before play/step
   for (size_t k = 1; k <= 3; ++k) {
@@ -32,7 +32,7 @@ TEST(PipelineWorker, StartsPausedAndStepsOneKeyframeAtATime) {
 }
 
 TEST(PipelineWorker, PlayRunsToTheEndLikeTheBatchPipeline) {
-  gui::PipelineWorker w(kLog, kIni, kModel);
+  gui::PipelineWorker w(kLog, kIni, kHome);
   w.play();
   ASSERT_TRUE(waitFor([&] { return w.finished(); }));
   const auto snap = w.collector().snapshot();
@@ -52,7 +52,7 @@ TEST(PipelineWorker, PlayRunsToTheEndLikeTheBatchPipeline) {
 }
 
 TEST(PipelineWorker, PauseStopsProgress) {
-  gui::PipelineWorker w(kLog, kIni, kModel);
+  gui::PipelineWorker w(kLog, kIni, kHome);
   w.setSpeed(50);  // 50x real time: the 270 s excerpt takes seconds, long enough to pause
   w.play();
   ASSERT_TRUE(waitFor([&] { return w.collector().snapshot().keyframes.size() >= 2; }));

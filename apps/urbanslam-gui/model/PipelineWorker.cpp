@@ -4,12 +4,10 @@
 
 namespace urbanslam::gui {
 
-PipelineWorker::PipelineWorker(const std::string& log_path, const std::string& ini_path, const std::string& default_laser_model,
-                               const std::string& default_vocabulary)
-    : log_path_(log_path), ini_path_(ini_path), default_laser_model_(default_laser_model) {
+PipelineWorker::PipelineWorker(const std::string& log_path, const std::string& ini_path, const std::string& home)
+    : log_path_(log_path), ini_path_(ini_path) {
   slam::PipelineOptions options = slam::loadPipelineOptions(ini_path, &resolved_ini_);
-  if (options.loop_closure.laser_model.empty()) options.loop_closure.laser_model = default_laser_model_;
-  if (options.image_loop.vocabulary.empty()) options.image_loop.vocabulary = default_vocabulary;
+  if (!home.empty()) slam::resolveDefaultPaths(options, home);
   source_ = io::openDataSource(log_path);
   format_ = source_->format();
   pipeline_ = std::make_unique<slam::Pipeline>(options);

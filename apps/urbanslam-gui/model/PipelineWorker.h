@@ -16,10 +16,9 @@ namespace urbanslam::gui {
 class PipelineWorker {
  public:
   // Opens the log and the ini; throws common::InputError with the CLI's message on bad input.
-  // `default_laser_model`: the classifier used when the ini names none ([loop_closure] laser_model);
-  // `default_vocabulary`: the same for the Tree of Words vocabulary ([image_loop] vocabulary).
-  PipelineWorker(const std::string& log_path, const std::string& ini_path, const std::string& default_laser_model = "",
-                 const std::string& default_vocabulary = "");
+  // `home`: the project home whose shipped classifiers and vocabulary are used where the ini
+  // names none (slam::resolveDefaultPaths); empty: the library's own defaults.
+  PipelineWorker(const std::string& log_path, const std::string& ini_path, const std::string& home = "");
   ~PipelineWorker();
 
   void play() { runner_.play(); }
@@ -46,7 +45,7 @@ class PipelineWorker {
   // Global SLAM may run behind on a thread of its own: paused or exporting, the map is whole.
   void waitForGlobalSlam();
 
-  std::string log_path_, ini_path_, resolved_ini_, format_, default_laser_model_;
+  std::string log_path_, ini_path_, resolved_ini_, format_;
   std::unique_ptr<io::DataSource> source_;
   // Before the pipeline: global SLAM's thread calls the collector until the pipeline is gone.
   SnapshotCollector collector_;

@@ -20,20 +20,26 @@ GlobalSlam::GlobalSlam(const PipelineOptions& options, Map& map, PipelineStats& 
   if (options_.loop_closure.enabled && options_.loop_closure.detector == LoopClosureOptions::Detector::Laser) {
     // The AdaBoost classifier adds candidates where the estimate is too uncertain to pick them. Its
     // score is the margin above the model's decision factor (eq. 3.30), so laser_threshold = 0
-    // is the model's own operating point. A configured model is read now, so that a bad file
-    // stops the run before it starts; without one, the shipped model is read at the first use.
-    if (!options_.loop_closure.laser_model.empty())
-      laser_detector_ = std::make_unique<laser_loop::LoopDetector>(laser_loop::LoopDetector::fromFile(options_.loop_closure.laser_model));
+    // is the model's own operating point. Configured models are read now, so that a bad file
+    // stops the run before it starts; which one is used (laserModelFor: whether the laser sees
+    // all around) is decided at the first use, from the first keyframe's scan.
+    for (const std::string* path : {&options_.loop_closure.laser_model, &options_.loop_closure.laser_model_360})
+      if (!path->empty()) laser_loop::loadModel(*path);
     closer_.setScorer([this](size_t earlier, size_t current) {
       laser_loop::LoopDetector& d = laserDetector();
-      return d.score(d.keyframe(current), earlier) - d.factor();
+      return d.score(current, earlier) - d.factor();
     });
   }
 }
 
 laser_loop::LoopDetector& GlobalSlam::laserDetector() {
-  if (!laser_detector_)
-    laser_detector_ = std::make_unique<laser_loop::LoopDetector>(laser_loop::LoopDetector::fromFile(laser_loop::kDefaultModelPath));
+  if (!laser_detector_) {
+    size_t first = 0;
+    while (first + 1 < map_.size() && !map_.keyframes()[first].hasScan()) ++first;
+    const io::LaserScan scan = map_.size() > 0 ? map_.scan(first) : io::LaserScan{};
+    laser_detector_ =
+        std::make_unique<laser_loop::LoopDetector>(laser_loop::LoopDetector::fromFile(laserModelFor(options_.loop_closure, scan)));
+  }
   // Features are a function of each keyframe's scan, computed once, when first needed (the
   // indoor logs never need them; a resumed run computes them from the saved scans).
   for (size_t k = laser_detector_->size(); k < map_.size(); ++k) laser_detector_->addKeyframe(map_.scan(k));

@@ -2,6 +2,7 @@
 
 #include "urbanslam/common/IniFile.h"
 #include "urbanslam/laser_loop/LoopDetector.h"
+#include "urbanslam/laser_loop/ScanFeatures.h"
 #include "urbanslam/vision_loop/ImageLoopOptions.h"
 
 namespace urbanslam::slam {
@@ -74,6 +75,8 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
       "where the pose is too uncertain to pick the candidates (appearance_min_sigma_m); none: the nearest to the estimate only; laser: the "
       "AdaBoost classifier's detections among every keyframe within reach as well");
   s.add("laser_model", o.loop_closure.laser_model, {}, "laser classifier model; empty: share/laser_loop/default.model");
+  s.add("laser_model_360", o.loop_closure.laser_model_360, {},
+        "laser classifier model for a laser whose scans cover the full circle; empty: share/laser_loop/default-360.model");
   s.add("appearance_min_sigma_m", o.loop_closure.appearance_min_sigma_m, 0.0, 1000.0, "m",
         "detector = laser: the classifier adds candidates once the pose relative to the nearest keyframe is this uncertain (1 sigma; from "
         "the estimate's guess, alignment reaches a few metres)");
@@ -209,10 +212,21 @@ std::string optionsToIni(const PipelineOptions& options) {
 
 std::string defaultLaserModelPath(const std::string& home) { return home + "/" + laser_loop::kDefaultModelPath; }
 
+std::string defaultLaser360ModelPath(const std::string& home) { return home + "/" + laser_loop::kDefault360ModelPath; }
+
+std::string laserModelFor(const LoopClosureOptions& options, const io::LaserScan& scan) {
+  // A scan of the whole circle has the whole place in its range distribution; the model trained
+  // on such scans tells places apart that the general one confuses (share/laser_loop/README.md).
+  if (laser_loop::coversFullCircle(scan))
+    return options.laser_model_360.empty() ? laser_loop::kDefault360ModelPath : options.laser_model_360;
+  return options.laser_model.empty() ? laser_loop::kDefaultModelPath : options.laser_model;
+}
+
 std::string defaultVocabularyPath(const std::string& home) { return home + "/" + vision_loop::kDefaultVocabularyPath; }
 
 void resolveDefaultPaths(PipelineOptions& options, const std::string& home) {
   if (options.loop_closure.laser_model.empty()) options.loop_closure.laser_model = defaultLaserModelPath(home);
+  if (options.loop_closure.laser_model_360.empty()) options.loop_closure.laser_model_360 = defaultLaser360ModelPath(home);
   if (options.image_loop.vocabulary.empty()) options.image_loop.vocabulary = defaultVocabularyPath(home);
 }
 

@@ -59,8 +59,7 @@ void SessionJoiner::appearanceFixes(size_t k, const io::LaserScan& scan) {
   const LoopClosureOptions& lc = s.loop_closure;
   const Map& map = s.map;
   if (!s.detector) {
-    s.detector = std::make_unique<laser_loop::LoopDetector>(
-        laser_loop::LoopDetector::fromFile(lc.laser_model.empty() ? laser_loop::kDefaultModelPath : lc.laser_model));
+    s.detector = std::make_unique<laser_loop::LoopDetector>(laser_loop::LoopDetector::fromFile(laserModelFor(lc, scan)));
     s.detector->reserve(map.size());
     for (size_t i = 0; i < map.size(); ++i) s.detector->addKeyframe(map.scan(i));
   }

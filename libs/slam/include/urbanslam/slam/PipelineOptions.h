@@ -5,6 +5,7 @@
 #include <string>
 
 #include "urbanslam/common/OptionsSchema.h"
+#include "urbanslam/io/LaserScan.h"
 #include "urbanslam/slam/MovingPoints.h"
 #include "urbanslam/vision_loop/ImageLoopOptions.h"
 
@@ -76,6 +77,7 @@ struct LoopClosureOptions {
   // (appearance_min_sigma_m): none, or laser (the AdaBoost classifier's detections).
   enum class Detector { None, Laser } detector = Detector::Laser;
   std::string laser_model;              // classifier model file; empty = share/laser_loop/default.model
+  std::string laser_model_360;          // the same for a laser that covers the full circle; empty = share/laser_loop/default-360.model
   double appearance_min_sigma_m = 3.0;  // detector = laser: the classifier adds candidates beyond this pose uncertainty
   double laser_threshold = 0.0;         // strong-classifier margin offset (higher: fewer false alarms)
   // Image proposals (Tree of Words, [image_loop]) go through the same alignment, gating and
@@ -215,10 +217,15 @@ PipelineOptions parsePipelineOptions(const std::string& ini_text, const std::str
 std::string optionsToIni(const PipelineOptions& options);
 
 // The shipped data files under the project home (the repository, or $URBANSLAM_HOME), in one
-// place for every program: the laser classifier's model and the Tree of Words vocabulary.
+// place for every program: the laser classifier's models and the Tree of Words vocabulary.
 std::string defaultLaserModelPath(const std::string& home);
+std::string defaultLaser360ModelPath(const std::string& home);
 std::string defaultVocabularyPath(const std::string& home);
-// Fills an empty [loop_closure] laser_model and [image_loop] vocabulary with those.
+// Fills an empty [loop_closure] laser_model, laser_model_360 and [image_loop] vocabulary with those.
 void resolveDefaultPaths(PipelineOptions& options, const std::string& home);
+// The classifier for a laser whose scans look like `scan`: laser_model_360 when they cover the
+// full circle, laser_model otherwise; an empty one is the shipped model's path relative to the
+// working directory (laser_loop::kDefaultModelPath, kDefault360ModelPath).
+std::string laserModelFor(const LoopClosureOptions& options, const io::LaserScan& scan);
 
 }  // namespace urbanslam::slam
