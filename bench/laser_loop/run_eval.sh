@@ -27,10 +27,14 @@ VP_RULES="--d-pos 3 --d-neg 10 --min-travel 20"
 
 log "train: indoor (intel, aces, csail, fr079)"
 $U train-laser-loop $INDOOR_TRAIN --out "$OUT/indoor.model" --plots "$OUT/cv-indoor" --quiet --json > "$OUT/train-indoor.json"
+log "train: indoor, the thesis's twenty features only (--features thesis)"
+$U train-laser-loop $INDOOR_TRAIN --features thesis --out "$OUT/indoor-thesis.model" --quiet --json > "$OUT/train-indoor-thesis.json"
 log "train: indoor, log-scale features (--log-features 1), measured against the plain indoor model"
 $U train-laser-loop $INDOOR_TRAIN --log-features 1 --out "$OUT/indoor-log.model" --quiet --json > "$OUT/train-indoor-log.json"
 log "train: indoor, virtual 360° scans from the last 5 m of odometry (--submap-window 5)"
 $U train-laser-loop $INDOOR_TRAIN --submap-window 5 --out "$OUT/indoor-submap5.model" --quiet --json > "$OUT/train-indoor-submap5.json"
+log "train: the five real logs of the default model, every comparison (no simulated city)"
+$U train-laser-loop $INDOOR_TRAIN $CAMPUS --out "$OUT/real.model" --quiet --json > "$OUT/train-real.json"
 log "train: outdoor (Freiburg campus)"
 $U train-laser-loop $CAMPUS --out "$OUT/campus.model" --plots "$OUT/cv-campus" --quiet --json > "$OUT/train-campus.json"
 
@@ -48,6 +52,8 @@ evaluate indoor-submap5-on-campus "$OUT/indoor-submap5.model" $CAMPUS
 evaluate indoor-submap5-on-heldout-indoor "$OUT/indoor-submap5.model" $INDOOR_HELDOUT
 evaluate indoor-on-campus-heading30 "$OUT/indoor.model" --max-heading-diff 30 $CAMPUS
 evaluate indoor-on-heldout-indoor "$OUT/indoor.model" $INDOOR_HELDOUT
+evaluate indoor-thesis-on-campus "$OUT/indoor-thesis.model" $CAMPUS
+evaluate indoor-thesis-on-heldout-indoor "$OUT/indoor-thesis.model" $INDOOR_HELDOUT
 evaluate indoor-on-victoria-park "$OUT/indoor.model" $VP_RULES $VP
 evaluate campus-on-indoor "$OUT/campus.model" $INDOOR_TRAIN
 evaluate campus-on-indoor-heading30 "$OUT/campus.model" --max-heading-diff 30 $INDOOR_TRAIN
@@ -55,13 +61,25 @@ evaluate campus-on-victoria-park "$OUT/campus.model" $VP_RULES $VP
 evaluate default-on-heldout-indoor share/laser_loop/default.model $INDOOR_HELDOUT
 evaluate default-on-heldout-indoor-heading30 share/laser_loop/default.model --max-heading-diff 30 $INDOOR_HELDOUT
 evaluate default-on-victoria-park share/laser_loop/default.model $VP_RULES $VP
+evaluate real-on-heldout-indoor "$OUT/real.model" $INDOOR_HELDOUT
+evaluate real-on-victoria-park "$OUT/real.model" $VP_RULES $VP
 # The evaluation city of bench/scale (seed 1, never trained on), 4 km² and 5 km of driving, with
-# the front 180° laser and with the 360° one.
+# the front 180° laser and with the 360° one; two more held-out cities (seeds 6 and 7) with the
+# 360° laser for the 360° model.
+city() {  # city SEED FOV
+  local name=city-seed$1-fov$2
+  sed -e "s/^seed .*/seed = $1/" -e "s/^area_km2 .*/area_km2 = 4/" -e "s/^route_length_km .*/route_length_km = 5/" \
+    -e "s/^fov_deg .*/fov_deg = $2/" ini/city-1km2.ini > "$OUT/$name.ini"
+  [ -f "$OUT/$name/city.rawlog" ] || $U simulate --quiet --ini "$OUT/$name.ini" --out "$OUT/$name" > /dev/null
+  echo "$OUT/$name/city.rawlog"
+}
 for fov in 180 360; do
-  sed -e "s/^area_km2 .*/area_km2 = 4/" -e "s/^route_length_km .*/route_length_km = 5/" -e "s/^fov_deg .*/fov_deg = $fov/" \
-    ini/city-1km2.ini > "$OUT/city-fov$fov.ini"
-  [ -f "$OUT/city-fov$fov/city.rawlog" ] || $U simulate --quiet --ini "$OUT/city-fov$fov.ini" --out "$OUT/city-fov$fov" > /dev/null
-  evaluate default-on-city-fov$fov share/laser_loop/default.model "$OUT/city-fov$fov/city.rawlog"
+  evaluate default-on-city-fov$fov share/laser_loop/default.model "$(city 1 $fov)"
+  evaluate default-360-on-city-fov$fov share/laser_loop/default-360.model "$(city 1 $fov)"
+  evaluate real-on-city-fov$fov "$OUT/real.model" "$(city 1 $fov)"
+done
+for seed in 6 7; do
+  evaluate default-360-on-city-seed$seed-fov360 share/laser_loop/default-360.model "$(city $seed 360)"
 done
 # Close-pair protocol (positives within 1 m with no minimum travel, so consecutive scans count —
 # the "scans very close together" positives attributed to the ICRA 2009 paper), any heading and
@@ -84,7 +102,7 @@ for f in sorted(os.listdir(out)):
     print(f"{f[:-5]:42s} {d['positives']:6d} {d['negatives']:6d} | {p(d['detection_at_fa_0'])} {p(d['detection_at_fa_0.001']):>8s} {p(d['detection_at_fa_0.01'])} | "
           f"{p(d['baseline_detection_at_fa_0'])} {p(d['baseline_detection_at_fa_0.01'])} | "
           f"{p(d['same_side'].get('detection_at_fa_0', 0))} {p(d['same_side'].get('detection_at_fa_0.01', 0))} | {p(r['detection_heading_gt_90'])} {p(r['detection_heading_lt_30'])}  ({r['pairs_heading_gt_90']}/{r['pairs_heading_lt_30']})")
-for f in ('train-indoor.json', 'train-indoor-log.json', 'train-indoor-submap5.json', 'train-campus.json'):
+for f in ('train-indoor.json', 'train-indoor-thesis.json', 'train-real.json', 'train-indoor-log.json', 'train-indoor-submap5.json', 'train-campus.json'):
     d = json.load(open(os.path.join(out, f)))
     print(f"{f}: T={d['T']} (CV chose {d['cv_chosen_T']}), CV FA {d['cv_fa_rate']:.3f} MD {d['cv_md_rate']:.3f} total {d['cv_total_rate']:.3f} on {d['positives']}+{d['negatives']} pairs")
 PY
