@@ -153,7 +153,66 @@ Street street(size_t n, double x_now, double link_sigma_m) {
   return s;
 }
 
+// A street driven along +x, keyframe i at x = i, then the current keyframe n back at x_now
+// heading the other way, every scan covering `fov_deg` ahead.
+Street streetBack(size_t n, double x_now, double fov_deg) {
+  io::LaserScan scan = test::constantScan(0, 10.0f, 80);
+  const size_t beams = static_cast<size_t>(std::lround(fov_deg));
+  scan.ranges.assign(beams, 10.0f);
+  scan.valid.assign(beams, 1);
+  scan.angle_min_rad = -fov_deg / 2 * kDeg;
+  Street s;
+  s.filter->initialise(esdf::Vec3::Zero(), esdf::Mat3::Identity() * 1e-9);
+  const esdf::Mat3 cov = esdf::Vec3(1e-4, 1e-4, 1e-6).asDiagonal();
+  for (size_t i = 0; i <= n; ++i) {
+    const common::Pose2 pose = i < n ? common::Pose2{static_cast<double>(i), 0, 0} : common::Pose2{x_now, 0, M_PI};
+    if (i > 0) s.filter->augmentRelative(static_cast<int>(i - 1), esdf::toVec(common::between(s.map->back().pose, pose)), cov.inverse());
+    s.map->addKeyframe({i, static_cast<double>(i), pose, true, false, {}}, io::CompactScan(scan));
+  }
+  s.filter->recover();
+  return s;
+}
+
 }  // namespace
+
+// Back along a street with a laser that sees only ahead, the earlier scans taken where the
+// vehicle is now looked the other way: the candidate is the earlier keyframe
+// opposite_view_offset_m ahead, whose scan saw what the current one sees. A laser that sees all
+// around, a street driven the same way, or the option off keep the nearest.
+TEST(LoopCloser, HeadingTheOtherWayTheCandidateIsWhereTheViewsMeet) {
+  slam::LoopClosureOptions o;  // search_radius_m 4, min_keyframe_gap 30, max_candidates 3
+  o.opposite_view_offset_m = 20;
+  const auto keyframes = [](const std::vector<slam::Candidate>& c) {
+    std::vector<size_t> k;
+    for (const auto& x : c) k.push_back(x.keyframe);
+    return k;
+  };
+  {
+    Street s = streetBack(200, 100, 180);
+    const auto c = slam::LoopCloser(o).candidates(*s.filter, *s.map, 200);
+    EXPECT_EQ(keyframes(c), std::vector<size_t>{80});  // the three nearest all meet the view there
+  }
+  {
+    Street s = streetBack(200, 100, 360);
+    const auto c = keyframes(slam::LoopCloser(o).candidates(*s.filter, *s.map, 200));
+    ASSERT_EQ(c.size(), 3u);
+    for (size_t k : c) EXPECT_LE(std::abs(static_cast<double>(k) - 100), 2.0) << k;
+  }
+  {
+    slam::LoopClosureOptions off = o;
+    off.opposite_view_offset_m = 0;
+    Street s = streetBack(200, 100, 180);
+    const auto c = keyframes(slam::LoopCloser(off).candidates(*s.filter, *s.map, 200));
+    ASSERT_EQ(c.size(), 3u);
+    for (size_t k : c) EXPECT_LE(std::abs(static_cast<double>(k) - 100), 2.0) << k;
+  }
+  {
+    Street s = street(200, 100, 0.01);
+    const auto c = keyframes(slam::LoopCloser(o).candidates(*s.filter, *s.map, 200));
+    ASSERT_EQ(c.size(), 3u);
+    EXPECT_EQ(c[0], 100u);
+  }
+}
 
 // The keyframes nearest the estimate are always the first candidates. Once the pose relative to
 // the nearest keyframe is uncertain beyond appearance_min_sigma_m, the classifier's detections

@@ -128,7 +128,12 @@ std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const Map& map
   std::sort(near_set.begin(), near_set.end());
   const size_t per_source = static_cast<size_t>(options_.max_candidates);
   std::vector<Candidate> out;
-  for (size_t n = 0; n < near_set.size() && n < per_source; ++n) out.push_back({near_set[n].second, std::nullopt});
+  for (size_t n = 0; n < near_set.size() && n < per_source; ++n) {
+    size_t i = near_set[n].second;
+    if (const auto partner = oppositeViewPartner(filter, map, i, current, newest_allowed)) i = *partner;
+    const bool known = std::any_of(out.begin(), out.end(), [i](const Candidate& c) { return c.keyframe == i; });
+    if (!known) out.push_back({i, std::nullopt});
+  }
   // There the classifier's detections among all of them follow, best first and one per place, so
   // that an aliased place cannot take every slot.
   if (!scorer_ || !far || !cur.hasScan()) return out;
@@ -148,6 +153,47 @@ std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const Map& map
     if (std::none_of(out.begin(), out.end(), same) && mahalanobis2(i) <= chi2_2dof_) out.push_back({i, Detection{"laser", score}});
   }
   return out;
+}
+
+std::optional<size_t> LoopCloser::oppositeViewPartner(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current,
+                                                      size_t newest_allowed) {
+  if (options_.opposite_view_offset_m <= 0) return std::nullopt;
+  const esdf::Vec3 xi = filter.mean(static_cast<int>(earlier)), xk = filter.mean(static_cast<int>(current));
+  if (std::fabs(common::wrapToPi(xk(2) - xi(2))) <= M_PI / 2) return std::nullopt;
+  // A scan of (nearly) the whole circle sees the place from any heading.
+  if (!narrow_view_) {
+    const io::LaserScan s = map.scan(current);
+    narrow_view_ = static_cast<double>(s.size()) * s.angle_increment_rad < 1.5 * M_PI;
+  }
+  if (!*narrow_view_) return std::nullopt;
+  // Where the current laser looks: ahead of the pose. The earlier visit saw that stretch from
+  // behind it, i.e. before it reached `earlier`; walk back along its keyframes while they approach.
+  const double tx = xk(0) + options_.opposite_view_offset_m * std::cos(xk(2));
+  const double ty = xk(1) + options_.opposite_view_offset_m * std::sin(xk(2));
+  const auto dist = [&](size_t j) {
+    const esdf::Vec3 xj = filter.mean(static_cast<int>(j));
+    return std::hypot(xj(0) - tx, xj(1) - ty);
+  };
+  const std::vector<Keyframe>& keyframes = map.keyframes();
+  size_t best = earlier;
+  double best_d = dist(earlier);
+  for (int step : {-1, 1}) {
+    size_t j = earlier;
+    double last = dist(earlier);
+    for (int n = 0; n < 400; ++n) {
+      if ((step < 0 && j == 0) || (step > 0 && j >= newest_allowed)) break;
+      j = step < 0 ? j - 1 : j + 1;
+      const double d = dist(j);
+      if (d > last + 1.0) break;  // moving away again (the path may waver by a metre)
+      last = std::min(last, d);
+      if (d < best_d && keyframes[j].hasScan()) {
+        best = j;
+        best_d = d;
+      }
+    }
+  }
+  if (best == earlier || best_d > options_.search_radius_m + 0.25 * options_.opposite_view_offset_m) return std::nullopt;
+  return best;
 }
 
 alignment::AlignmentResult LoopCloser::verifyAlignment(const io::LaserScan& earlier_scan, const io::LaserScan& current_scan,
@@ -260,7 +306,11 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_
   // must have no other alignment nearly as good within the gate's reach, and their alignment
   // becomes the measurement (more of the street than two scans see; the two scans' covariance
   // is kept, the conservative of the two).
-  if (options_.submap_check_path_m > 0 && r.prior_sigma_m > options_.appearance_min_sigma_m) {
+  // Two narrow views heading opposite ways meet only ahead of both (oppositeViewPartner), on a
+  // stretch of street that slides along itself as easily as a far closure's: the same check.
+  const bool opposite =
+      options_.opposite_view_offset_m > 0 && narrow_view_.value_or(false) && std::fabs(common::wrapToPi(xk(2) - xi(2))) > M_PI / 2;
+  if (options_.submap_check_path_m > 0 && (r.prior_sigma_m > options_.appearance_min_sigma_m || opposite)) {
     PathSubmapOptions po;
     po.path_m = options_.submap_check_path_m;
     const SubmapCheck c = alignPathSubmaps(map, earlier, current, a.transform, 3 * r.prior_sigma_m, po);

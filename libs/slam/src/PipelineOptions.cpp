@@ -94,6 +94,9 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("mahalanobis_probability", o.loop_closure.mahalanobis_probability, 0.5, 0.999999, "",
         "final candidate set: chi2 (2 dof) probability");
   s.add("max_candidates", o.loop_closure.max_candidates, 1, 1000, "", "candidates aligned per keyframe");
+  s.add("opposite_view_offset_m", o.loop_closure.opposite_view_offset_m, 0.0, 1000.0, "m",
+        "a laser short of the full circle: a candidate heading the other way is replaced by the keyframe of its visit nearest to this "
+        "far ahead of the current pose, where the two views meet (0: off)");
   s.add("every_n_keyframes", o.loop_closure.every_n_keyframes, 1, 1000, "keyframes", "search at every n-th keyframe");
   s.add("far_every_n_keyframes", o.loop_closure.far_every_n_keyframes, 1, 1000, "keyframes",
         "beyond appearance_min_sigma_m, the keyframes nearest the estimate are candidates at every n-th keyframe only (as likely wrong at "

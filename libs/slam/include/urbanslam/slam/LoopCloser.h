@@ -137,6 +137,11 @@ class LoopCloser {
   double chi2_3dof_gate_;  // the innovation gate's threshold
   size_t cached_for_ = static_cast<size_t>(-1);
   std::unordered_map<size_t, Eigen::Matrix3d> cached_;  // relative covariances for cached_for_
+  std::optional<bool> narrow_view_;                     // the laser covers well under the full circle (read once)
+
+  // For a candidate heading the other way, the keyframe of its visit whose view meets the current
+  // scan's ([loop_closure] opposite_view_offset_m); none when the candidate stays.
+  std::optional<size_t> oppositeViewPartner(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current, size_t newest_allowed);
 };
 
 }  // namespace urbanslam::slam

@@ -88,7 +88,11 @@ struct LoopClosureOptions {
   double search_radius_m = 4.0;           // initial set: earlier keyframes this close (+ 3 sigma)
   double mahalanobis_probability = 0.99;  // final set: chi2 (2 dof) gate on the relative position
   int max_candidates = 3;                 // aligned per keyframe, nearest (Mahalanobis) first
-  int every_n_keyframes = 1;              // search at every n-th keyframe
+  // A laser that does not see all around shares no view with an earlier scan taken at the same
+  // place heading the other way: such a candidate is replaced by the keyframe of that earlier
+  // visit nearest to this far ahead of the current pose (0: off).
+  double opposite_view_offset_m = 20.0;
+  int every_n_keyframes = 1;  // search at every n-th keyframe
   // Where the pose relative to the nearest keyframe is uncertain beyond appearance_min_sigma_m,
   // the keyframes nearest the estimate are searched at every n-th keyframe only (detections still
   // at every one): from one keyframe to the next they are the same guesses about as wrong.
