@@ -162,12 +162,14 @@ std::optional<size_t> LoopCloser::oppositeViewPartner(esdf::Esdf& filter, const 
   if (std::fabs(common::wrapToPi(xk(2) - xi(2))) <= M_PI / 2) return std::nullopt;
   // A scan of (nearly) the whole circle sees the place from any heading.
   if (!narrow_view_) {
+    if (!map.keyframes()[current].hasScan()) return std::nullopt;
     const io::LaserScan s = map.scan(current);
     narrow_view_ = static_cast<double>(s.size()) * s.angle_increment_rad < 1.5 * M_PI;
   }
   if (!*narrow_view_) return std::nullopt;
   // Where the current laser looks: ahead of the pose. The earlier visit saw that stretch from
-  // behind it, i.e. before it reached `earlier`; walk back along its keyframes while they approach.
+  // behind it, i.e. before it reached `earlier`: walk along its keyframes (both ways, the path
+  // may turn) while they approach that point.
   const double tx = xk(0) + options_.opposite_view_offset_m * std::cos(xk(2));
   const double ty = xk(1) + options_.opposite_view_offset_m * std::sin(xk(2));
   const auto dist = [&](size_t j) {
