@@ -66,20 +66,14 @@ evaluate real-on-victoria-park "$OUT/real.model" $VP_RULES $VP
 # The evaluation city of bench/scale (seed 1, never trained on), 4 km² and 5 km of driving, with
 # the front 180° laser and with the 360° one; two more held-out cities (seeds 6 and 7) with the
 # 360° laser for the 360° model.
-city() {  # city SEED FOV
-  local name=city-seed$1-fov$2
-  sed -e "s/^seed .*/seed = $1/" -e "s/^area_km2 .*/area_km2 = 4/" -e "s/^route_length_km .*/route_length_km = 5/" \
-    -e "s/^fov_deg .*/fov_deg = $2/" ini/city-1km2.ini > "$OUT/$name.ini"
-  [ -f "$OUT/$name/city.rawlog" ] || $U simulate --quiet --ini "$OUT/$name.ini" --out "$OUT/$name" > /dev/null
-  echo "$OUT/$name/city.rawlog"
-}
+. bench/laser_loop/cities.sh
 for fov in 180 360; do
-  evaluate default-on-city-fov$fov share/laser_loop/default.model "$(city 1 $fov)"
-  evaluate default-360-on-city-fov$fov share/laser_loop/default-360.model "$(city 1 $fov)"
-  evaluate real-on-city-fov$fov "$OUT/real.model" "$(city 1 $fov)"
+  evaluate default-on-city-fov$fov share/laser_loop/default.model "$(city "$U" "$OUT" 1 $fov)"
+  evaluate default-360-on-city-fov$fov share/laser_loop/default-360.model "$(city "$U" "$OUT" 1 $fov)"
+  evaluate real-on-city-fov$fov "$OUT/real.model" "$(city "$U" "$OUT" 1 $fov)"
 done
 for seed in 6 7; do
-  evaluate default-360-on-city-seed$seed-fov360 share/laser_loop/default-360.model "$(city $seed 360)"
+  evaluate default-360-on-city-seed$seed-fov360 share/laser_loop/default-360.model "$(city "$U" "$OUT" $seed 360)"
 done
 # Close-pair protocol (positives within 1 m with no minimum travel, so consecutive scans count —
 # the "scans very close together" positives attributed to the ICRA 2009 paper), any heading and

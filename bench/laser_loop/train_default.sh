@@ -21,16 +21,10 @@ D=../shared/data/freiburg_slam_benchmark/corrected_logs
 W=$BUILD/laser_loop_train
 mkdir -p "$W"
 
-city() {  # city SEED FOV: simulates once, prints the rawlog's path
-  local name=city-seed$1-fov$2
-  sed -e "s/^seed .*/seed = $1/" -e "s/^area_km2 .*/area_km2 = 4/" -e "s/^route_length_km .*/route_length_km = 5/" \
-    -e "s/^fov_deg .*/fov_deg = $2/" ini/city-1km2.ini > "$W/$name.ini"
-  [ -f "$W/$name/city.rawlog" ] || "$U" simulate --quiet --ini "$W/$name.ini" --out "$W/$name" > /dev/null
-  echo "$W/$name/city.rawlog"
-}
+. bench/laser_loop/cities.sh
 
 "$U" train-laser-loop "$D/intel-corrected.log.gz" "$D/aces-corrected.log.gz" "$D/csail-corrected.log.gz" \
-  "$D/freiburg-079-corrected.log.gz" "$D/freiburg-campus-corrected.log.gz" "$(city 2 180)" "$(city 3 180)" \
+  "$D/freiburg-079-corrected.log.gz" "$D/freiburg-campus-corrected.log.gz" "$(city "$U" "$W" 2 180)" "$(city "$U" "$W" 3 180)" \
   --features thesis --out share/laser_loop/default.model --plots share/laser_loop/default-cv --quiet --json
-"$U" train-laser-loop "$(city 2 360)" "$(city 3 360)" "$(city 4 360)" "$(city 5 360)" \
+"$U" train-laser-loop "$(city "$U" "$W" 2 360)" "$(city "$U" "$W" 3 360)" "$(city "$U" "$W" 4 360)" "$(city "$U" "$W" 5 360)" \
   --max-positives 10000 --out share/laser_loop/default-360.model --quiet --json

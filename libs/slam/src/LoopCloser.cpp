@@ -155,18 +155,22 @@ std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const Map& map
   return out;
 }
 
-std::optional<size_t> LoopCloser::oppositeViewPartner(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current,
-                                                      size_t newest_allowed) {
-  if (options_.opposite_view_offset_m <= 0) return std::nullopt;
-  const esdf::Vec3 xi = filter.mean(static_cast<int>(earlier)), xk = filter.mean(static_cast<int>(current));
-  if (std::fabs(common::wrapToPi(xk(2) - xi(2))) <= M_PI / 2) return std::nullopt;
-  // A scan of (nearly) the whole circle sees the place from any heading.
+bool LoopCloser::headingOtherWay(const Map& map, const esdf::Vec3& xi, const esdf::Vec3& xk, size_t current) {
+  if (options_.opposite_view_offset_m <= 0 || std::fabs(common::wrapToPi(xk(2) - xi(2))) <= M_PI / 2) return false;
+  // A scan of (nearly) the whole circle sees the place from any heading. Read from the first
+  // keyframe with a scan that gets here: one laser per run.
   if (!narrow_view_) {
-    if (!map.keyframes()[current].hasScan()) return std::nullopt;
+    if (!map.keyframes()[current].hasScan()) return false;
     const io::LaserScan s = map.scan(current);
     narrow_view_ = static_cast<double>(s.size()) * s.angle_increment_rad < 1.5 * M_PI;
   }
-  if (!*narrow_view_) return std::nullopt;
+  return *narrow_view_;
+}
+
+std::optional<size_t> LoopCloser::oppositeViewPartner(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current,
+                                                      size_t newest_allowed) {
+  const esdf::Vec3 xi = filter.mean(static_cast<int>(earlier)), xk = filter.mean(static_cast<int>(current));
+  if (!headingOtherWay(map, xi, xk, current)) return std::nullopt;
   // Where the current laser looks: ahead of the pose. The earlier visit saw that stretch from
   // behind it, i.e. before it reached `earlier`: walk along its keyframes (both ways, the path
   // may turn) while they approach that point.
@@ -310,9 +314,7 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_
   // is kept, the conservative of the two).
   // Two narrow views heading opposite ways meet only ahead of both (oppositeViewPartner), on a
   // stretch of street that slides along itself as easily as a far closure's: the same check.
-  const bool opposite =
-      options_.opposite_view_offset_m > 0 && narrow_view_.value_or(false) && std::fabs(common::wrapToPi(xk(2) - xi(2))) > M_PI / 2;
-  if (options_.submap_check_path_m > 0 && (r.prior_sigma_m > options_.appearance_min_sigma_m || opposite)) {
+  if (options_.submap_check_path_m > 0 && (r.prior_sigma_m > options_.appearance_min_sigma_m || headingOtherWay(map, xi, xk, current))) {
     PathSubmapOptions po;
     po.path_m = options_.submap_check_path_m;
     const SubmapCheck c = alignPathSubmaps(map, earlier, current, a.transform, 3 * r.prior_sigma_m, po);

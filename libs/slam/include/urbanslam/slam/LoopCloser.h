@@ -142,6 +142,9 @@ class LoopCloser {
   // For a candidate heading the other way, the keyframe of its visit whose view meets the current
   // scan's ([loop_closure] opposite_view_offset_m); none when the candidate stays.
   std::optional<size_t> oppositeViewPartner(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current, size_t newest_allowed);
+  // Whether the pair (estimates xi, xk) heads more than 90° apart with a laser well short of the
+  // full circle (opposite_view_offset_m on): the candidates it changes and the check it adds.
+  bool headingOtherWay(const Map& map, const esdf::Vec3& xi, const esdf::Vec3& xk, size_t current);
 };
 
 }  // namespace urbanslam::slam
