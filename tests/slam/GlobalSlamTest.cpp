@@ -144,3 +144,84 @@ TEST(GlobalSlam, ACameraClosureWhoseSceneWouldLieBeyondTheCamerasReachIsRefused)
   EXPECT_NE(closures[1].reason, slam::ClosureReason::SceneDepth);
   EXPECT_TRUE(closures[1].accepted) << slam::reasonName(closures[1].reason);
 }
+
+// A closure the scans measured waits for a second closure to agree with it, unless the images
+// nearest its keyframes measure the same full relative pose: then it goes in at once, confirmed
+// by the camera. Images that measure another pose (a metre off) confirm nothing: the closure
+// waits, and the next keyframe's closure confirms it as before. The drive of the first test: the
+// scans of keyframes 200 and on are those of keyframes 100 and on, at the same places.
+TEST(GlobalSlam, AClosureIsConfirmedByTheCameraWhenTheImagesMeasureTheSamePose) {
+  const auto run = [](double camera_error_m, bool enabled) {
+    auto r = std::make_unique<::Run>();
+    r->options.loop_closure.detector = slam::LoopClosureOptions::Detector::None;
+    r->options.loop_closure.submap_check_path_m = 0;
+    r->options.loop_closure.camera_confirmation = enabled;
+    r->global = std::make_unique<slam::GlobalSlam>(r->options, r->map, r->stats, r->observers);
+    size_t asked = 0;
+    // The images nearest keyframes a and b are those of a - 1 and b: camera b is one metre ahead
+    // of camera a-1 (a and b at the same place, one scan seen twice). The camera looks left
+    // (mount yaw 90°): ahead of the vehicle is -y in its frame, its x the vehicle's left.
+    r->global->setCameraMeasurer([&asked, camera_error_m](size_t a, size_t b) {
+      ++asked;
+      slam::CameraPairView v;
+      v.earlier = a - 1;
+      v.current = b;
+      v.camera.mount = common::Pose2{1.0, 0.5, M_PI / 2};
+      v.camera.relative.valid = true;
+      v.camera.metric.valid = true;
+      v.camera.metric.pose = common::Pose2{camera_error_m, -1.0, 0.0};
+      return std::optional<slam::CameraPairView>(v);
+    });
+    slam::KeyframeConstraint c;
+    c.cov = Eigen::Vector3d(0.25, 0.25, 1e-6).asDiagonal();
+    for (size_t k = 0; k <= 201; ++k) {
+      c.z = {k == 200 ? -99.0 : 1.0, 0, 0};
+      r->global->addKeyframe({k, static_cast<double>(k), {}, true, false, {}}, io::CompactScan(test::constantScan(k, 10.0, 80)), c);
+      if (k >= 200) r->global->closeLoops(k, std::chrono::steady_clock::now());
+    }
+    return std::make_pair(std::move(r), asked);
+  };
+  const auto accepted_at = [](const ::Run& r, size_t keyframe, slam::Confirmation by) {
+    return std::count_if(r.global->closures().begin(), r.global->closures().end(),
+                         [&](const slam::LoopClosureRecord& c) { return c.accepted && c.to == keyframe && c.confirmed_by == by; });
+  };
+  const auto [agree, asked_agree] = run(0.0, true);
+  EXPECT_GE(asked_agree, 1u);
+  EXPECT_EQ(accepted_at(*agree, 200, slam::Confirmation::Camera), 1);
+  const auto [off, asked_off] = run(1.0, true);
+  EXPECT_GE(asked_off, 1u);
+  EXPECT_EQ(accepted_at(*off, 200, slam::Confirmation::Camera), 0);
+  EXPECT_EQ(accepted_at(*off, 201, slam::Confirmation::Closure), 1);
+  EXPECT_EQ(accepted_at(*off, 200, slam::Confirmation::Closure), 1);  // the waiting one, confirmed by 201's
+  const auto [disabled, asked_disabled] = run(0.0, false);
+  EXPECT_EQ(asked_disabled, 0u);
+  EXPECT_EQ(accepted_at(*disabled, 200, slam::Confirmation::Camera), 0);
+}
+
+// A closure the camera itself measured (no scans) is not confirmed by the camera's view of the
+// same pair: that would be one measurement agreeing with itself. It waits for a second closure.
+TEST(GlobalSlam, ACameraClosureIsNotConfirmedByItsOwnImages) {
+  ::Run r;
+  r.options.loop_closure.appearance_min_sigma_m = 3.0;
+  driveStraight(r, Eigen::Vector3d(0.09, 0.09, 1e-6).asDiagonal());
+  slam::CameraMeasurement m;
+  m.mount = common::Pose2{1.0, 0.0, M_PI / 2};  // looking left; the vehicle drives along x
+  m.relative.valid = true;
+  m.relative.bearing_rad = -M_PI / 2;  // camera b ahead along x
+  m.relative.cov = Eigen::Vector2d(1e-4, 1e-4).asDiagonal();
+  m.relative.depth_per_baseline = 2.0;
+  m.metric.valid = true;
+  m.metric.pose = common::Pose2{0.0, -5.0, 0.0};  // 5 m ahead: the drive's truth
+  m.metric.cov = Eigen::Vector3d(1e-4, 1e-4, 1e-6).asDiagonal();
+  size_t asked = 0;
+  r.global->setCameraMeasurer([&](size_t a, size_t b) {
+    ++asked;
+    return std::optional<slam::CameraPairView>(slam::CameraPairView{a, b, m});
+  });
+  r.global->proposeImageClosure(200, 205, 1.0, m, std::chrono::steady_clock::now());
+  EXPECT_EQ(asked, 0u);
+  EXPECT_EQ(r.stats.closures_accepted, 0u);  // waiting for a second closure
+  r.global->finish();
+  ASSERT_EQ(r.global->closures().size(), 1u);
+  EXPECT_EQ(r.global->closures()[0].reason, slam::ClosureReason::Unconfirmed);
+}

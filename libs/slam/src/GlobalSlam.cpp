@@ -144,7 +144,8 @@ void GlobalSlam::expirePending(size_t current) {
   }
 }
 
-GlobalSlam::Admission GlobalSlam::admit(LoopClosureRecord r, size_t current) {
+GlobalSlam::Admission GlobalSlam::admit(LoopClosureRecord r, size_t current, MeasuredBy measured,
+                                        const std::optional<CameraPairView>& view) {
   const size_t window = static_cast<size_t>(options_.loop_closure.confirm_window);
   if (!r.accepted) {
     reportClosure(r);
@@ -163,19 +164,32 @@ GlobalSlam::Admission GlobalSlam::admit(LoopClosureRecord r, size_t current) {
   // campus 4 -> 6, ACES 3 -> 6, CSAIL 1 -> 2 at the same ATE.
   auto match =
       std::find_if(pending_.begin(), pending_.end(), [&](const LoopClosureRecord& p) { return p.to < current && consistent(p, r); });
-  if (match == pending_.end()) {
-    if (pending_.size() < 4 * window) pending_.push_back(r);
-    return Admission::Pending;
+  if (match != pending_.end()) {
+    LoopClosureRecord first = *match;
+    pending_.erase(match);
+    first.confirmed_by = r.confirmed_by = Confirmation::Closure;
+    return commit({&first, &r});
   }
-  LoopClosureRecord first = *match;
-  pending_.erase(match);
+  // Or by the other sensor: the images of the two places measure what the scans did.
+  if (measured == MeasuredBy::Scans && cameraConfirms(r, view)) {
+    r.confirmed_by = Confirmation::Camera;
+    return commit({&r});
+  }
+  if (pending_.size() < 4 * window) pending_.push_back(r);
+  return Admission::Pending;
+}
+
+GlobalSlam::Admission GlobalSlam::commit(std::initializer_list<LoopClosureRecord*> records) {
   bool accepted = false;
-  for (LoopClosureRecord* c : {&first, &r}) {
+  for (LoopClosureRecord* c : records) {
     const auto res = map_.filter()->observeRelative(static_cast<int>(c->from), static_cast<int>(c->to), esdf::toVec(c->measurement),
                                                     c->information, true);
     c->accepted = res.accepted;
     c->mahalanobis2 = res.gate.mahalanobis2;
-    if (!res.accepted) c->reason = ClosureReason::Gating;
+    if (!res.accepted) {
+      c->reason = ClosureReason::Gating;
+      c->confirmed_by = Confirmation::None;
+    }
     if (c->accepted) {
       map_.addEdge({c->from, c->to, c->measurement, c->information, true});
       accepted = true;
@@ -183,6 +197,26 @@ GlobalSlam::Admission GlobalSlam::admit(LoopClosureRecord r, size_t current) {
     reportClosure(*c);
   }
   return accepted ? Admission::Accepted : Admission::Rejected;
+}
+
+// The camera confirms a closure that the scans measured when the images nearest its two
+// keyframes give the same full relative pose, the closure carried to the images' keyframes by the
+// estimate (they are at most a few keyframes from the closure's, a few centimetres of odometry):
+// the same agreement as two closures' (consistent). Bearing and heading alone leave the length
+// along the baseline open, which is where a street's repeated facades put a wrong alignment, so
+// they confirm nothing.
+bool GlobalSlam::cameraConfirms(const LoopClosureRecord& r, const std::optional<CameraPairView>& given) const {
+  if (!options_.loop_closure.camera_confirmation || r.bearing_only) return false;
+  const std::optional<CameraPairView> view = given ? given : camera_measurer_ ? camera_measurer_(r.from, r.to) : std::nullopt;
+  if (!view || !view->camera.metric.valid) return false;
+  const auto& kf = map_.keyframes();
+  const common::Pose2 scans = common::compose(common::compose(common::between(kf[view->earlier].pose, kf[r.from].pose), r.measurement),
+                                              common::between(kf[r.to].pose, kf[view->current].pose));
+  const common::Pose2& m = view->camera.mount;
+  const common::Pose2 camera = common::compose(common::compose(m, view->camera.metric.pose), common::inverse(m));
+  const common::Pose2 d = common::between(camera, scans);
+  return std::hypot(d.x, d.y) <= options_.loop_closure.confirm_tolerance_m &&
+         std::abs(d.phi) <= options_.loop_closure.confirm_tolerance_deg * kDeg;
 }
 
 void GlobalSlam::closeLoops(size_t current, SteadyTime handed_over) {
@@ -266,8 +300,10 @@ void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double scor
     const Detection detection{"image", score};
     esdf::Esdf& f = *map_.filter();
     LoopClosureRecord r;
+    std::optional<CameraPairView> view;
     if (scans) {
       r = closer_.tryClose(f, map_, earlier, current, !confirm, &detection);
+      if (camera) view = CameraPairView{earlier, current, *camera};
     } else {
       CameraMeasurement m = *camera;
       if (m.metric.valid && !allowsFullCameraPose(earlier, current)) m.metric.valid = false;
@@ -276,7 +312,7 @@ void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double scor
     }
     ++stats_.closures_tried;
     const ClosureReason reason = r.reason;
-    const Admission a = admit(std::move(r), current);
+    const Admission a = admit(std::move(r), current, scans ? MeasuredBy::Scans : MeasuredBy::Camera, view);
     ev.accepted = a == Admission::Accepted;
     ev.fate = a == Admission::Accepted  ? "accepted"
               : a == Admission::Pending ? "pending"

@@ -57,6 +57,18 @@ const char* reasonName(ClosureReason reason) {
   return "";
 }
 
+const char* confirmationName(Confirmation c) {
+  switch (c) {
+    case Confirmation::None:
+      return "";
+    case Confirmation::Closure:
+      return "closure";
+    case Confirmation::Camera:
+      return "camera";
+  }
+  return "";
+}
+
 LoopCloser::LoopCloser(const LoopClosureOptions& options)
     : options_(options),
       chi2_2dof_(esdf::chi2Quantile(options.mahalanobis_probability, 2)),

@@ -1,6 +1,8 @@
 // The pipeline's camera side: images attached to keyframes, Tree of Words proposals turned into
 // loop-closure hypotheses (thesis §4.2 detection, then the same §5.3 alignment and §5.4 gating
 // as the laser candidates).
+#include <algorithm>
+#include <iterator>
 #include <opencv2/core.hpp>
 
 #include "urbanslam/common/Timing.h"
@@ -12,6 +14,15 @@
 
 namespace urbanslam::slam {
 
+namespace {
+// An image confirms closures of keyframes at most this many from its own: a camera at 2 Hz beside
+// a laser at 10 Hz has an image every five keyframes at driving speed, so one within two or three
+// of any keyframe.
+constexpr size_t kImageReachKeyframes = 3;
+// The camera's views kept for the next keyframes' closures (they ask for the same image pairs).
+constexpr size_t kCameraViewsKept = 16;
+}  // namespace
+
 void Pipeline::startImageDetector() {
   if (image_detector_ || options_.loop_closure.image_detector != LoopClosureOptions::ImageDetector::TreeOfWords) return;
   // Tree of Words over the keyframe images (thesis §4.2); the vocabulary decides SIFT or ORB.
@@ -20,6 +31,42 @@ void Pipeline::startImageDetector() {
   auto vocabulary = std::make_shared<const vision_loop::Vocabulary>(vision_loop::loadVocabulary(path));
   const auto features = vision_loop::featureOptions(options_.image_loop, vocabulary->descriptorType());
   image_detector_ = std::make_unique<vision_loop::LoopDetector>(vocabulary, features, vision_loop::detectorOptions(options_.image_loop));
+  global_.setCameraMeasurer([this](size_t earlier, size_t current) { return cameraView(earlier, current); });
+}
+
+std::optional<size_t> Pipeline::nearestImage(size_t keyframe) const {
+  // image_keyframes_ grows with the keyframes: sorted.
+  const auto it = std::lower_bound(image_keyframes_.begin(), image_keyframes_.end(), keyframe);
+  std::optional<size_t> best;
+  size_t best_gap = kImageReachKeyframes + 1;
+  for (auto c = it == image_keyframes_.begin() ? it : std::prev(it); c != image_keyframes_.end() && c <= it; ++c) {
+    const size_t gap = *c > keyframe ? *c - keyframe : keyframe - *c;
+    if (gap < best_gap) best_gap = gap, best = static_cast<size_t>(c - image_keyframes_.begin());
+  }
+  return best;
+}
+
+std::optional<CameraPairView> Pipeline::cameraView(size_t earlier, size_t current) {
+  const std::optional<size_t> a = nearestImage(earlier), b = nearestImage(current);
+  if (!a || !b || *a >= *b) return std::nullopt;
+  const size_t ka = image_keyframes_[*a], kb = image_keyframes_[*b];
+  // The full pose only where the estimate tells a facade from its copy (as for the camera's own
+  // closures): farther, a confirmation by the camera could be a copy's.
+  if (!options_.image_loop.metric_pose || !global_.allowsFullCameraPose(ka, kb)) return std::nullopt;
+  const auto pair = std::make_pair(*a, *b);
+  for (const auto& [key, view] : camera_views_)
+    if (key == pair) return view;
+  const auto id = [](size_t i) { return static_cast<vision_loop::ImageId>(i); };
+  std::optional<CameraPairView> view;
+  std::optional<CameraMeasurement> m =
+      measureCamera(image_cameras_[*a], image_detector_->features(id(*a)), image_cameras_[*b], image_detector_->features(id(*b)));
+  if (m && m->relative.valid) {
+    measureLength(*a, *b, *m);
+    if (m->metric.valid) view = CameraPairView{ka, kb, *m};
+  }
+  camera_views_.emplace_back(pair, view);
+  if (camera_views_.size() > kCameraViewsKept) camera_views_.pop_front();
+  return view;
 }
 
 void Pipeline::onCameraImage(const io::CameraImage& image, double progress) {
@@ -100,12 +147,14 @@ void Pipeline::measureLength(size_t earlier_image, size_t current_image, CameraM
   esdf::Esdf* filter = map_.filter();
   if (!options_.image_loop.metric_pose || !filter) return;
   // The earlier keyframe's neighbour in the same visit: the next image, else the previous, of a
-  // keyframe at most two away, taken by the same camera.
+  // keyframe at most twice kImageReachKeyframes away (with a laser, the images fall between its
+  // keyframes; without, every image is a keyframe), taken by the same camera.
   const size_t a = image_keyframes_[earlier_image];
+  const size_t reach = 2 * kImageReachKeyframes;
   const auto usable = [&](size_t n) {
     return n < image_keyframes_.size() && n != current_image && image_cameras_[n].width == image_cameras_[earlier_image].width &&
            image_cameras_[n].calibration == image_cameras_[earlier_image].calibration &&
-           (image_keyframes_[n] > a ? image_keyframes_[n] - a : a - image_keyframes_[n]) <= 2;
+           (image_keyframes_[n] > a ? image_keyframes_[n] - a : a - image_keyframes_[n]) <= reach;
   };
   const size_t n = usable(earlier_image + 1)                        ? earlier_image + 1
                    : earlier_image > 0 && usable(earlier_image - 1) ? earlier_image - 1

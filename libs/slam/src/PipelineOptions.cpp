@@ -143,6 +143,9 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
         "a closure is added once another within this many keyframes agrees with it; 0: at once");
   s.add("confirm_tolerance_m", o.loop_closure.confirm_tolerance_m, 0.0, 100.0, "m", "agreement of two closures: position");
   s.add("confirm_tolerance_deg", o.loop_closure.confirm_tolerance_deg, 0.0, 180.0, "deg", "agreement of two closures: heading");
+  s.add("camera_confirmation", o.loop_closure.camera_confirmation,
+        "with a camera too: a closure the scans measured is confirmed at once when the images nearest its keyframes measure the same "
+        "full relative pose (within the confirm tolerances)");
 
   s.section("image_loop", "Tree of Words image loop-closure detection (used when [loop_closure] image_detector = tree_of_words)");
   vision_loop::declareImageLoopOptions(s, o.image_loop);

@@ -140,6 +140,7 @@ void writeRecord(BinaryWriter& w, const LoopClosureRecord& c) {
   w.f64(c.free_space_conflict);
   w.f64(c.prior_sigma_m);
   w.boolean(c.bearing_only);
+  w.u8(static_cast<std::uint8_t>(c.confirmed_by));
 }
 
 LoopClosureRecord readRecord(BinaryReader& r, size_t keyframes, std::uint32_t format_version) {
@@ -168,6 +169,12 @@ LoopClosureRecord readRecord(BinaryReader& r, size_t keyframes, std::uint32_t fo
   c.bearing_only = format_version >= 6 ? r.boolean()
                                        : c.detector == "image" && c.rms_m == 0 && c.reason != ClosureReason::CameraGeometry &&
                                              c.reason != ClosureReason::NoScans;
+  // Before version 7 what confirmed a closure was not kept.
+  if (format_version >= 7) {
+    const std::uint8_t confirmed = r.u8();
+    if (confirmed > static_cast<std::uint8_t>(Confirmation::Camera)) r.fail("loop closure confirmation " + std::to_string(confirmed));
+    c.confirmed_by = static_cast<Confirmation>(confirmed);
+  }
   return c;
 }
 

@@ -1,5 +1,6 @@
 #include "urbanslam/slam/RunOutputs.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -101,13 +102,13 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   {
     common::AtomicFile f(path("loop_closures.csv"));
     f.stream() << "from_keyframe,to_keyframe,from_time,to_time,detector,score,accepted,reason,x,y,phi,rms_m,mahalanobis2,gate_threshold,"
-                  "free_space_conflict,prior_sigma_m,bearing_only\n";
+                  "free_space_conflict,prior_sigma_m,bearing_only,confirmed_by\n";
     char buf[512];
     for (const auto& c : p.loopClosures()) {
-      std::snprintf(buf, sizeof buf, "%zu,%zu,%.6f,%.6f,%s,%.6g,%d,%s,%.6f,%.6f,%.6f,%.6g,%.6g,%.6g,%.4f,%.4g,%d\n", c.from, c.to,
+      std::snprintf(buf, sizeof buf, "%zu,%zu,%.6f,%.6f,%s,%.6g,%d,%s,%.6f,%.6f,%.6f,%.6g,%.6g,%.6g,%.4f,%.4g,%d,%s\n", c.from, c.to,
                     c.from_time, c.to_time, c.detector.c_str(), c.score, c.accepted ? 1 : 0, reasonName(c.reason), c.measurement.x,
                     c.measurement.y, c.measurement.phi, c.rms_m, c.mahalanobis2, c.gate_threshold, c.free_space_conflict, c.prior_sigma_m,
-                    c.bearing_only ? 1 : 0);
+                    c.bearing_only ? 1 : 0, confirmationName(c.confirmed_by));
       f.stream() << buf;
     }
     f.commit();
@@ -195,6 +196,8 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   c["loop_closures_tried"] = s.closures_tried;
   c["loop_closures_accepted"] = s.closures_accepted;
   c["loop_closures_rejected"] = s.closures_rejected;
+  c["loop_closures_camera_confirmed"] = std::count_if(p.loopClosures().begin(), p.loopClosures().end(),
+                                                      [](const LoopClosureRecord& r) { return r.confirmed_by == Confirmation::Camera; });
   c["image_keyframes"] = s.image_keyframes;
   c["image_proposals"] = s.image_proposals;
   Json& t = j["timing"];

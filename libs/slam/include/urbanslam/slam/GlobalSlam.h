@@ -8,6 +8,7 @@
 #include <array>
 #include <chrono>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -27,6 +28,16 @@ class LoopDetector;
 namespace urbanslam::slam {
 
 using SteadyTime = std::chrono::steady_clock::time_point;
+
+// The camera's view of a pair of keyframes: the keyframes of the images nearest to them (the
+// estimate carries a closure between the pair to these), and the images' relative pose.
+struct CameraPairView {
+  size_t earlier = 0, current = 0;
+  CameraMeasurement camera;
+};
+// Measures the camera's view of the pair (earlier, current), or nothing when no images near both
+// can (no camera, no nearby image, too few matches).
+using CameraPairMeasurer = std::function<std::optional<CameraPairView>(size_t earlier, size_t current)>;
 
 class GlobalSlam {
  public:
@@ -62,6 +73,9 @@ class GlobalSlam {
   // it are its confirmation.
   void addPlaceFix(size_t earlier, size_t current, const common::Pose2& z, const Eigen::Matrix3d& information, double score,
                    const std::string& detector);
+  // How closures the scans measured are confirmed by the camera ([loop_closure]
+  // camera_confirmation); without it, only by a second closure.
+  void setCameraMeasurer(CameraPairMeasurer measurer) { camera_measurer_ = std::move(measurer); }
   // End of input: hypotheses still awaiting confirmation are dropped, the last poses recovered.
   void finish();
 
@@ -75,7 +89,15 @@ class GlobalSlam {
 
  private:
   enum class Admission { Rejected, Pending, Accepted };
-  Admission admit(LoopClosureRecord r, size_t current);
+  // What measured a hypothesis: the scans (the camera may confirm it), or the camera itself.
+  enum class MeasuredBy { Scans, Camera };
+  // A hypothesis's fate: confirmed by an earlier one that agrees with it, or, measured by the
+  // scans, by the camera's view (`view`, when the caller measured it: an image proposal; else the
+  // measurer's), then gated again and added; else kept waiting for confirmation.
+  Admission admit(LoopClosureRecord r, size_t current, MeasuredBy measured = MeasuredBy::Scans,
+                  const std::optional<CameraPairView>& view = std::nullopt);
+  Admission commit(std::initializer_list<LoopClosureRecord*> records);
+  bool cameraConfirms(const LoopClosureRecord& r, const std::optional<CameraPairView>& view) const;
   void expirePending(size_t current);
   bool consistent(const LoopClosureRecord& a, const LoopClosureRecord& b) const;
   void reportClosure(const LoopClosureRecord& r);
@@ -94,6 +116,7 @@ class GlobalSlam {
   LoopCloser closer_;
   std::unique_ptr<laser_loop::LoopDetector> laser_detector_;  // [loop_closure] detector = laser, once read
   std::deque<LoopClosureRecord> pending_;                     // passed alignment + gate, awaiting confirmation
+  CameraPairMeasurer camera_measurer_;
   std::vector<LoopClosureRecord> closures_;
   bool dirty_since_recovery_ = false;
   size_t last_full_size_ = 0;  // keyframes at the last full recovery

@@ -5,6 +5,7 @@
 // estimate is too uncertain to pick them — then alignment for the relative pose and its
 // covariance (§5.3) and the innovation gate (§5.4) before the ESDF update.
 #include <Eigen/Core>
+#include <cstdint>
 #include <functional>
 #include <optional>
 #include <string>
@@ -47,6 +48,15 @@ enum class ClosureReason {
 // Its name in loop_closures.csv and in observer events ("" for None).
 const char* reasonName(ClosureReason reason);
 
+// What confirmed an accepted closure before it went into the filter.
+enum class Confirmation : std::uint8_t {
+  None,     // nothing (confirm_window = 0: added at once), or not accepted
+  Closure,  // a second closure of the next keyframes agreed with it (GlobalSlam::consistent)
+  Camera,   // the two places' images measured the same relative pose as the scans (camera_confirmation)
+};
+// Its name in loop_closures.csv ("" for None).
+const char* confirmationName(Confirmation c);
+
 // One loop-closure hypothesis and what became of it (a row of loop_closures.csv).
 struct LoopClosureRecord {
   size_t from = 0, to = 0;  // earlier keyframe, current keyframe
@@ -63,6 +73,7 @@ struct LoopClosureRecord {
   // A camera closure that measured bearing and heading only: its translation's length is the
   // estimate's (CameraClosure.h). Scan alignments and full camera poses measure all three.
   bool bearing_only = false;
+  Confirmation confirmed_by = Confirmation::None;
 };
 
 // Appearance similarity of a pair of keyframes (the laser classifier's margin above its

@@ -140,6 +140,11 @@ class Pipeline {
   // The same closure's full pose (m.metric), when an image next to the earlier one (database ids)
   // gives its features a depth ([image_loop] metric_pose).
   void measureLength(size_t earlier_image, size_t current_image, CameraMeasurement& m);
+  // The camera's view of keyframes (earlier, current) for global SLAM's confirmation of closures:
+  // the images nearest to them (kImageReachKeyframes), measured with their full pose, or nothing.
+  // The last few pairs are kept: the next keyframes' closures ask for the same images.
+  std::optional<CameraPairView> cameraView(size_t earlier, size_t current);
+  std::optional<size_t> nearestImage(size_t keyframe) const;  // its image database id
 
   PipelineOptions options_;
   std::vector<PipelineObserver*> observers_;
@@ -153,6 +158,7 @@ class Pipeline {
   std::vector<size_t> image_keyframes_;                        // image database id -> keyframe
   std::vector<ImageCamera> image_cameras_;                     // image database id -> its camera
   KeyframeImageAssigner images_;
+  std::deque<std::pair<std::pair<size_t, size_t>, std::optional<CameraPairView>>> camera_views_;  // (image, image) -> view
   SubmapCorrections submap_corrections_;
   std::deque<std::pair<size_t, size_t>> keyframe_tickets_;  // keyframe -> its global SLAM job's ticket
   bool have_first_ts_ = false;

@@ -141,6 +141,12 @@ struct LoopClosureOptions {
   int confirm_window = 3;
   double confirm_tolerance_m = 0.3;
   double confirm_tolerance_deg = 3.0;
+  // With a camera too: a closure measured by the scans is confirmed at once when the images
+  // nearest its two keyframes measure the same full relative pose (within the tolerances above).
+  // The camera measures the full pose only where the estimate knows the pair within
+  // appearance_min_sigma_m (GlobalSlam::allowsFullCameraPose), so farther closures still wait for
+  // a second closure.
+  bool camera_confirmation = true;
 };
 
 struct EstimatorOptions {
