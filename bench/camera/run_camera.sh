@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Camera + odometry mapping (no laser) against laser + odometry mapping, on the same simulated
-# 1 km² city and drive (ini/city-camera.ini is ini/city-1km2.ini seen by a left-looking camera):
+# Camera + odometry mapping (no laser) against laser + odometry mapping and laser + camera +
+# odometry mapping, on the same simulated 1 km² city and drive (ini/city-camera.ini is
+# ini/city-1km2.ini seen by a left-looking camera; `both` has the laser and that camera):
 # ATE against the simulator's truth, as metres and as a share of the distance driven, the
 # closures accepted and how many of them join two views of the same place (true positions
 # within 25 m; a laser closure may join scans further apart), how many of the camera's measured
@@ -10,8 +11,10 @@
 # closures at another place, or whose full pose is more than 0.5 m or 5° off the truth's, or, for
 # bearing and heading only, whose bearing, times the true distance between the cameras, or
 # heading is more than 0.5 m or 5° off, the camera mount read from the city ini; for the laser,
-# `eval_false`), and the real-time factor. AREA_KM2 and ROUTE_KM give both runs another city size and drive length
-# (default: the inis' own, 1 km² and 3 km).
+# `eval_false`), the closures the camera confirmed (`cam_confirm`: the images nearest a scan
+# closure's keyframes measured the same full pose), and the real-time factor. AREA_KM2 and
+# ROUTE_KM give every run another city size and drive length (default: the inis' own, 1 km² and
+# 3 km).
 #
 #   bash bench/camera/run_camera.sh [BUILD_DIR] [OUT_DIR]
 #   AREA_KM2=10 ROUTE_KM=10 bash bench/camera/run_camera.sh [BUILD_DIR] [OUT_DIR]
@@ -21,8 +24,11 @@ OUT=${2:-out/bench-camera}
 U=$BUILD/apps/urbanslam/urbanslam
 [[ -x $U ]] || { echo "missing $U (build first)" >&2; exit 2; }
 mkdir -p "$OUT"
-printf '%-8s %9s %10s %8s %7s %9s %10s %9s %6s %10s %6s\n' run keyframes driven_m ate_m ate_pct accepted same_place full_pose false eval_false rtf
-for spec in camera:ini/city-camera.ini laser:ini/city-1km2.ini; do
+printf '%-8s %9s %10s %8s %7s %9s %10s %9s %10s %6s %10s %6s\n' run keyframes driven_m ate_m ate_pct accepted same_place full_pose cam_confirm false eval_false rtf
+# Laser + camera: ini/city-1km2.ini with ini/city-camera.ini's camera.
+awk '/^\[camera\]/{on=1} /^\[odometry\]/{on=0} on' ini/city-camera.ini > "$OUT/camera-section.ini"
+awk -v cam="$OUT/camera-section.ini" '/^\[odometry\]/{while ((getline l < cam) > 0) print l} {print}' ini/city-1km2.ini > "$OUT/city-both.ini"
+for spec in camera:ini/city-camera.ini laser:ini/city-1km2.ini both:$OUT/city-both.ini; do
   name=${spec%%:*}
   ini=${spec#*:}
   if [[ -n ${AREA_KM2:-} || -n ${ROUTE_KM:-} ]]; then
@@ -60,7 +66,7 @@ def inverse(a):
     return (-c * a[0] - s * a[1], s * a[0] - c * a[1], -a[2])
 def wrap(x):
     return math.atan2(math.sin(x), math.cos(x))
-accepted = same = full_pose = camera_false = 0
+accepted = same = full_pose = camera_false = cam_confirmed = 0
 for r in csv.DictReader(open(run + '/loop_closures.csv')):
     if r['accepted'] != '1': continue
     accepted += 1
@@ -68,7 +74,8 @@ for r in csv.DictReader(open(run + '/loop_closures.csv')):
     a, b = ref.get(ta), ref.get(tb)
     here = a is not None and b is not None and math.hypot(a[0] - b[0], a[1] - b[1]) < 25
     same += here
-    if r['detector'] != 'image' or a is None or b is None: continue
+    cam_confirmed += r.get('confirmed_by') == 'camera'
+    if name != 'camera' or r['detector'] != 'image' or a is None or b is None: continue
     if r['bearing_only'] != '1':
         # The full pose, as eval judges it.
         full_pose += 1
@@ -81,7 +88,8 @@ for r in csv.DictReader(open(run + '/loop_closures.csv')):
     lateral = math.hypot(truth[0], truth[1]) * abs(math.sin(math.atan2(seen[1], seen[0]) - math.atan2(truth[1], truth[0])))
     camera_false += not here or lateral > 0.5 or abs(wrap(seen[2] - truth[2])) > math.radians(5)
 false = camera_false if name == 'camera' else ev['loops_false']
-print('%-8s %9d %10.0f %8.2f %6.2f%% %9d %10d %9d %6d %10d %6.1f' % (name, stats['counts']['keyframes'], driven, ev['ate_rmse_m'],
-      100 * ev['ate_rmse_m'] / driven, accepted, same, full_pose, false, ev['loops_false'], stats['timing']['real_time_factor']))
+print('%-8s %9d %10.0f %8.2f %6.2f%% %9d %10d %9d %10d %6d %10d %6.1f' % (name, stats['counts']['keyframes'], driven, ev['ate_rmse_m'],
+      100 * ev['ate_rmse_m'] / driven, accepted, same, full_pose, cam_confirmed, false, ev['loops_false'],
+      stats['timing']['real_time_factor']))
 PY
 done
