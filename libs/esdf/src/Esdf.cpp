@@ -15,7 +15,6 @@ Esdf::~Esdf() = default;
 
 void Esdf::reserve(int poses) {
   state_.reserve(poses);
-  factors_.reserve(static_cast<size_t>(poses) * 2);
   first_factor_of_pose_.reserve(static_cast<size_t>(poses));
 }
 
@@ -512,7 +511,8 @@ const Esdf::ChainAnchor& Esdf::chainAnchor() {
 }
 
 size_t Esdf::memoryBytes() const {
-  return state_.memoryBytes() + factors_.capacity() * sizeof(Factor) + first_factor_of_pose_.capacity() * sizeof(int) +
+  // (The factors grow by fixed blocks: their size is their memory, to a block.)
+  return state_.memoryBytes() + factors_.size() * sizeof(Factor) + first_factor_of_pose_.capacity() * sizeof(int) +
          (chain_phi_.capacity() + chain_cov_.capacity()) * sizeof(Mat3);
 }
 

@@ -90,7 +90,7 @@ Eigen::Matrix3d LoopCloser::relativeCovariance(esdf::Esdf& filter, size_t i, siz
 }
 
 std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const Map& map, size_t current, bool confirming) {
-  const std::vector<Keyframe>& keyframes = map.keyframes();
+  const auto& keyframes = map.keyframes();
   const KeyframeGrid& grid = map.index();
   const auto& cur = keyframes[current];
   if (current < static_cast<size_t>(options_.min_keyframe_gap)) return {};
@@ -192,7 +192,7 @@ std::optional<size_t> LoopCloser::oppositeViewPartner(esdf::Esdf& filter, const 
     const esdf::Vec3 xj = filter.mean(static_cast<int>(j));
     return std::hypot(xj(0) - tx, xj(1) - ty);
   };
-  const std::vector<Keyframe>& keyframes = map.keyframes();
+  const auto& keyframes = map.keyframes();
   size_t best = earlier;
   double best_d = dist(earlier);
   for (int step : {-1, 1}) {
@@ -280,7 +280,7 @@ alignment::AlignmentResult LoopCloser::verifyAlignment(const io::LaserScan& earl
 
 LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current, bool commit,
                                        const Detection* detection) {
-  const std::vector<Keyframe>& keyframes = map.keyframes();
+  const auto& keyframes = map.keyframes();
   LoopClosureRecord r;
   r.from = earlier;
   r.to = current;
@@ -365,7 +365,7 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_
 LoopClosureRecord LoopCloser::tryCloseMeasured(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current, const esdf::Vec3& z,
                                                const Eigen::Matrix3d& information, bool commit, const Detection& detection,
                                                const CameraMeasurement* camera) {
-  const std::vector<Keyframe>& keyframes = map.keyframes();
+  const auto& keyframes = map.keyframes();
   LoopClosureRecord r;
   r.from = earlier;
   r.to = current;

@@ -18,6 +18,7 @@
 // the first linearisation's error.
 #include <Eigen/Core>
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <queue>
@@ -256,7 +257,9 @@ class Esdf {
 
   EsdfOptions options_;
   InformationState state_;
-  std::vector<Factor> factors_;
+  // Two or more per pose, up to millions: a deque grows by fixed blocks, where a vector's doubling
+  // leaves up to half its capacity unused and holds three times its size while it moves.
+  std::deque<Factor> factors_;
   std::vector<int> first_factor_of_pose_;  // factors_.size() when the pose was created
 
   SparseCholesky full_factor_;
@@ -270,11 +273,11 @@ class Esdf {
   int chain_base_ = 0;
   std::vector<Mat3> chain_phi_, chain_cov_;
   bool chain_valid_ = true;
-  Eigen::MatrixXd base_columns_;                      // stale Sigma(:, base-1), from the last full factorisation
-  std::vector<Mat3> factored_marginals_;              // Sigma(p, p) of the factored poses (empty: not yet computed)
+  Eigen::MatrixXd base_columns_;          // stale Sigma(:, base-1), from the last full factorisation
+  std::vector<Mat3> factored_marginals_;  // Sigma(p, p) of the factored poses (empty: not yet computed)
   ChainAnchor anchor_;
-  size_t anchor_factors_ = 0;       // factors_.size() when anchor_ was looked for ...
-  int anchor_base_ = -1;            // ... and chain_base_ then
+  size_t anchor_factors_ = 0;                        // factors_.size() when anchor_ was looked for ...
+  int anchor_base_ = -1;                             // ... and chain_base_ then
   std::unordered_map<int, PathBound> anchor_paths_;  // from anchor_paths_from_, within the factored poses
   struct PathEntry {
     double spread;
@@ -282,7 +285,7 @@ class Esdf {
     bool operator>(const PathEntry& o) const { return spread > o.spread; }
   };
   std::priority_queue<PathEntry, std::vector<PathEntry>, std::greater<PathEntry>> anchor_open_;  // the path search, resumed
-  std::unordered_set<int> anchor_settled_;                                                      // when a pose is asked
+  std::unordered_set<int> anchor_settled_;                                                       // when a pose is asked
   int anchor_paths_from_ = -1, anchor_paths_base_ = -1;
   std::vector<std::vector<int>> factors_of_pose_;  // the factors touching each pose (anchorPath's graph) ...
   size_t factors_indexed_ = 0;                     // ... for factors_[0, this)

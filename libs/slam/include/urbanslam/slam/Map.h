@@ -8,6 +8,7 @@
 // The keyframes' own scans live in a scan store (io::ScanStore): compact, in memory up to a
 // bound and in a spill file beyond it, so a city of a million keyframes does not hold them all.
 #include <Eigen/Core>
+#include <deque>
 #include <memory>
 #include <vector>
 
@@ -23,6 +24,12 @@ class Esdf;
 }
 
 namespace urbanslam::slam {
+
+// What the map appends to per keyframe, up to millions of entries: a deque grows by fixed blocks,
+// where a vector's doubling leaves up to half its capacity unused and, while it moves to a new
+// buffer, holds three times its size at once.
+template <class T>
+using PerKeyframe = std::deque<T>;
 
 struct Keyframe {
   size_t index = 0;
@@ -63,7 +70,7 @@ class Map {
       std::string spill_dir = {});
   ~Map();
 
-  const std::vector<Keyframe>& keyframes() const { return keyframes_; }
+  const PerKeyframe<Keyframe>& keyframes() const { return keyframes_; }
   size_t size() const { return keyframes_.size(); }
   bool empty() const { return keyframes_.empty(); }
   const Keyframe& back() const { return keyframes_.back(); }
@@ -77,7 +84,7 @@ class Map {
   void scanInto(size_t k, io::LaserScan& out) const { scans_.expandInto(k, out); }
   const io::ScanStore& scans() const { return scans_; }
 
-  const std::vector<GraphEdge>& edges() const { return edges_; }
+  const PerKeyframe<GraphEdge>& edges() const { return edges_; }
   void addEdge(const GraphEdge& e) { edges_.push_back(e); }
 
   // Spatial index over the keyframes' current positions.
@@ -118,13 +125,13 @@ class Map {
     size_t anchor;       // last anchor before it (npos: none yet)
   };
 
-  std::vector<Keyframe> keyframes_;
+  PerKeyframe<Keyframe> keyframes_;
   io::ScanStore scans_;  // keyframe k's scan has id k
-  std::vector<GraphEdge> edges_;
+  PerKeyframe<GraphEdge> edges_;
   KeyframeGrid index_;
   std::unique_ptr<esdf::Esdf> filter_;
-  std::vector<ScanAnchor> anchors_;
-  std::vector<OdometrySample> odometry_;
+  PerKeyframe<ScanAnchor> anchors_;
+  PerKeyframe<OdometrySample> odometry_;
 };
 
 }  // namespace urbanslam::slam

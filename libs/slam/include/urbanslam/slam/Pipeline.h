@@ -80,7 +80,7 @@ class Pipeline {
   // Keyframes made so far by local SLAM (global SLAM may not have taken them all yet).
   size_t keyframesMade() const { return local_.keyframes(); }
   const Map& map() const { return map_; }
-  const std::vector<Keyframe>& keyframes() const { return map_.keyframes(); }
+  const PerKeyframe<Keyframe>& keyframes() const { return map_.keyframes(); }
   // Estimated pose at every odometry (or drive) reading's time and at every scan placed by
   // matching (scanTrajectory(): at a scan's time this is the scan's pose), from the current
   // keyframe estimates and the odometry between the scans.
@@ -91,8 +91,8 @@ class Pipeline {
   std::vector<io::StampedPose> scanTrajectory() const { return map_.scanTrajectory(); }
   // The log's reference trajectory, when it has one (e.g. a corrected CARMEN log).
   const std::vector<io::StampedPose>& referenceTrajectory() const { return reference_; }
-  const std::vector<LoopClosureRecord>& loopClosures() const { return global_.closures(); }
-  const std::vector<GraphEdge>& graphEdges() const { return map_.edges(); }
+  const PerKeyframe<LoopClosureRecord>& loopClosures() const { return global_.closures(); }
+  const PerKeyframe<GraphEdge>& graphEdges() const { return map_.edges(); }
   const PipelineStats& stats() const { return stats_; }
   const PipelineOptions& options() const { return options_; }
   std::string estimatorName() const { return slam::estimatorName(options_.estimator.type); }
