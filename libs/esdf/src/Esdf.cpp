@@ -13,10 +13,7 @@ namespace urbanslam::esdf {
 Esdf::Esdf(EsdfOptions options) : options_(options), full_factor_(options.ordering) {}
 Esdf::~Esdf() = default;
 
-void Esdf::reserve(int poses) {
-  state_.reserve(poses);
-  first_factor_of_pose_.reserve(static_cast<size_t>(poses));
-}
+void Esdf::reserve(int poses) { first_factor_of_pose_.reserve(static_cast<size_t>(poses)); }
 
 Vec3 Esdf::stabilisingNoise(const MotionModel& m) const {
   // Three-input models have a full-rank F_u Q_v F_u' and need no stabilisation.

@@ -43,7 +43,7 @@ void InformationState::write(common::BinaryWriter& w) const {
 
 void InformationState::read(common::BinaryReader& r) {
   constexpr size_t kRowBytes = (9 + 3 + 3) * 8 + 8, kLinkBytes = 4 + 9 * 8;
-  std::vector<Row> rows(r.count(kRowBytes));
+  std::deque<Row> rows(r.count(kRowBytes));
   long long links = 0;
   for (Row& row : rows) {
     row.diag = r.matrix<3, 3>();

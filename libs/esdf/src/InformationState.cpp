@@ -80,7 +80,7 @@ void InformationState::marginalise(int k) {
 }
 
 size_t InformationState::memoryBytes() const {
-  size_t bytes = rows_.capacity() * sizeof(Row);
+  size_t bytes = rows_.size() * sizeof(Row);  // grown by fixed blocks: its size, to a block
   for (const Row& r : rows_) bytes += r.links.capacity() * sizeof(Link);
   return bytes;
 }

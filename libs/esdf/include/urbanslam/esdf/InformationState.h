@@ -9,6 +9,7 @@
 // trajectory; nothing here is dense in the number of poses.
 #include <Eigen/Core>
 #include <cstdint>
+#include <deque>
 #include <vector>
 
 #include "urbanslam/esdf/PoseOps.h"
@@ -28,7 +29,6 @@ class InformationState {
   };
 
   int size() const { return static_cast<int>(rows_.size()); }
-  void reserve(int poses) { rows_.reserve(static_cast<size_t>(poses)); }
 
   // Appends a pose with zero information and the given mean; returns its index.
   int addPose(const Vec3& mean);
@@ -79,7 +79,9 @@ class InformationState {
   };
   Link* findLink(int i, int j);
 
-  std::vector<Row> rows_;
+  // One per pose, up to millions: grown by fixed blocks (a vector's doubling leaves up to half
+  // its capacity unused and holds three times its size while it moves).
+  std::deque<Row> rows_;
   std::uint64_t structure_stamp_ = 0;
   long long link_count_ = 0;
 };
