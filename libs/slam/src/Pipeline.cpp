@@ -222,11 +222,14 @@ void Pipeline::addKeyframe(io::LaserScan scan, const std::optional<CameraMeasure
   // The observers get the keyframe's scan as the map keeps it: the expanded copy local SLAM used
   // goes along rather than being expanded again there.
   //    Then the submap's keyframes as global SLAM sees them, for local SLAM to take later.
-  const size_t ticket = postToGlobalSlam([this, kf = Keyframe{k, timestamp, {}, false, false, {}}, kept = std::move(kept), c, scan = std::move(scan),
-                                          handed_over = std::chrono::steady_clock::now()]() mutable {
+  const size_t ticket = postToGlobalSlam([this, kf = Keyframe{k, timestamp, {}, false, false, {}}, kept = std::move(kept), c,
+                                          scan = std::move(scan), handed_over = std::chrono::steady_clock::now()]() mutable {
     const std::array<double, 9> cov = global_.addKeyframe(std::move(kf), std::move(kept), c);
     const Keyframe& added = map_.back();
     for (auto* o : observers_) o->onKeyframe({added.index, added.timestamp, added.pose, cov, &scan});
+    // The camera's views are kept for this keyframe's candidates only: a continued run (which
+    // starts between keyframes without them) then decides as the whole run did.
+    camera_views_.clear();
     global_.closeLoops(added.index, handed_over);
     if (takesSubmapCorrections()) {
       SubmapEstimate e{added.index, {}};

@@ -19,7 +19,7 @@ namespace {
 // a laser at 10 Hz has an image every five keyframes at driving speed, so one within two or three
 // of any keyframe.
 constexpr size_t kImageReachKeyframes = 3;
-// The camera's views kept for the next keyframes' closures (they ask for the same image pairs).
+// The camera's views kept for a keyframe's candidates (they ask for the same image pairs).
 constexpr size_t kCameraViewsKept = 16;
 }  // namespace
 

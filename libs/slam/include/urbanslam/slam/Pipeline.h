@@ -142,7 +142,8 @@ class Pipeline {
   void measureLength(size_t earlier_image, size_t current_image, CameraMeasurement& m);
   // The camera's view of keyframes (earlier, current) for global SLAM's confirmation of closures:
   // the images nearest to them (kImageReachKeyframes), measured with their full pose, or nothing.
-  // The last few pairs are kept: the next keyframes' closures ask for the same images.
+  // The pairs measured for the current keyframe's candidates are kept (they ask for the same
+  // images), until the next keyframe's.
   std::optional<CameraPairView> cameraView(size_t earlier, size_t current);
   std::optional<size_t> nearestImage(size_t keyframe) const;  // its image database id
 
