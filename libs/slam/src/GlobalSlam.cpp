@@ -127,7 +127,11 @@ bool GlobalSlam::consistent(const LoopClosureRecord& a, const LoopClosureRecord&
   const auto& kf = map_.keyframes();
   const common::Pose2 predicted = common::compose(common::compose(common::between(kf[b.from].pose, kf[a.from].pose), a.measurement),
                                                   common::between(kf[a.to].pose, kf[b.to].pose));
-  const common::Pose2 d = common::between(predicted, b.measurement);
+  return agree(predicted, b.measurement);
+}
+
+bool GlobalSlam::agree(const common::Pose2& a, const common::Pose2& b) const {
+  const common::Pose2 d = common::between(a, b);
   return std::hypot(d.x, d.y) <= options_.loop_closure.confirm_tolerance_m &&
          std::abs(d.phi) <= options_.loop_closure.confirm_tolerance_deg * kDeg;
 }
@@ -213,10 +217,7 @@ bool GlobalSlam::cameraConfirms(const LoopClosureRecord& r, const std::optional<
   const common::Pose2 scans = common::compose(common::compose(common::between(kf[view->earlier].pose, kf[r.from].pose), r.measurement),
                                               common::between(kf[r.to].pose, kf[view->current].pose));
   const common::Pose2& m = view->camera.mount;
-  const common::Pose2 camera = common::compose(common::compose(m, view->camera.metric.pose), common::inverse(m));
-  const common::Pose2 d = common::between(camera, scans);
-  return std::hypot(d.x, d.y) <= options_.loop_closure.confirm_tolerance_m &&
-         std::abs(d.phi) <= options_.loop_closure.confirm_tolerance_deg * kDeg;
+  return agree(common::compose(common::compose(m, view->camera.metric.pose), common::inverse(m)), scans);
 }
 
 void GlobalSlam::closeLoops(size_t current, SteadyTime handed_over) {

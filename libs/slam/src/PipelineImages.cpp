@@ -19,8 +19,6 @@ namespace {
 // a laser at 10 Hz has an image every five keyframes at driving speed, so one within two or three
 // of any keyframe.
 constexpr size_t kImageReachKeyframes = 3;
-// The camera's views kept for a keyframe's candidates (they ask for the same image pairs).
-constexpr size_t kCameraViewsKept = 16;
 }  // namespace
 
 void Pipeline::startImageDetector() {
@@ -35,14 +33,17 @@ void Pipeline::startImageDetector() {
 }
 
 std::optional<size_t> Pipeline::nearestImage(size_t keyframe) const {
-  // image_keyframes_ grows with the keyframes: sorted.
-  const auto it = std::lower_bound(image_keyframes_.begin(), image_keyframes_.end(), keyframe);
+  // image_keyframes_ grows with the keyframes: sorted. The nearest is the first at or after the
+  // keyframe or the one before it (the earlier on a tie).
+  const auto after = std::lower_bound(image_keyframes_.begin(), image_keyframes_.end(), keyframe);
   std::optional<size_t> best;
   size_t best_gap = kImageReachKeyframes + 1;
-  for (auto c = it == image_keyframes_.begin() ? it : std::prev(it); c != image_keyframes_.end() && c <= it; ++c) {
+  const auto consider = [&](std::vector<size_t>::const_iterator c) {
     const size_t gap = *c > keyframe ? *c - keyframe : keyframe - *c;
     if (gap < best_gap) best_gap = gap, best = static_cast<size_t>(c - image_keyframes_.begin());
-  }
+  };
+  if (after != image_keyframes_.begin()) consider(std::prev(after));
+  if (after != image_keyframes_.end()) consider(after);
   return best;
 }
 
@@ -65,7 +66,6 @@ std::optional<CameraPairView> Pipeline::cameraView(size_t earlier, size_t curren
     if (m->metric.valid) view = CameraPairView{ka, kb, *m};
   }
   camera_views_.emplace_back(pair, view);
-  if (camera_views_.size() > kCameraViewsKept) camera_views_.pop_front();
   return view;
 }
 

@@ -3,7 +3,8 @@
 // delayed pose (ESDF prediction with augmentation, constant time) with local SLAM's constraint;
 // then the loop-closure candidates (near the estimate, Mahalanobis-gated; with the laser
 // classifier's detections too where the estimate is too uncertain), alignment, the innovation
-// gate, confirmation by a second agreeing closure, the update, and the recovery after it. Tree of Words proposals take the same path from
+// gate, confirmation (by a second agreeing closure, or with a camera by the images of the two
+// places), the update, and the recovery after it. Tree of Words proposals take the same path from
 // the alignment on.
 #include <array>
 #include <chrono>
@@ -97,9 +98,11 @@ class GlobalSlam {
   Admission admit(LoopClosureRecord r, size_t current, MeasuredBy measured = MeasuredBy::Scans,
                   const std::optional<CameraPairView>& view = std::nullopt);
   Admission commit(std::initializer_list<LoopClosureRecord*> records);
-  bool cameraConfirms(const LoopClosureRecord& r, const std::optional<CameraPairView>& view) const;
+  bool cameraConfirms(const LoopClosureRecord& r, const std::optional<CameraPairView>& given) const;
   void expirePending(size_t current);
   bool consistent(const LoopClosureRecord& a, const LoopClosureRecord& b) const;
+  // Two measurements of one relative pose agree: within confirm_tolerance_m and _deg.
+  bool agree(const common::Pose2& a, const common::Pose2& b) const;
   void reportClosure(const LoopClosureRecord& r);
   // After an accepted closure of keyframe `current`: a full recovery when the map has grown
   // enough since the last one ([estimator] full_recovery_min_growth), else the recent poses.

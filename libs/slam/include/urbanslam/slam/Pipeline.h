@@ -159,7 +159,8 @@ class Pipeline {
   std::vector<size_t> image_keyframes_;                        // image database id -> keyframe
   std::vector<ImageCamera> image_cameras_;                     // image database id -> its camera
   KeyframeImageAssigner images_;
-  std::deque<std::pair<std::pair<size_t, size_t>, std::optional<CameraPairView>>> camera_views_;  // (image, image) -> view
+  // (image, image) -> view, for the current keyframe's candidates (a few pairs)
+  std::vector<std::pair<std::pair<size_t, size_t>, std::optional<CameraPairView>>> camera_views_;
   SubmapCorrections submap_corrections_;
   std::deque<std::pair<size_t, size_t>> keyframe_tickets_;  // keyframe -> its global SLAM job's ticket
   bool have_first_ts_ = false;
