@@ -11,6 +11,7 @@
 #include "SkippingSource.h"
 #include "TestPaths.h"
 #include "urbanslam/evaluation/Evaluation.h"
+#include "urbanslam/alignment/ScanModel.h"
 #include "urbanslam/slam/LocalizationSmoothing.h"
 #include "urbanslam/slam/Localizer.h"
 #include "urbanslam/slam/Pipeline.h"
@@ -370,4 +371,105 @@ TEST(Localizer, NeverTracksInALookAlikeWingFarFromWhereItWasLost) {
     }
   EXPECT_GT(tracked_scans, 20u);
   EXPECT_GE(localizer.stats().lost_events, 1u);
+}
+
+namespace {
+
+// The rest of the excerpt's scans as the localizer sees them (input filter applied), with the
+// full run's pose at each.
+struct RestScan {
+  double timestamp;
+  alignment::PointSet points;
+  common::Pose2 truth;
+};
+
+std::vector<RestScan> restScans() {
+  const slam::Pipeline& first = *maps().first;
+  const slam::InputFilter input(first.options().input);
+  const slam::LocalizerOptions o = slam::localizerOptions(first.options());
+  test::SkippingSource src(io::openDataSource(excerpt()), maps().skip);
+  std::vector<RestScan> out;
+  io::Measurement m;
+  while (src.next(m))
+    if (auto* scan = std::get_if<io::LaserScan>(&m); scan && input.accepts(scan->label)) {
+      input.limitRanges(*scan);
+      out.push_back({scan->timestamp, alignment::pointSetFromScan(*scan, o.areas.scan_model, true), reference(scan->timestamp)});
+    }
+  return out;
+}
+
+// The map with a copy of every keyframe `offset` away, the copy's keyframes within `radius` of
+// `hole` (in the original's frame) left out: near the hole the copy looks like the original, and
+// differs once the hole's walls come into view.
+std::unique_ptr<slam::Map> copyWithHole(const slam::Map& map, const common::Pose2& offset, const Eigen::Vector2d& hole, double radius) {
+  auto out = std::make_unique<slam::Map>(nullptr, 1.0);
+  size_t index = 0;
+  for (const slam::Keyframe& k : map.keyframes()) {
+    slam::Keyframe kf = k;
+    kf.index = index++;
+    out->addKeyframe(kf, io::CompactScan(map.scan(k.index)));
+  }
+  for (const slam::Keyframe& k : map.keyframes()) {
+    if (std::hypot(k.pose.x - hole.x(), k.pose.y - hole.y()) < radius) continue;
+    slam::Keyframe kf = k;
+    kf.index = index++;
+    kf.pose = common::compose(offset, k.pose);
+    out->addKeyframe(kf, io::CompactScan(map.scan(k.index)));
+  }
+  return out;
+}
+
+}  // namespace
+
+// A place and its copy that one scan cannot tell apart (the place search says ambiguous) are
+// told apart by following both while the vehicle drives on (the full run's motion): the place
+// where the vehicle really is wins once the walls the copy lacks come into view, at the full
+// run's pose. Followed with the copy first (a search whose winner was the copy), the copy never
+// wins: the following gives up.
+TEST(PlaceHypotheses, FollowingTellsApartAPlaceAndItsCopyThatOneScanCannot) {
+  const slam::Pipeline& first = *maps().first;
+  const std::vector<RestScan> rest = restScans();
+  const common::Pose2 offset{60.0, -40.0, 0.3};
+  const slam::LocalizerOptions o = slam::localizerOptions(first.options());
+  size_t followed = 0;
+  for (size_t hole_at = 60; hole_at < rest.size() && followed < 3; hole_at += 40) {
+    const Eigen::Vector2d hole(rest[hole_at].truth.x, rest[hole_at].truth.y);
+    const auto map = copyWithHole(first.map(), offset, hole, 3.0);
+    slam::MapAreas areas(*map, o.areas);
+    slam::PlaceRecognizer places(*map, areas, o.places);
+    const alignment::PriorMatcherOptions matcher = areas.options().matcher;
+    // The first scan on the way to the hole that one scan cannot place, its two places the
+    // original and the copy.
+    for (size_t k = hole_at - 40; k + 5 < hole_at; k += 5) {
+      const slam::PlaceHypothesis h = places.locate(rest[k].points, matcher);
+      if (h.reason != "ambiguous" || h.places.size() > 4) continue;
+      const common::Pose2 copy = common::compose(offset, rest[k].truth);
+      const auto near = [&](const slam::PlaceCandidate& c, const common::Pose2& p) { return distance(c.pose, p) < 0.5; };
+      const bool both = std::any_of(h.places.begin(), h.places.end(), [&](const auto& c) { return near(c, rest[k].truth); }) &&
+                        std::any_of(h.places.begin(), h.places.end(), [&](const auto& c) { return near(c, copy); });
+      if (!both) continue;
+      for (const bool copy_first : {false, true}) {
+        slam::PlaceHypotheses following(areas, o.places, o.following);
+        const std::vector<slam::PlaceCandidate> pair = copy_first ? std::vector<slam::PlaceCandidate>{{copy, 0}, {rest[k].truth, 0}}
+                                                                  : std::vector<slam::PlaceCandidate>{{rest[k].truth, 0}, {copy, 0}};
+        following.start(pair, places.searchPoints(rest[k].points), rest[k].timestamp);
+        ASSERT_TRUE(following.active());
+        slam::PlaceHypotheses::Outcome outcome = slam::PlaceHypotheses::Outcome::Following;
+        size_t j = k + 1;
+        for (; j < rest.size() && outcome == slam::PlaceHypotheses::Outcome::Following; ++j)
+          outcome =
+              following.update(common::between(rest[j - 1].truth, rest[j].truth), places.searchPoints(rest[j].points), rest[j].timestamp);
+        if (copy_first) {
+          EXPECT_NE(outcome, slam::PlaceHypotheses::Outcome::Decided) << "the copy won at " << rest[j - 1].timestamp;
+        } else {
+          ASSERT_EQ(outcome, slam::PlaceHypotheses::Outcome::Decided) << "from " << rest[k].timestamp;
+          EXPECT_LT(distance(following.winner(), rest[j - 1].truth), 0.3) << rest[j - 1].timestamp;
+          EXPECT_LT(std::abs(common::wrapToPi(following.winner().phi - rest[j - 1].truth.phi)), 3 * M_PI / 180);
+        }
+      }
+      ++followed;
+      break;
+    }
+  }
+  EXPECT_GE(followed, 2u);
 }

@@ -58,6 +58,8 @@ common::Json localizationStats(const std::vector<LocalizedScan>& scans, const Lo
   c["discontinuities"] = s.discontinuities;
   c["poses_replaced"] = s.poses_replaced;
   c["place_search_windows"] = s.place_search_windows;
+  c["places_followed"] = s.places_followed;
+  c["places_decided"] = s.places_decided;
   c["map_references_built"] = s.references_built;
   c["coarse_grids_built"] = s.coarse_grids_built;
   Json& l = j["localization"];

@@ -46,6 +46,7 @@ Localizer::Localizer(const Map& map, const PipelineOptions& map_options, Localiz
       motion_(map_options.motion, map_options.vehicle),
       areas_(map_, options_.areas),
       places_(map_, areas_, options_.places),
+      following_(areas_, options_.places, options_.following),
       monitor_(options_.monitor),
       matcher_(areas_.options().matcher),
       continuity_gate_(esdf::chi2Quantile(options_.continuity_probability, 2)),
@@ -125,6 +126,7 @@ void Localizer::takeFix(const PlaceHypothesis& h, bool confirmed, LocalizedScan&
   confirmed_ = confirmed;
   consecutive_matches_ = 0;
   monitor_.reset();
+  following_.stop();
   searched_ = false;
   out.map_fix = true;
   out.map_pose = pose_;
@@ -133,6 +135,14 @@ void Localizer::takeFix(const PlaceHypothesis& h, bool confirmed, LocalizedScan&
   out.matched = true;
   out.matched_fraction = h.matched_fraction;
   ++stats_.relocalisations;
+}
+
+void Localizer::follow(const PlaceHypothesis& h, const alignment::PointSet& points, double t, const std::optional<common::Pose2>& tracked) {
+  if (h.places.empty()) return;
+  std::vector<PlaceCandidate> places = h.places;
+  if (tracked) places.push_back({*tracked, 0.0});
+  following_.start(places, places_.searchPoints(points), t);
+  if (following_.active()) ++stats_.places_followed;
 }
 
 bool Localizer::placeSearchDue(double t) const {
@@ -169,11 +179,10 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
   // composed onto its pose, the covariance carried through the composition's Jacobians.
   common::Pose2 predicted = pose_;
   Eigen::Matrix3d predicted_cov = cov_;
+  const common::Pose2 d = local_now && local_previous_
+                              ? common::between(*local_previous_, *local_now)
+                              : common::compose(common::compose(common::inverse(lead_), motion_.increment()), odometryLead(t));
   if (have_pose_) {
-    const common::Pose2 lead = odometryLead(t);
-    const common::Pose2 d = local_now && local_previous_
-                                ? common::between(*local_previous_, *local_now)
-                                : common::compose(common::compose(common::inverse(lead_), motion_.increment()), lead);
     const double c = std::cos(pose_.phi), s = std::sin(pose_.phi);
     Eigen::Matrix3d ja = Eigen::Matrix3d::Identity(), jd = Eigen::Matrix3d::Identity();
     ja(0, 2) = -s * d.x - c * d.y;
@@ -201,7 +210,23 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
   }
   bool initial_contradicted = false;
   bool replaced = false;
-  if (discontinuity) {
+  if (following_.active() && following_.update(d, places_.searchPoints(points), t) == PlaceHypotheses::Outcome::Decided) {
+    // The search's winner led every other place: the pose, unless it is the one tracked already.
+    ++stats_.places_decided;
+    const bool tracked_there =
+        state_ == LocalizationState::Tracking && have_pose_ &&
+        std::hypot(following_.winner().x - predicted.x, following_.winner().y - predicted.y) <= options_.places.distinct_m &&
+        std::abs(common::wrapToPi(following_.winner().phi - predicted.phi)) <= options_.places.distinct_deg * kDeg;
+    if (!tracked_there) {
+      PlaceHypothesis h = places_.refine(points, following_.winner(), matcher_, PlaceHypothesis{});
+      if (h.found) {
+        if (state_ == LocalizationState::Tracking) ++stats_.poses_replaced;
+        takeFix(h, false, out);
+        replaced = true;
+      }
+    }
+  }
+  if (discontinuity && !replaced) {
     // The dead reckoning from the pose rules nothing out any more; the whole map is searched,
     // and the scan matched near the pose if the search does not replace it.
     ++stats_.discontinuities;
@@ -214,6 +239,8 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
       takeFix(h, false, out);
       ++stats_.poses_replaced;
       replaced = true;
+    } else {
+      follow(h, points, t, predicted);
     }
   }
   if (replaced) {

@@ -33,12 +33,7 @@ PlaceRecognizer::PlaceRecognizer(const Map& map, MapAreas& areas, PlaceRecogniti
 PlaceHypothesis PlaceRecognizer::locate(const alignment::PointSet& scan, const alignment::PriorMatcherOptions& matcher,
                                         const std::optional<PlaceSearchRegion>& region) {
   PlaceHypothesis h;
-  // The search's points: one per voxel, near returns only (far ones fall outside the grids).
-  alignment::PointSet near;
-  for (const auto& sp : scan)
-    if (sp.p.norm() <= options_.max_range_m) near.push_back(sp);
-  std::vector<Eigen::Vector2d> points;
-  for (const size_t i : alignment::firstPerVoxel(near, options_.voxel_m)) points.push_back(near[i].p);
+  const std::vector<Eigen::Vector2d> points = searchPoints(scan);
   h.points = static_cast<int>(points.size());
   if (h.points < options_.min_points) {
     h.reason = "too few points";
@@ -117,17 +112,42 @@ PlaceHypothesis PlaceRecognizer::locate(const alignment::PointSet& scan, const a
   h.pose = best->pose;
   if (h.margin_per_point < options_.min_margin_per_point) {
     h.reason = "ambiguous";
+    // The places within the margin, one per place: best first, each distinct from every one kept.
+    std::sort(found.begin(), found.end(), [](const Found& a, const Found& b) { return a.score > b.score; });
+    for (const Found& f : found) {
+      if (f.score < h.score - margin) break;
+      const bool distinct = std::all_of(h.places.begin(), h.places.end(), [&](const PlaceCandidate& p) {
+        return std::hypot(f.pose.x - p.pose.x, f.pose.y - p.pose.y) > options_.distinct_m ||
+               std::abs(common::wrapToPi(f.pose.phi - p.pose.phi)) > options_.distinct_deg * kDeg;
+      });
+      if (distinct) h.places.push_back({f.pose, f.score});
+    }
     return h;
   }
+  return refine(scan, best->pose, matcher, std::move(h));
+}
+
+std::vector<Eigen::Vector2d> PlaceRecognizer::searchPoints(const alignment::PointSet& scan) const {
+  alignment::PointSet near;
+  for (const auto& sp : scan)
+    if (sp.p.norm() <= options_.max_range_m) near.push_back(sp);
+  std::vector<Eigen::Vector2d> points;
+  for (const size_t i : alignment::firstPerVoxel(near, options_.voxel_m)) points.push_back(near[i].p);
+  return points;
+}
+
+PlaceHypothesis PlaceRecognizer::refine(const alignment::PointSet& scan, const common::Pose2& coarse,
+                                        const alignment::PriorMatcherOptions& matcher, PlaceHypothesis h) {
+  h.pose = coarse;
   // The winner refined on the fine reference, from the coarse pose.
-  const alignment::MatchReference* reference = areas_.reference(best->pose.x, best->pose.y);
+  const alignment::MatchReference* reference = areas_.reference(coarse.x, coarse.y);
   if (!reference) {
     h.reason = "no reference";
     return h;
   }
   const double s = options_.refine_sigma_m, a = options_.refine_sigma_deg * kDeg;
   const alignment::PriorMatchResult r =
-      alignment::matchWithPrior(*reference, scan, best->pose, Eigen::Vector3d(s * s, s * s, a * a).asDiagonal(), matcher);
+      alignment::matchWithPrior(*reference, scan, coarse, Eigen::Vector3d(s * s, s * s, a * a).asDiagonal(), matcher);
   h.matched_fraction = r.matchedFraction();
   if (!r.valid) {
     h.reason = "refinement failed: " + r.failure_reason;
@@ -138,7 +158,9 @@ PlaceHypothesis PlaceRecognizer::locate(const alignment::PointSet& scan, const a
     return h;
   }
   h.seen_through_share = r.in_view > 0 ? static_cast<double>(r.seen_through) / r.in_view : 1.0;
-  if (h.seen_through_share > options_.max_seen_through_share) {
+  const double max_share =
+      h.margin_per_point >= options_.clear_margin_per_point ? options_.max_seen_through_share_clear : options_.max_seen_through_share;
+  if (h.seen_through_share > max_share) {
     h.reason = "walls where the other side saw free space";
     return h;
   }

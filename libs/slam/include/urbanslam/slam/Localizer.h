@@ -20,6 +20,13 @@
 // its confirmation (the dead reckoning from it rules nothing out any more) and the whole map is
 // searched at once: a clear winner elsewhere replaces the pose.
 //
+// A place search that leaves several places within its margin (look-alike rooms, a corridor's
+// doors) has them followed over the next scans (PlaceHypotheses.h): carried by the same motion,
+// each scored against the map where it went, until the search's winner leads every other by the
+// search's margin. That happens after a discontinuity, where the vehicle was tracked a moment
+// ago: the pose being tracked is one of the places, and is replaced only if the winner leads it
+// too. Lost (where the vehicle may stand somewhere the map never saw), only a clear winner counts.
+//
 // A place search answers from one scan, and a building of repeated rooms and corridors (ACES)
 // has places that one scan, and the scans tracked after it, cannot tell apart: a wrong fix there
 // tracks as smoothly as the right one. What does tell them apart is where the vehicle came from:
@@ -44,6 +51,7 @@
 #include "urbanslam/slam/MapAreas.h"
 #include "urbanslam/slam/MotionIntegrator.h"
 #include "urbanslam/slam/PipelineOptions.h"
+#include "urbanslam/slam/PlaceHypotheses.h"
 #include "urbanslam/slam/PlaceRecognizer.h"
 #include "urbanslam/slam/TrackingMonitor.h"
 
@@ -52,6 +60,7 @@ namespace urbanslam::slam {
 struct LocalizerOptions {
   MapAreaOptions areas;
   PlaceRecognitionOptions places;
+  PlaceTrackingOptions following;
   TrackingMonitorOptions monitor;
   double min_matched_fraction = 0.5;  // a tracking match must explain this share of the scan's points
   // A match's posterior covariance times covariance_scale (the map's [local] one: successive
@@ -141,6 +150,8 @@ struct LocalizerStats {
   size_t discontinuities = 0;       // local SLAM's view broke off while tracked (a whole-map search each, in place_searches)
   size_t poses_replaced = 0;        // tracked poses such a search replaced (also in relocalisations)
   size_t place_search_windows = 0;  // windows searched by branch and bound, over all place searches
+  size_t places_followed = 0;       // ambiguous searches whose places were followed over the next scans
+  size_t places_decided = 0;        // ... until one stood alone (a relocalisation each when it was not the pose tracked)
   double first_timestamp = 0, last_timestamp = 0;
   double lost_s = 0;        // log time spent lost
   double first_fix_s = -1;  // log time from the first scan to the first tracked one (-1: never)
@@ -177,6 +188,8 @@ class Localizer {
   // A place search's fix becomes the pose: tracking again, confirmed only when `confirmed` (a fix
   // the confirmed dead reckoning admitted), a relocalisation in `out` and the stats.
   void takeFix(const PlaceHypothesis& h, bool confirmed, LocalizedScan& out);
+  // An ambiguous search's places followed from this scan on (and the pose tracked, when given).
+  void follow(const PlaceHypothesis& h, const alignment::PointSet& points, double t, const std::optional<common::Pose2>& tracked);
   // The pose and its covariance, floored (withFloors).
   void setPose(const common::Pose2& pose, const Eigen::Matrix3d& cov);
 
@@ -194,6 +207,7 @@ class Localizer {
   common::Pose2 lead_;  // the lead applied at the previous scan
   MapAreas areas_;
   PlaceRecognizer places_;
+  PlaceHypotheses following_;
   TrackingMonitor monitor_;
   alignment::PriorMatcherOptions matcher_;
   alignment::SeenThroughRate seen_through_{0.05}, seen_through_displaced_{0.3};

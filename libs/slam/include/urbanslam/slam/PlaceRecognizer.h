@@ -39,6 +39,12 @@ struct PlaceRecognitionOptions {
   // percent (people, glass; about 3 % on FR079), at a wrong one that looks alike, walls stand
   // in open space (8-12 % measured for Intel scans placed in the FR079 map).
   double max_seen_through_share = 0.06;
+  // A winner that beats every other place by clear_margin_per_point is allowed up to this share:
+  // no place of the map looks like it, and the walls it has in free space are what changed since
+  // the map was made (people, doors: 6-13 % at the right pose after a simulated kidnapping in
+  // the raw benchmark logs, whose margins were 0.75-1.1 nats per point).
+  double clear_margin_per_point = 0.6;
+  double max_seen_through_share_clear = 0.15;
   double refine_sigma_m = 0.2;  // the coarse pose's uncertainty as the refinement's prior
   double refine_sigma_deg = 3.0;
 };
@@ -52,6 +58,13 @@ struct PlaceSearchRegion {
   double gate = 0;  // on d' cov⁻¹ d
 };
 
+// A place the search could not rule out: the best pose of one search window, and its coarse scan
+// log-likelihood.
+struct PlaceCandidate {
+  common::Pose2 pose;
+  double score = 0;
+};
+
 struct PlaceHypothesis {
   bool found = false;
   std::string reason;  // why not found
@@ -62,6 +75,10 @@ struct PlaceHypothesis {
   double matched_fraction = 0;
   double seen_through_share = 0;
   int points = 0, candidates = 0, nodes = 0;
+  // Ambiguous: the distinct places within the margin of the winner, the winner first (the rest
+  // one per place, best first). Following them over the next scans can tell them apart
+  // (PlaceHypotheses.h).
+  std::vector<PlaceCandidate> places;
 };
 
 class PlaceRecognizer {
@@ -72,6 +89,14 @@ class PlaceRecognizer {
   PlaceHypothesis locate(const alignment::PointSet& scan, const alignment::PriorMatcherOptions& matcher,
                          const std::optional<PlaceSearchRegion>& region = std::nullopt);
   size_t candidates() const { return centres_.size(); }
+  // The scan's points a search scores: near returns only (farther ones fall outside the grids),
+  // one per voxel (roughly independent).
+  std::vector<Eigen::Vector2d> searchPoints(const alignment::PointSet& scan) const;
+  // A coarse pose refined on the fine reference and checked (matched share, walls in the other
+  // side's free space): `h` found, or the reason it is not.
+  PlaceHypothesis refine(const alignment::PointSet& scan, const common::Pose2& coarse, const alignment::PriorMatcherOptions& matcher,
+                         PlaceHypothesis h);
+  const PlaceRecognitionOptions& options() const { return options_; }
 
  private:
   MapAreas& areas_;
