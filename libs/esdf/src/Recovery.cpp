@@ -4,6 +4,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -29,13 +30,58 @@ class SerialOpenMp {
 };
 }  // namespace
 
+namespace {
+
+// Doubles kept in an unnamed temporary file (deleted when closed), in memory when the file
+// cannot be written.
+class KeptValues {
+ public:
+  KeptValues() = default;
+  KeptValues(const KeptValues&) = delete;
+  KeptValues& operator=(const KeptValues&) = delete;
+  ~KeptValues() {
+    if (file_) std::fclose(file_);
+  }
+  void keep(std::vector<double> values) {
+    count_ = values.size();
+    memory_.clear();
+    memory_.shrink_to_fit();
+    if (!file_) file_ = std::tmpfile();
+    if (file_ && std::fseek(file_, 0, SEEK_SET) == 0 && std::fwrite(values.data(), sizeof(double), count_, file_) == count_ &&
+        std::fflush(file_) == 0) {
+      in_file_ = true;
+      return;
+    }
+    in_file_ = false;
+    memory_ = std::move(values);
+  }
+  std::vector<double> read() const {
+    if (!in_file_) return memory_;
+    std::vector<double> out(count_);
+    if (std::fseek(file_, 0, SEEK_SET) != 0 || std::fread(out.data(), sizeof(double), count_, file_) != count_)
+      throw std::runtime_error("the factorised matrix's values could not be read back from their temporary file");
+    return out;
+  }
+
+ private:
+  std::FILE* file_ = nullptr;
+  bool in_file_ = false;
+  size_t count_ = 0;
+  std::vector<double> memory_;
+};
+
+}  // namespace
+
 struct SparseCholesky::Impl {
   cholmod_common common;
   cholmod_factor* factor = nullptr;
   FillReducingOrdering ordering;
   // Pattern of the last analysed matrix: the symbolic factor is reused when it is unchanged.
   std::vector<int> last_p, last_i;
-  std::vector<double> last_x;  // its values at the last factorisation (see matrix())
+  // Its values at the last factorisation, read only to save the filter (matrix()): written to an
+  // unnamed temporary file rather than held (two thirds of the matrix's bytes; at a million poses
+  // about 160 MB), or held when no temporary file can be written.
+  KeptValues last_x;
 
   explicit Impl(FillReducingOrdering o) : ordering(o) {
     cholmod_start(&common);
@@ -141,7 +187,13 @@ void SparseCholesky::factorizeLower(std::vector<int> colptr, std::vector<int> ro
     impl_->last_p.clear();
     throw NotPositiveDefinite("information matrix is not positive definite (CHOLMOD status " + std::to_string(cm->status) + ")");
   }
-  impl_->last_x = std::move(values);
+  impl_->last_x.keep(std::move(values));
+  // Built with room to grow, kept as long as the pattern lasts (not before the factorisation:
+  // `a` points into them).
+  if (!same_pattern) {
+    impl_->last_p.shrink_to_fit();
+    impl_->last_i.shrink_to_fit();
+  }
 }
 
 SparseCholesky::Matrix SparseCholesky::matrix() const {
@@ -152,7 +204,7 @@ SparseCholesky::Matrix SparseCholesky::matrix() const {
   m.structure_stamp = stamp_;
   m.colptr = impl_->last_p;
   m.rowind = impl_->last_i;
-  m.values = impl_->last_x;
+  m.values = impl_->last_x.read();
   return m;
 }
 
