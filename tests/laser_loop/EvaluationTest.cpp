@@ -132,14 +132,20 @@ TEST(LoopDetector, ScreenAgreesWithPairScoresOnDistances) {
   std::vector<FeatureVector> kept;
   for (int i = 0; i < 3000; ++i) det.addKeyframe(kept.emplace_back(descriptor()));
   const FeatureVector q = descriptor();
-  // The detector keeps only the features its model reads, and scores exactly as the classifier
-  // does on the whole vectors.
+  // The detector keeps only the features its model reads, in single precision, and scores
+  // exactly as the classifier does on the whole vectors rounded so.
+  const auto rounded = [](FeatureVector f) {
+    for (double& v : f) v = static_cast<float>(v);
+    return f;
+  };
   for (size_t i = 0; i < 50; ++i) {
-    EXPECT_EQ(det.score(q, i), m.classifier.score(q, kept[i]));
-    EXPECT_EQ(det.score(i, i + 1), m.classifier.score(kept[i], kept[i + 1]));
+    EXPECT_EQ(det.score(q, i), m.classifier.score(q, rounded(kept[i])));
+    EXPECT_EQ(det.score(i, i + 1), m.classifier.score(rounded(kept[i]), rounded(kept[i + 1])));
     const FeatureVector back = det.keyframe(i);
-    EXPECT_EQ(back[hist + 3], kept[i][hist + 3]);
-    EXPECT_EQ(back[static_cast<size_t>(kThesisFeatureCount + kShapeQuantiles)], kept[i][kThesisFeatureCount + kShapeQuantiles]);
+    EXPECT_EQ(back[hist + 3], static_cast<float>(kept[i][hist + 3]));
+    EXPECT_NE(back[hist + 3], kept[i][hist + 3]);  // rounded indeed (a random fraction is not a float)
+    EXPECT_EQ(back[static_cast<size_t>(kThesisFeatureCount + kShapeQuantiles)],
+              static_cast<float>(kept[i][kThesisFeatureCount + kShapeQuantiles]));
     EXPECT_EQ(back[0], 0.0);  // not used by the model: not kept
   }
   EXPECT_THROW(det.keyframe(3000), std::out_of_range);

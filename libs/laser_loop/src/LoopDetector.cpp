@@ -51,14 +51,12 @@ LoopDetector::LoopDetector(ClassifierModel model) : model_(std::move(model)), fa
 LoopDetector LoopDetector::fromFile(const std::string& path) { return LoopDetector(loadModel(path)); }
 
 void LoopDetector::reserve(size_t n) {
-  stored_.reserve(n * used_features_.size());
   for (auto& c : columns_) c.reserve(n);
 }
 
 size_t LoopDetector::addKeyframe(const FeatureVector& f) {
   for (size_t c = 0; c < columns_.size(); ++c) {
     const double v = f[static_cast<size_t>(used_features_[c])];
-    stored_.push_back(v);
     columns_[c].push_back(static_cast<float>(v));
   }
   return count_++;
@@ -66,8 +64,7 @@ size_t LoopDetector::addKeyframe(const FeatureVector& f) {
 
 void LoopDetector::fillUsed(size_t id, FeatureVector& f) const {
   if (id >= count_) throw std::out_of_range("LoopDetector: no keyframe " + std::to_string(id));
-  const double* v = stored_.data() + id * used_features_.size();
-  for (size_t c = 0; c < used_features_.size(); ++c) f[static_cast<size_t>(used_features_[c])] = v[c];
+  for (size_t c = 0; c < used_features_.size(); ++c) f[static_cast<size_t>(used_features_[c])] = columns_[c][id];
 }
 
 FeatureVector LoopDetector::keyframe(size_t id) const {
