@@ -88,7 +88,7 @@ TEST(GlobalThread, SameMapAsGlobalSlamInline) {
   for (const PipelineRun* r : {&inline_run, &threaded_run}) {
     EXPECT_EQ(r->recorder.keyframes, a.keyframes().size());
     EXPECT_FALSE(r->recorder.out_of_order);
-    EXPECT_EQ(r->recorder.corrections, r->pipeline->stats().global_latency_ms.size());
+    EXPECT_EQ(r->recorder.corrections, r->pipeline->stats().global_latency_ms.count());
     EXPECT_GT(r->recorder.corrections, 0u);
   }
   EXPECT_EQ(inline_run.pipeline->stats().global_backlog_max, 0u);

@@ -176,7 +176,8 @@ TEST(MapFile, MapWithAnImageDatabaseIsRefused) {
 // A file of the format before separate maps (version 3, written by that version: the fuzzing
 // seed) is read as a map without any; written again, every section is as it was (the options
 // aside: they list the keys added since), local SLAM's but for its heading corrections (none
-// learnt: three zeros), and the empty separate-maps section follows.
+// learnt: three zeros), the statistics but for their durations (histograms now, one per step
+// read), and the empty separate-maps section follows.
 TEST(MapFile, AVersion3FileIsReadAsAMapWithoutSeparateMaps) {
   const std::string path = test::repoPath("fuzz/corpus/map_file/three-scans-24-beams.usmap");
   const std::string old = readBytes(path);
@@ -189,7 +190,7 @@ TEST(MapFile, AVersion3FileIsReadAsAMapWithoutSeparateMaps) {
   EXPECT_EQ(now[8], static_cast<char>(slam::kMapFormatVersion));
   const auto a = test::mapFileSections(old), b = test::mapFileSections(now);
   EXPECT_EQ(a.size(), 7u);
-  for (const char* tag : {"STAT", "MAP ", "ESDF", "GLOB", "IMGS"}) {
+  for (const char* tag : {"MAP ", "ESDF", "GLOB", "IMGS"}) {
     ASSERT_TRUE(a.count(tag) && b.count(tag)) << tag;
     EXPECT_TRUE(a.at(tag) == b.at(tag)) << "section " << tag << " differs";
   }
@@ -203,4 +204,19 @@ TEST(MapFile, AVersion3FileIsReadAsAMapWithoutSeparateMaps) {
   EXPECT_TRUE(inserted) << "section LOCL differs beyond the heading corrections";
   ASSERT_TRUE(b.count("SEPM"));
   EXPECT_EQ(b.at("SEPM"), std::string(8, '\0'));  // a count of 0
+  // The durations read into histograms: one per step, and they stay as they are once written so.
+  const slam::PipelineStats& st = loaded->stats();
+  EXPECT_GT(st.step_ms.count(), 0u);
+  size_t by_decade = 0;
+  for (const auto& d : st.step_ms_by_decade) by_decade += d.count();
+  EXPECT_EQ(by_decade, st.step_ms.count());
+  const std::string again_path = testing::TempDir() + "version3-written-again.usmap";
+  {
+    std::ofstream f(again_path, std::ios::binary);
+    f << now;
+  }
+  const auto again = slam::loadMap(again_path);
+  EXPECT_EQ(again->stats().step_ms.count(), st.step_ms.count());
+  EXPECT_EQ(again->stats().step_ms.max(), st.step_ms.max());
+  EXPECT_TRUE(test::mapFileSections(slam::encodeMap(*again)).at("STAT") == b.at("STAT"));
 }

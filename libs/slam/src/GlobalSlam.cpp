@@ -247,7 +247,7 @@ void GlobalSlam::closeLoops(size_t current, SteadyTime handed_over) {
   // 10. Recovery after a closure: the whole map (with relinearisation) when it has grown enough
   //     since the last, else the recent poses.
   if (accepted) closureAdded(current, handed_over);
-  stats_.closure_ms.push_back(sw.milliseconds());
+  stats_.closure_ms.add(sw.milliseconds());
 }
 
 void GlobalSlam::addPlaceFix(size_t earlier, size_t current, const common::Pose2& z, const Eigen::Matrix3d& information, double score,
@@ -274,7 +274,7 @@ void GlobalSlam::recoverAll() {
   if (unrecovered_closure_) {
     e.keyframe = unrecovered_closure_->first;
     e.latency_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - unrecovered_closure_->second).count();
-    stats_.global_latency_ms.push_back(e.latency_ms);
+    stats_.global_latency_ms.add(e.latency_ms);
     unrecovered_closure_.reset();
   }
   for (auto* o : observers_) o->onPosesUpdated(e);
@@ -319,7 +319,7 @@ void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double scor
               : a == Admission::Pending ? "pending"
                                         : (reason == ClosureReason::None ? "gating" : reasonName(reason));
     if (ev.accepted) closureAdded(current, handed_over);
-    stats_.closure_ms.push_back(sw.milliseconds());
+    stats_.closure_ms.add(sw.milliseconds());
   } else {
     // Neither scans nor a camera relative pose (or no filter): a proposal on record, never a
     // constraint.

@@ -49,11 +49,11 @@ Pipeline::Pipeline(PipelineOptions options)
 Pipeline::~Pipeline() = default;
 
 void PipelineStats::recordStep(double ms, size_t keyframes) {
-  step_ms.push_back(ms);
+  step_ms.add(ms);
   size_t decade = 0;
   for (size_t n = keyframes; n >= 10; n /= 10) ++decade;
   if (step_ms_by_decade.size() <= decade) step_ms_by_decade.resize(decade + 1);
-  step_ms_by_decade[decade].push_back(ms);
+  step_ms_by_decade[decade].add(ms);
 }
 
 void Pipeline::addObserver(PipelineObserver* observer) { observers_.push_back(observer); }
@@ -182,7 +182,7 @@ void Pipeline::onScan(io::LaserScan scan, double progress) {
   if (local_.isKeyframe()) {
     common::Stopwatch kw;
     addKeyframe(std::move(scan));
-    stats_.keyframe_ms.push_back(kw.milliseconds() - waitedMs());
+    stats_.keyframe_ms.add(kw.milliseconds() - waitedMs());
   } else if (const auto anchor = local_.placeScan(scan, map_.lastAnchor())) {
     ++stats_.scans_anchored;
     map_.addAnchor(*anchor);

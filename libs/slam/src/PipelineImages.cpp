@@ -99,7 +99,7 @@ void Pipeline::onCameraImage(const io::CameraImage& image, double progress) {
   addKeyframe(std::move(none), camera_motion);
   postImage(images_.imageKeyframe(local_.keyframes() - 1, image), std::move(prepared));
   const double ms = sw.milliseconds();
-  stats_.keyframe_ms.push_back(ms);
+  stats_.keyframe_ms.add(ms);
   stats_.recordStep(ms, local_.keyframes());
   StepEvent ev{stats_.scans_used, local_.keyframes(), stats_.last_timestamp, ms, progress};
   for (auto* o : observers_) o->onStep(ev);

@@ -112,11 +112,6 @@ std::optional<io::CameraImage> readOptionalImage(BinaryReader& r) {
   return readImage(r);
 }
 
-void writeDoubles(BinaryWriter& w, const std::vector<double>& v) {
-  w.size(v.size());
-  for (double x : v) w.f64(x);
-}
-
 std::vector<double> readDoubles(BinaryReader& r) {
   std::vector<double> v(r.count(8));
   for (double& x : v) x = r.f64();
@@ -204,15 +199,26 @@ void writeStats(BinaryWriter& w, const PipelineStats& s) {
   w.f64(s.last_timestamp);
   w.f64(s.wall_s);
   w.f64(s.global_wait_s);
-  writeDoubles(w, s.step_ms);
+  s.step_ms.write(w);
   w.size(s.step_ms_by_decade.size());
-  for (const auto& d : s.step_ms_by_decade) writeDoubles(w, d);
-  writeDoubles(w, s.keyframe_ms);
-  writeDoubles(w, s.closure_ms);
-  writeDoubles(w, s.global_latency_ms);
+  for (const auto& d : s.step_ms_by_decade) d.write(w);
+  s.keyframe_ms.write(w);
+  s.closure_ms.write(w);
+  s.global_latency_ms.write(w);
 }
 
-void readStats(BinaryReader& r, PipelineStats& s) {
+// Format 8 keeps the durations as histograms; earlier formats kept every one.
+common::DurationHistogram readDurations(BinaryReader& r, std::uint32_t format_version) {
+  common::DurationHistogram h;
+  if (format_version >= 8) {
+    h.read(r);
+  } else {
+    for (double ms : readDoubles(r)) h.add(ms);
+  }
+  return h;
+}
+
+void readStats(BinaryReader& r, PipelineStats& s, std::uint32_t format_version) {
   for (size_t* v : {&s.measurements,
                     &s.scans,
                     &s.scans_used,
@@ -238,12 +244,12 @@ void readStats(BinaryReader& r, PipelineStats& s) {
   s.last_timestamp = r.f64();
   s.wall_s = r.f64();
   s.global_wait_s = r.f64();
-  s.step_ms = readDoubles(r);
+  s.step_ms = readDurations(r, format_version);
   s.step_ms_by_decade.resize(r.count(8));
-  for (auto& d : s.step_ms_by_decade) d = readDoubles(r);
-  s.keyframe_ms = readDoubles(r);
-  s.closure_ms = readDoubles(r);
-  s.global_latency_ms = readDoubles(r);
+  for (auto& d : s.step_ms_by_decade) d = readDurations(r, format_version);
+  s.keyframe_ms = readDurations(r, format_version);
+  s.closure_ms = readDurations(r, format_version);
+  s.global_latency_ms = readDurations(r, format_version);
 }
 
 void writePointSet(BinaryWriter& w, const alignment::PointSet& points) {
@@ -634,7 +640,7 @@ void Pipeline::readState(BinaryReader& r, std::uint32_t format_version) {
   if (map_.size() != 0 || stats_.measurements != 0 || finished_) throw std::logic_error("Pipeline::readState into a pipeline that has run");
   {
     BinaryReader s = r.section(kStatsTag);
-    readStats(s, stats_);
+    readStats(s, stats_, format_version);
     have_first_ts_ = s.boolean();
     reference_.resize(s.count(32));
     for (auto& p : reference_) {

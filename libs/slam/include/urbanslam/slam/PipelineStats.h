@@ -3,6 +3,8 @@
 #include <cstddef>
 #include <vector>
 
+#include "urbanslam/common/DurationHistogram.h"
+
 namespace urbanslam::slam {
 
 struct PipelineStats {
@@ -14,16 +16,17 @@ struct PipelineStats {
   size_t image_keyframes = 0;  // keyframes with an image attached
   size_t image_proposals = 0;  // Tree of Words detections (each also a loop_closures.csv row)
   double first_timestamp = 0, last_timestamp = 0;
-  double wall_s = 0;            // processing time, reading included
-  std::vector<double> step_ms;  // per processed scan
+  double wall_s = 0;  // processing time, reading included
+  // Durations as histograms (percentiles within 1 %, constant memory however long the run).
+  common::DurationHistogram step_ms;  // per processed scan
   // The same, by the map's size when the step ran: decade k holds the steps taken with 10^k to
   // 10^(k+1) - 1 keyframes (constant time per step means the same figures in every decade).
-  std::vector<std::vector<double>> step_ms_by_decade;
+  std::vector<common::DurationHistogram> step_ms_by_decade;
   void recordStep(double ms, size_t keyframes);
-  std::vector<double> keyframe_ms, closure_ms;
+  common::DurationHistogram keyframe_ms, closure_ms;
   // From local SLAM handing over a keyframe to the map corrected by the closure it brought, per
   // accepted closure (global SLAM's queue included when it runs on its own thread).
-  std::vector<double> global_latency_ms;
+  common::DurationHistogram global_latency_ms;
   size_t global_backlog_max = 0;  // most keyframes and images waiting for global SLAM at once
   // Local SLAM waited this long for global SLAM's estimate of the submap ([local]
   // correction_lag_keyframes): global SLAM was further behind than the lag.
