@@ -317,23 +317,20 @@ TEST(Localizer, StaysLostWhereTheMapHasNeverBeen) {
 namespace {
 
 // The map with every keyframe copied `offset` away (a second wing that looks exactly like the
-// first) and the first wing's keyframes within `radius` of `hole` taken out, so that at `hole`
-// the scan fits the copy better than the place it was taken at.
-std::unique_ptr<slam::Map> twinWings(const slam::Map& map, const common::Pose2& offset, const Eigen::Vector2d& hole, double radius) {
+// first) and the keyframes within `radius` of `hole` taken out of one of the two (the original's
+// frame; `hole_in_copy`: out of the copy), so that near the hole a scan fits one wing better.
+std::unique_ptr<slam::Map> twinWings(const slam::Map& map, const common::Pose2& offset, const Eigen::Vector2d& hole, double radius,
+                                     bool hole_in_copy = false) {
   auto out = std::make_unique<slam::Map>(nullptr, 1.0);
   size_t index = 0;
-  for (const slam::Keyframe& k : map.keyframes()) {
-    if (std::hypot(k.pose.x - hole.x(), k.pose.y - hole.y()) < radius) continue;
-    slam::Keyframe kf = k;
-    kf.index = index++;
-    out->addKeyframe(kf, io::CompactScan(map.scan(k.index)));
-  }
-  for (const slam::Keyframe& k : map.keyframes()) {
-    slam::Keyframe kf = k;
-    kf.index = index++;
-    kf.pose = common::compose(offset, k.pose);
-    out->addKeyframe(kf, io::CompactScan(map.scan(k.index)));
-  }
+  for (const bool copy : {false, true})
+    for (const slam::Keyframe& k : map.keyframes()) {
+      if (copy == hole_in_copy && std::hypot(k.pose.x - hole.x(), k.pose.y - hole.y()) < radius) continue;
+      slam::Keyframe kf = k;
+      kf.index = index++;
+      if (copy) kf.pose = common::compose(offset, k.pose);
+      out->addKeyframe(kf, io::CompactScan(map.scan(k.index)));
+    }
   return out;
 }
 
@@ -398,27 +395,6 @@ std::vector<RestScan> restScans() {
   return out;
 }
 
-// The map with a copy of every keyframe `offset` away, the copy's keyframes within `radius` of
-// `hole` (in the original's frame) left out: near the hole the copy looks like the original, and
-// differs once the hole's walls come into view.
-std::unique_ptr<slam::Map> copyWithHole(const slam::Map& map, const common::Pose2& offset, const Eigen::Vector2d& hole, double radius) {
-  auto out = std::make_unique<slam::Map>(nullptr, 1.0);
-  size_t index = 0;
-  for (const slam::Keyframe& k : map.keyframes()) {
-    slam::Keyframe kf = k;
-    kf.index = index++;
-    out->addKeyframe(kf, io::CompactScan(map.scan(k.index)));
-  }
-  for (const slam::Keyframe& k : map.keyframes()) {
-    if (std::hypot(k.pose.x - hole.x(), k.pose.y - hole.y()) < radius) continue;
-    slam::Keyframe kf = k;
-    kf.index = index++;
-    kf.pose = common::compose(offset, k.pose);
-    out->addKeyframe(kf, io::CompactScan(map.scan(k.index)));
-  }
-  return out;
-}
-
 }  // namespace
 
 // A place and its copy that one scan cannot tell apart (the place search says ambiguous) are
@@ -434,7 +410,7 @@ TEST(PlaceHypotheses, FollowingTellsApartAPlaceAndItsCopyThatOneScanCannot) {
   size_t followed = 0;
   for (size_t hole_at = 60; hole_at < rest.size() && followed < 3; hole_at += 40) {
     const Eigen::Vector2d hole(rest[hole_at].truth.x, rest[hole_at].truth.y);
-    const auto map = copyWithHole(first.map(), offset, hole, 3.0);
+    const auto map = twinWings(first.map(), offset, hole, 3.0, true);
     slam::MapAreas areas(*map, o.areas);
     slam::PlaceRecognizer places(*map, areas, o.places);
     const alignment::PriorMatcherOptions matcher = areas.options().matcher;
