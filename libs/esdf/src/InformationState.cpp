@@ -29,6 +29,10 @@ void InformationState::addBlock(int i, int j, const Mat3& m) {
     findLink(j, i)->block += m.transpose();
     return;
   }
+  // Beyond the two reserved, a row grows by one link at a time: a doubling vector left up to
+  // half its capacity unused in every row a loop closure reached (tens of bytes per pose).
+  for (const int r : {i, j})
+    if (auto& ls = rows_[r].links; ls.size() == ls.capacity()) ls.reserve(ls.size() + 1);
   rows_[i].links.push_back({j, m});
   rows_[j].links.push_back({i, m.transpose()});
   ++structure_stamp_;
