@@ -214,9 +214,7 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
     // The search's winner led every other place: the pose, unless it is the one tracked already.
     ++stats_.places_decided;
     const bool tracked_there =
-        state_ == LocalizationState::Tracking && have_pose_ &&
-        std::hypot(following_.winner().x - predicted.x, following_.winner().y - predicted.y) <= options_.places.distinct_m &&
-        std::abs(common::wrapToPi(following_.winner().phi - predicted.phi)) <= options_.places.distinct_deg * kDeg;
+        state_ == LocalizationState::Tracking && have_pose_ && !distinctPlaces(following_.winner(), predicted, options_.places);
     if (!tracked_there) {
       PlaceHypothesis h = places_.refine(points, following_.winner(), matcher_, PlaceHypothesis{});
       if (h.found) {
@@ -234,8 +232,7 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
     match_due = true;
     initial_pose_ = false;
     const PlaceHypothesis h = searchPlaces(points);
-    if (h.found && (std::hypot(h.pose.x - predicted.x, h.pose.y - predicted.y) > options_.places.distinct_m ||
-                    std::abs(common::wrapToPi(h.pose.phi - predicted.phi)) > options_.places.distinct_deg * kDeg)) {
+    if (h.found && distinctPlaces(h.pose, predicted, options_.places)) {
       takeFix(h, false, out);
       ++stats_.poses_replaced;
       replaced = true;

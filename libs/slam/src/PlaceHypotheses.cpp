@@ -15,10 +15,6 @@ constexpr double kDeg = M_PI / 180.0;
 PlaceHypotheses::PlaceHypotheses(MapAreas& areas, const PlaceRecognitionOptions& places, PlaceTrackingOptions options)
     : areas_(areas), search_(places), options_(options) {}
 
-bool PlaceHypotheses::distinct(const common::Pose2& a, const common::Pose2& b) const {
-  return std::hypot(a.x - b.x, a.y - b.y) > search_.distinct_m || std::abs(common::wrapToPi(a.phi - b.phi)) > search_.distinct_deg * kDeg;
-}
-
 bool PlaceHypotheses::score(const std::vector<Eigen::Vector2d>& points, Place& place) {
   const alignment::LikelihoodGrid* grid = areas_.coarseGrid(place.pose.x, place.pose.y);
   if (!grid) return false;
@@ -56,7 +52,7 @@ PlaceHypotheses::Outcome PlaceHypotheses::decide(const std::vector<Eigen::Vector
   const Place& best = places_.front();
   bool clear = true;
   for (size_t i = 1; i < places_.size(); ++i) {
-    if (!distinct(places_[i].pose, best.pose)) continue;  // converged onto the winner
+    if (!distinctPlaces(places_[i].pose, best.pose, search_)) continue;  // converged onto the winner
     if (places_[i].total - best.total >= margin) {
       places_.clear();
       return Outcome::GaveUp;

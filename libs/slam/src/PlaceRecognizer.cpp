@@ -16,6 +16,10 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 }  // namespace
 
+bool distinctPlaces(const common::Pose2& a, const common::Pose2& b, const PlaceRecognitionOptions& options) {
+  return std::hypot(a.x - b.x, a.y - b.y) > options.distinct_m || std::abs(common::wrapToPi(a.phi - b.phi)) > options.distinct_deg * kDeg;
+}
+
 PlaceRecognizer::PlaceRecognizer(const Map& map, MapAreas& areas, PlaceRecognitionOptions options)
     : areas_(areas), options_(std::move(options)) {
   const double s = options_.candidate_spacing_m;
@@ -104,9 +108,7 @@ PlaceHypothesis PlaceRecognizer::locate(const alignment::PointSet& scan, const a
   h.score = best->score;
   h.second_score = -std::numeric_limits<double>::infinity();
   for (const Found& f : found) {
-    const bool elsewhere = std::hypot(f.pose.x - best->pose.x, f.pose.y - best->pose.y) > options_.distinct_m ||
-                           std::abs(common::wrapToPi(f.pose.phi - best->pose.phi)) > options_.distinct_deg * kDeg;
-    if (elsewhere) h.second_score = std::max(h.second_score, f.score);
+    if (distinctPlaces(f.pose, best->pose, options_)) h.second_score = std::max(h.second_score, f.score);
   }
   h.margin_per_point = (h.score - h.second_score) / h.points;  // +inf when the map has one place only
   h.pose = best->pose;
@@ -116,10 +118,8 @@ PlaceHypothesis PlaceRecognizer::locate(const alignment::PointSet& scan, const a
     std::sort(found.begin(), found.end(), [](const Found& a, const Found& b) { return a.score > b.score; });
     for (const Found& f : found) {
       if (f.score < h.score - margin) break;
-      const bool distinct = std::all_of(h.places.begin(), h.places.end(), [&](const PlaceCandidate& p) {
-        return std::hypot(f.pose.x - p.pose.x, f.pose.y - p.pose.y) > options_.distinct_m ||
-               std::abs(common::wrapToPi(f.pose.phi - p.pose.phi)) > options_.distinct_deg * kDeg;
-      });
+      const bool distinct =
+          std::all_of(h.places.begin(), h.places.end(), [&](const PlaceCandidate& p) { return distinctPlaces(f.pose, p.pose, options_); });
       if (distinct) h.places.push_back({f.pose, f.score});
     }
     return h;

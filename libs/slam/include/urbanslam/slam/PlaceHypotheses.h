@@ -61,7 +61,6 @@ class PlaceHypotheses {
   // The best pose within the window around `pose` and its scan log-likelihood; false where the
   // map has no grid.
   bool score(const std::vector<Eigen::Vector2d>& points, Place& place);
-  bool distinct(const common::Pose2& a, const common::Pose2& b) const;
   // Decided when the first place leads every other by the margin; GaveUp when one leads it so.
   Outcome decide(const std::vector<Eigen::Vector2d>& points);
 

@@ -49,6 +49,10 @@ struct PlaceRecognitionOptions {
   double refine_sigma_deg = 3.0;
 };
 
+// Two poses are different places: farther apart than distinct_m, or turned by more than
+// distinct_deg.
+bool distinctPlaces(const common::Pose2& a, const common::Pose2& b, const PlaceRecognitionOptions& options);
+
 // Where the scan may have been taken, when something other than the scan says so: a position
 // with its covariance and a chi-square gate. Only the windows that reach into that ellipse are
 // searched, and the winner must stand out among those only; the rest of the map is ruled out.
