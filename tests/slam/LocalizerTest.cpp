@@ -420,14 +420,14 @@ TEST(PlaceHypotheses, FollowingTellsApartAPlaceAndItsCopyThatOneScanCannot) {
       const slam::PlaceHypothesis h = places.locate(rest[k].points, matcher);
       if (h.reason != "ambiguous" || h.places.size() > 4) continue;
       const common::Pose2 copy = common::compose(offset, rest[k].truth);
-      const auto near = [&](const slam::PlaceCandidate& c, const common::Pose2& p) { return distance(c.pose, p) < 0.5; };
+      const auto near = [&](const common::Pose2& c, const common::Pose2& p) { return distance(c, p) < 0.5; };
       const bool both = std::any_of(h.places.begin(), h.places.end(), [&](const auto& c) { return near(c, rest[k].truth); }) &&
                         std::any_of(h.places.begin(), h.places.end(), [&](const auto& c) { return near(c, copy); });
       if (!both) continue;
       for (const bool copy_first : {false, true}) {
         slam::PlaceHypotheses following(areas, o.places, o.following);
-        const std::vector<slam::PlaceCandidate> pair = copy_first ? std::vector<slam::PlaceCandidate>{{copy, 0}, {rest[k].truth, 0}}
-                                                                  : std::vector<slam::PlaceCandidate>{{rest[k].truth, 0}, {copy, 0}};
+        const std::vector<common::Pose2> pair =
+            copy_first ? std::vector<common::Pose2>{copy, rest[k].truth} : std::vector<common::Pose2>{rest[k].truth, copy};
         following.start(pair, places.searchPoints(rest[k].points), rest[k].timestamp);
         ASSERT_TRUE(following.active());
         slam::PlaceHypotheses::Outcome outcome = slam::PlaceHypotheses::Outcome::Following;

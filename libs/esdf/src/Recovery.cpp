@@ -79,8 +79,8 @@ struct SparseCholesky::Impl {
   // Pattern of the last analysed matrix: the symbolic factor is reused when it is unchanged.
   std::vector<int> last_p, last_i;
   // Its values at the last factorisation, read only to save the filter (matrix()): written to an
-  // unnamed temporary file rather than held (two thirds of the matrix's bytes; at a million poses
-  // about 160 MB), or held when no temporary file can be written.
+  // unnamed temporary file rather than held (8 of the 12 bytes per non-zero of the matrix's lower
+  // triangle), or held when no temporary file can be written.
   KeptValues last_x;
 
   explicit Impl(FillReducingOrdering o) : ordering(o) {

@@ -139,8 +139,8 @@ void Localizer::takeFix(const PlaceHypothesis& h, bool confirmed, LocalizedScan&
 
 void Localizer::follow(const PlaceHypothesis& h, const alignment::PointSet& points, double t, const std::optional<common::Pose2>& tracked) {
   if (h.places.empty()) return;
-  std::vector<PlaceCandidate> places = h.places;
-  if (tracked) places.push_back({*tracked, 0.0});
+  std::vector<common::Pose2> places = h.places;
+  if (tracked) places.push_back(*tracked);
   following_.start(places, places_.searchPoints(points), t);
   if (following_.active()) ++stats_.places_followed;
 }
@@ -216,6 +216,8 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
     const bool tracked_there =
         state_ == LocalizationState::Tracking && have_pose_ && !distinctPlaces(following_.winner(), predicted, options_.places);
     if (!tracked_there) {
+      // Checked as a search's winner is, with no one-scan margin to its name: the strict share of
+      // walls in free space applies.
       PlaceHypothesis h = places_.refine(points, following_.winner(), matcher_, PlaceHypothesis{});
       if (h.found) {
         if (state_ == LocalizationState::Tracking) ++stats_.poses_replaced;

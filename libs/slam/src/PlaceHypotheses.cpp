@@ -31,11 +31,11 @@ bool PlaceHypotheses::score(const std::vector<Eigen::Vector2d>& points, Place& p
   return true;
 }
 
-void PlaceHypotheses::start(const std::vector<PlaceCandidate>& places, const std::vector<Eigen::Vector2d>& points, double t) {
+void PlaceHypotheses::start(const std::vector<common::Pose2>& places, const std::vector<Eigen::Vector2d>& points, double t) {
   places_.clear();
   if (places.size() < 2 || places.size() > static_cast<size_t>(options_.max_places)) return;
-  for (const PlaceCandidate& c : places) {
-    Place p{c.pose, 0};
+  for (const common::Pose2& pose : places) {
+    Place p{pose, 0};
     if (score(points, p))
       places_.push_back(p);
     else if (places_.empty())

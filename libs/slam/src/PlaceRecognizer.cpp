@@ -119,8 +119,8 @@ PlaceHypothesis PlaceRecognizer::locate(const alignment::PointSet& scan, const a
     for (const Found& f : found) {
       if (f.score < h.score - margin) break;
       const bool distinct =
-          std::all_of(h.places.begin(), h.places.end(), [&](const PlaceCandidate& p) { return distinctPlaces(f.pose, p.pose, options_); });
-      if (distinct) h.places.push_back({f.pose, f.score});
+          std::all_of(h.places.begin(), h.places.end(), [&](const common::Pose2& p) { return distinctPlaces(f.pose, p, options_); });
+      if (distinct) h.places.push_back(f.pose);
     }
     return h;
   }

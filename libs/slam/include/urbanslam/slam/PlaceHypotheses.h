@@ -42,7 +42,7 @@ class PlaceHypotheses {
 
   // Follow these places from the scan of time t, whose search points are `points`: each is scored
   // again with them (within the window). Fewer than two, or more than max_places: nothing to do.
-  void start(const std::vector<PlaceCandidate>& places, const std::vector<Eigen::Vector2d>& points, double t);
+  void start(const std::vector<common::Pose2>& places, const std::vector<Eigen::Vector2d>& points, double t);
   void stop() { places_.clear(); }
   bool active() const { return !places_.empty(); }
 

@@ -62,13 +62,6 @@ struct PlaceSearchRegion {
   double gate = 0;  // on d' cov⁻¹ d
 };
 
-// A place the search could not rule out: the best pose of one search window, and its coarse scan
-// log-likelihood.
-struct PlaceCandidate {
-  common::Pose2 pose;
-  double score = 0;
-};
-
 struct PlaceHypothesis {
   bool found = false;
   std::string reason;  // why not found
@@ -79,10 +72,10 @@ struct PlaceHypothesis {
   double matched_fraction = 0;
   double seen_through_share = 0;
   int points = 0, candidates = 0, nodes = 0;
-  // Ambiguous: the distinct places within the margin of the winner, the winner first (the rest
-  // one per place, best first). Following them over the next scans can tell them apart
-  // (PlaceHypotheses.h).
-  std::vector<PlaceCandidate> places;
+  // Ambiguous: the distinct places within the margin of the winner (each the best pose of its
+  // window), the winner first, the rest best first. Following them over the next scans can tell
+  // them apart (PlaceHypotheses.h).
+  std::vector<common::Pose2> places;
 };
 
 class PlaceRecognizer {
@@ -100,7 +93,6 @@ class PlaceRecognizer {
   // side's free space): `h` found, or the reason it is not.
   PlaceHypothesis refine(const alignment::PointSet& scan, const common::Pose2& coarse, const alignment::PriorMatcherOptions& matcher,
                          PlaceHypothesis h);
-  const PlaceRecognitionOptions& options() const { return options_; }
 
  private:
   MapAreas& areas_;
