@@ -60,6 +60,9 @@ common::Json localizationStats(const std::vector<LocalizedScan>& scans, const Lo
   c["place_search_windows"] = s.place_search_windows;
   c["places_followed"] = s.places_followed;
   c["places_decided"] = s.places_decided;
+  c["images"] = s.images;
+  c["image_place_searches"] = s.image_place_searches;
+  c["image_relocalisations"] = s.image_relocalisations;
   c["map_references_built"] = s.references_built;
   c["coarse_grids_built"] = s.coarse_grids_built;
   Json& l = j["localization"];

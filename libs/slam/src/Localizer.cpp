@@ -33,6 +33,7 @@ LocalizerOptions localizerOptions(const PipelineOptions& map_options) {
   o.areas.coarse.full_resolution_levels = 4;
   o.match_spacing_m = map_options.keyframes.min_translation_m;
   o.match_spacing_deg = map_options.keyframes.min_rotation_deg;
+  o.images.image_loop = map_options.image_loop;
   return o;
 }
 
@@ -47,6 +48,7 @@ Localizer::Localizer(const Map& map, const PipelineOptions& map_options, Localiz
       areas_(map_, options_.areas),
       places_(map_, areas_, options_.places),
       following_(areas_, options_.places, options_.following),
+      images_(map_, options_.images),
       monitor_(options_.monitor),
       matcher_(areas_.options().matcher),
       continuity_gate_(esdf::chi2Quantile(options_.continuity_probability, 2)),
@@ -94,6 +96,9 @@ std::optional<LocalizedScan> Localizer::add(const io::Measurement& m) {
     }
   } else if (const auto* dr = std::get_if<io::DriveReading>(&m)) {
     if (motion_model_ != MotionOptions::Model::Odometry) motion_.addDrive(*dr);
+  } else if (const auto* im = std::get_if<io::CameraImage>(&m)) {
+    ++stats_.images;
+    images_.addImage(*im);
   }
   stats_.wall_s += sw.seconds();
   stats_.references_built = areas_.referencesBuilt();
@@ -111,13 +116,27 @@ common::Pose2 Localizer::odometryLead(double t) const {
   return {f * step.x, f * step.y, f * step.phi};
 }
 
-PlaceHypothesis Localizer::searchPlaces(const alignment::PointSet& points, const std::optional<PlaceSearchRegion>& region) {
+PlaceHypothesis Localizer::searchPlaces(const alignment::PointSet& points, const std::vector<PlaceSearchRegion>& regions) {
   common::Stopwatch sw;
-  PlaceHypothesis h = places_.locate(points, matcher_, region);
+  PlaceHypothesis h = places_.locate(points, matcher_, regions);
   stats_.place_search_wall_s += sw.seconds();
   ++stats_.place_searches;
   stats_.place_search_windows += static_cast<size_t>(h.candidates);
   return h;
+}
+
+std::optional<PlaceHypothesis> Localizer::searchImagePlaces(const alignment::PointSet& points, double t, double not_before) {
+  if (!images_.mapHasImages()) return std::nullopt;
+  const double r = options_.images.radius_m;
+  const Eigen::Matrix2d circle = r * r * Eigen::Matrix2d::Identity();
+  std::vector<PlaceSearchRegion> regions;
+  for (const ImagePlace& p : images_.query(t, not_before)) {
+    const common::Pose2& k = map_.keyframes()[p.keyframe].pose;
+    regions.push_back({{k.x, k.y}, circle, 1.0});
+  }
+  if (regions.empty()) return std::nullopt;
+  ++stats_.image_place_searches;
+  return searchPlaces(points, regions);
 }
 
 void Localizer::takeFix(const PlaceHypothesis& h, bool confirmed, LocalizedScan& out) {
@@ -127,6 +146,7 @@ void Localizer::takeFix(const PlaceHypothesis& h, bool confirmed, LocalizedScan&
   consecutive_matches_ = 0;
   monitor_.reset();
   following_.stop();
+  image_search_since_.reset();
   searched_ = false;
   out.map_fix = true;
   out.map_pose = pose_;
@@ -170,8 +190,10 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
     if (const auto newest = trajectory_->newestScan(); newest && newest->timestamp == t) {
       local_now = newest->pose;
       // A scan local SLAM did not try to match (too soon after the last) neither extends nor ends a run.
-      if (const double f = trajectory_->scans().back().matched_fraction; f >= 0)
+      if (const double f = trajectory_->scans().back().matched_fraction; f >= 0) {
         local_low_run_ = f < options_.discontinuity_matched_fraction ? local_low_run_ + 1 : 0;
+        if (local_low_run_ == 1) view_break_t_ = t;
+      }
       discontinuity = local_low_run_ == options_.discontinuity_scans && state_ == LocalizationState::Tracking;
     }
 
@@ -240,6 +262,22 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
       replaced = true;
     } else {
       follow(h, points, t, predicted);
+      if (!h.found && images_.mapHasImages()) image_search_since_ = view_break_t_;
+    }
+  }
+  if (image_search_since_ && !replaced && state_ == LocalizationState::Tracking) {
+    // The whole map's search left the discontinuity open: the first image since the view broke
+    // off searches near the places it resembles (a fix there replaces the pose, as above).
+    if (t - *image_search_since_ > options_.image_search_s) {
+      image_search_since_.reset();
+    } else if (const auto h = searchImagePlaces(points, t, *image_search_since_)) {
+      image_search_since_.reset();
+      if (h->found && distinctPlaces(h->pose, predicted, options_.places)) {
+        takeFix(*h, false, out);
+        ++stats_.poses_replaced;
+        ++stats_.image_relocalisations;
+        replaced = true;
+      }
     }
   }
   if (replaced) {
@@ -336,13 +374,27 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
     std::optional<PlaceSearchRegion> region;
     const double k2 = options_.continuity_sigma_scale * options_.continuity_sigma_scale;
     if (confirmed_ && have_pose_) region = PlaceSearchRegion{{pose_.x, pose_.y}, k2 * cov_.topLeftCorner<2, 2>(), continuity_gate_};
-    const PlaceHypothesis h = searchPlaces(points, region);
-    bool accepted = h.found;
-    if (h.found && region) {
+    const auto admitted = [&](const PlaceHypothesis& h) {
+      if (!h.found || !region) return h.found;
       const Eigen::Vector2d d(h.pose.x - pose_.x, h.pose.y - pose_.y);
       const Eigen::Matrix2d s = region->cov + options_.covariance_scale * h.cov.topLeftCorner<2, 2>();
-      accepted = d.dot(s.inverse() * d) <= continuity_gate_;
-      if (!accepted) ++stats_.fixes_rejected;
+      if (d.dot(s.inverse() * d) <= continuity_gate_) return true;
+      ++stats_.fixes_rejected;
+      return false;
+    };
+    PlaceHypothesis h = searchPlaces(points, region ? std::vector<PlaceSearchRegion>{*region} : std::vector<PlaceSearchRegion>{});
+    bool accepted = admitted(h);
+    if (!h.found) {
+      // No clear winner from the scan alone: the camera's image narrows the places. Not to the
+      // dead reckoning's reach: that rules out the look-alikes of a scan, and an image that
+      // resembles places beyond it says the vehicle is not where the dead reckoning has it (a
+      // kidnapping local SLAM did not notice, as in a city's streets, whose scans continue
+      // each other). The laser's winner must stand out among the image's places.
+      if (auto hi = searchImagePlaces(points, t, -HUGE_VAL); hi && hi->found) {
+        h = std::move(*hi);
+        accepted = true;
+        ++stats_.image_relocalisations;
+      }
     }
     if (accepted) {
       // A fix that the confirmed dead reckoning admitted carries its confirmation on; one from

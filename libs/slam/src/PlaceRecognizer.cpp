@@ -35,7 +35,7 @@ PlaceRecognizer::PlaceRecognizer(const Map& map, MapAreas& areas, PlaceRecogniti
 }
 
 PlaceHypothesis PlaceRecognizer::locate(const alignment::PointSet& scan, const alignment::PriorMatcherOptions& matcher,
-                                        const std::optional<PlaceSearchRegion>& region) {
+                                        const std::vector<PlaceSearchRegion>& regions) {
   PlaceHypothesis h;
   const std::vector<Eigen::Vector2d> points = searchPoints(scan);
   h.points = static_cast<int>(points.size());
@@ -53,19 +53,24 @@ PlaceHypothesis PlaceRecognizer::locate(const alignment::PointSet& scan, const a
     common::Pose2 pose;
     double score;
   };
-  // A window reaches into the region when its centre does once the region's covariance is
+  // A window reaches into a region when its centre does once the region's covariance is
   // widened by the window's half diagonal.
-  Eigen::Matrix2d region_inverse = Eigen::Matrix2d::Zero();
-  if (region) {
-    const double reach = window.half_width_m * M_SQRT2;
-    region_inverse = (region->cov + reach * reach * Eigen::Matrix2d::Identity()).inverse();
-  }
+  std::vector<Eigen::Matrix2d> region_inverse;
+  const double reach = window.half_width_m * M_SQRT2;
+  for (const PlaceSearchRegion& r : regions) region_inverse.push_back((r.cov + reach * reach * Eigen::Matrix2d::Identity()).inverse());
+  const auto withinReach = [&](const Eigen::Vector2d& c) {
+    for (size_t k = 0; k < regions.size(); ++k) {
+      const Eigen::Vector2d d = c - regions[k].centre;
+      if (d.dot(region_inverse[k] * d) <= regions[k].gate) return true;
+    }
+    return regions.empty();
+  };
   std::vector<Found> found;
   // Only poses within the margin of the best so far can win or make the winner ambiguous: each
   // window is searched for those only (the prior's log-density, flat, as the search takes it).
   double best_scan = -HUGE_VAL;
   const double margin = options_.min_margin_per_point * static_cast<double>(points.size());
-  // The windows within reach of the region (every window without one).
+  // The windows within reach of the regions (every window without any).
   std::vector<Eigen::Vector2d> windows;
   std::set<std::pair<int64_t, int64_t>> searched;
   const auto cellOf = [&](const Eigen::Vector2d& c) {
@@ -73,10 +78,7 @@ PlaceHypothesis PlaceRecognizer::locate(const alignment::PointSet& scan, const a
                           static_cast<int64_t>(std::floor(c.y() / options_.candidate_spacing_m)));
   };
   for (const Eigen::Vector2d& c : centres_) {
-    if (region) {
-      const Eigen::Vector2d d = c - region->centre;
-      if (d.dot(region_inverse * d) > region->gate) continue;
-    }
+    if (!withinReach(c)) continue;
     windows.push_back(c);
     searched.insert(cellOf(c));
   }
@@ -101,7 +103,7 @@ PlaceHypothesis PlaceRecognizer::locate(const alignment::PointSet& scan, const a
     best_scan = std::max(best_scan, r.scan_score);
   }
   if (found.empty()) {
-    h.reason = region ? "no mapped place within reach" : "empty map";
+    h.reason = regions.empty() ? "empty map" : "no mapped place within reach";
     return h;
   }
   const auto best = std::max_element(found.begin(), found.end(), [](const Found& a, const Found& b) { return a.score < b.score; });

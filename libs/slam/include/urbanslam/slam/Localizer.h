@@ -27,6 +27,15 @@
 // ago: the pose being tracked is one of the places, and is replaced only if the winner leads it
 // too. Lost (where the vehicle may stand somewhere the map never saw), only a clear winner counts.
 //
+// With a camera, a map whose keyframes kept their images' words (a run with [loop_closure]
+// image_detector = tree_of_words) also knows what each place looked like (ImagePlaces.h). When a
+// place search over the whole map leaves no clear winner, the latest image (taken since the view
+// broke off, after a discontinuity) picks the keyframes whose images it resembles, and the scan is
+// searched again near those only: the winner must stand out among them, the places the image
+// does not resemble ruled out (wherever the dead reckoning has the vehicle: an image unlike
+// anything near it is what a kidnapping that local SLAM did not notice looks like). After a
+// discontinuity with no fresh image yet, the first image within image_search_s does it.
+//
 // A place search answers from one scan, and a building of repeated rooms and corridors (ACES)
 // has places that one scan, and the scans tracked after it, cannot tell apart: a wrong fix there
 // tracks as smoothly as the right one. What does tell them apart is where the vehicle came from:
@@ -45,6 +54,7 @@
 
 #include "urbanslam/alignment/SeenThroughRate.h"
 #include "urbanslam/io/Measurements.h"
+#include "urbanslam/slam/ImagePlaces.h"
 #include "urbanslam/slam/InputFilter.h"
 #include "urbanslam/slam/LocalTrajectory.h"
 #include "urbanslam/slam/Map.h"
@@ -110,6 +120,10 @@ struct LocalizerOptions {
   // 13 of 20 jumps (bench/localize/kidnap.py).
   double discontinuity_matched_fraction = 0.7;
   int discontinuity_scans = 2;
+  ImagePlaceOptions images;
+  // After a discontinuity that the whole map's search left unresolved, the first image taken
+  // since the view broke off narrows the search, if it comes within this much log time.
+  double image_search_s = 3.0;
 };
 
 // The defaults, with the matcher, scan model and floors of the map's own [local] options.
@@ -152,6 +166,9 @@ struct LocalizerStats {
   size_t place_search_windows = 0;  // windows searched by branch and bound, over all place searches
   size_t places_followed = 0;       // ambiguous searches whose places were followed over the next scans
   size_t places_decided = 0;        // ... until one stood alone (a relocalisation each when it was not the pose tracked)
+  size_t images = 0;                 // camera images read
+  size_t image_place_searches = 0;   // place searches near the keyframes an image resembled (also in place_searches)
+  size_t image_relocalisations = 0;  // ... that found the pose (also in relocalisations)
   double first_timestamp = 0, last_timestamp = 0;
   double lost_s = 0;        // log time spent lost
   double first_fix_s = -1;  // log time from the first scan to the first tracked one (-1: never)
@@ -184,7 +201,10 @@ class Localizer {
   LocalizedScan onScan(io::LaserScan scan);
   bool placeSearchDue(double t) const;
   // A place search (the whole map, or only `region`), counted in the stats.
-  PlaceHypothesis searchPlaces(const alignment::PointSet& points, const std::optional<PlaceSearchRegion>& region = std::nullopt);
+  PlaceHypothesis searchPlaces(const alignment::PointSet& points, const std::vector<PlaceSearchRegion>& regions = {});
+  // The scan searched near the map keyframes whose images the latest image resembles: none when
+  // no image taken since `not_before` is fresh enough at `t`, or it resembles no keyframe's.
+  std::optional<PlaceHypothesis> searchImagePlaces(const alignment::PointSet& points, double t, double not_before);
   // A place search's fix becomes the pose: tracking again, confirmed only when `confirmed` (a fix
   // the confirmed dead reckoning admitted), a relocalisation in `out` and the stats.
   void takeFix(const PlaceHypothesis& h, bool confirmed, LocalizedScan& out);
@@ -208,6 +228,7 @@ class Localizer {
   MapAreas areas_;
   PlaceRecognizer places_;
   PlaceHypotheses following_;
+  ImagePlaces images_;
   TrackingMonitor monitor_;
   alignment::PriorMatcherOptions matcher_;
   alignment::SeenThroughRate seen_through_{0.05}, seen_through_displaced_{0.3};
@@ -231,6 +252,8 @@ class Localizer {
   std::optional<common::Pose2> local_previous_;  // the previous scan's pose in local SLAM's frame
   std::optional<common::Pose2> local_at_match_;  // ... and the last map match's
   int local_low_run_ = 0;                        // local SLAM's matches in a row below discontinuity_matched_fraction
+  double view_break_t_ = 0;                      // the first scan of that run
+  std::optional<double> image_search_since_;     // a discontinuity left unresolved: an image taken since then is awaited
   // Place-search schedule while lost.
   bool searched_ = false;
   double last_search_time_ = 0, search_interval_s_ = 0;

@@ -54,8 +54,10 @@ struct PlaceRecognitionOptions {
 bool distinctPlaces(const common::Pose2& a, const common::Pose2& b, const PlaceRecognitionOptions& options);
 
 // Where the scan may have been taken, when something other than the scan says so: a position
-// with its covariance and a chi-square gate. Only the windows that reach into that ellipse are
-// searched, and the winner must stand out among those only; the rest of the map is ruled out.
+// with its covariance and a chi-square gate (the dead reckoning), or a circle about a keyframe
+// whose image looks like the camera's (cov r² I, gate 1). Only the windows that reach into one
+// of a search's regions are searched, and the winner must stand out among those only; the rest
+// of the map is ruled out.
 struct PlaceSearchRegion {
   Eigen::Vector2d centre = Eigen::Vector2d::Zero();
   Eigen::Matrix2d cov = Eigen::Matrix2d::Identity();
@@ -82,9 +84,9 @@ class PlaceRecognizer {
  public:
   PlaceRecognizer(const Map& map, MapAreas& areas, PlaceRecognitionOptions options);
   // `scan`: the scan's points in the vehicle frame. `matcher`: the local matcher's options for
-  // the refinement. `region`: search only there (none: the whole map).
+  // the refinement. `regions`: search only within reach of one of them (none: the whole map).
   PlaceHypothesis locate(const alignment::PointSet& scan, const alignment::PriorMatcherOptions& matcher,
-                         const std::optional<PlaceSearchRegion>& region = std::nullopt);
+                         const std::vector<PlaceSearchRegion>& regions = {});
   size_t candidates() const { return centres_.size(); }
   // The scan's points a search scores: near returns only (farther ones fall outside the grids),
   // one per voxel (roughly independent).
