@@ -21,7 +21,7 @@
 #include "urbanslam/common/Pose2.h"
 #include "urbanslam/common/Timing.h"
 #include "urbanslam/evaluation/Kidnapping.h"
-#include "urbanslam/io/DataSource.h"
+#include "urbanslam/io/MemorySource.h"
 #include "urbanslam/sim/SimOptions.h"
 #include "urbanslam/sim/SimulatedSource.h"
 #include "urbanslam/slam/LocalizeInMaps.h"
@@ -32,23 +32,6 @@
 using namespace urbanslam;
 
 namespace {
-
-// Measurements held in memory, replayed.
-class VectorSource : public io::DataSource {
- public:
-  explicit VectorSource(std::vector<io::Measurement> m) : io::DataSource("memory"), m_(std::move(m)) {}
-  bool next(io::Measurement& out) override {
-    if (i_ >= m_.size()) return false;
-    out = m_[i_++];
-    return true;
-  }
-  double progress() const override { return m_.empty() ? 1.0 : static_cast<double>(i_) / static_cast<double>(m_.size()); }
-  std::string format() const override { return "measurements in memory"; }
-
- private:
-  std::vector<io::Measurement> m_;
-  size_t i_ = 0;
-};
 
 bool usable(const io::Measurement& m) {
   // The localizer reads scans, odometry and images; the truth it must not see.
@@ -62,7 +45,7 @@ std::vector<slam::LocalizedScan> localize(const slam::Pipeline& map, const std::
   o.images.enabled = images;
   slam::Localizer loc(map.map(), map.options(), o);
   loc.setInitialPose(initial);
-  VectorSource source(stream);
+  io::MemorySource source(stream);
   std::vector<slam::LocalizedScan> scans = slam::localizeInMaps({&loc}, source, nullptr, &map.options()).scans;
   if (stats) *stats = loc.stats();
   return scans;
@@ -120,7 +103,8 @@ int main(int argc, char** argv) {
     for (size_t seen = 0; half < all.size() && seen < scans / 2; ++half) seen += std::holds_alternative<io::LaserScan>(all[half]);
     slam::Pipeline map(options);
     {
-      VectorSource first(std::vector<io::Measurement>(all.begin(), all.begin() + static_cast<long>(half)));
+      const std::vector<io::Measurement> first_half(all.begin(), all.begin() + static_cast<long>(half));
+      io::MemorySource first(first_half);
       map.run(first);
       map.finish();
     }

@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "TestPaths.h"
+#include "LaserCameraCity.h"
 #include "urbanslam/evaluation/Evaluation.h"
 #include "urbanslam/sim/SimOptions.h"
 #include "urbanslam/sim/SimulatedSource.h"
@@ -15,15 +15,8 @@
 using namespace urbanslam;
 
 TEST(CameraConfirmationCity, ClosuresConfirmedByTheCameraMeasureTheTruePose) {
-  sim::SimOptions so = sim::loadSimOptions(test::repoPath("ini/city-1km2.ini"));
-  so.camera = sim::loadSimOptions(test::repoPath("ini/city-camera.ini")).camera;  // the left-looking camera
-  so.city.area_km2 = 0.25;
-  so.route.route_length_km = 1.5;
-  slam::PipelineOptions po = slam::loadPipelineOptions(test::repoPath("ini/default.ini"));
-  slam::resolveDefaultPaths(po, URBANSLAM_SOURCE_DIR);
-  po.image_loop.vocabulary = test::repoPath("share/vision_loop/orb_k10_L4.usvoc");  // ORB: a sixth of SIFT's time
-  slam::Pipeline p(po);
-  sim::SimulatedSource src(so);
+  slam::Pipeline p(test::laserCameraPipeline());
+  sim::SimulatedSource src(test::laserCameraCity());
   p.runInput(src);
   p.finish(src);
   ASSERT_GT(p.stats().image_keyframes, 100u);

@@ -7,9 +7,10 @@
 #include <cmath>
 #include <iostream>
 
-#include "TestPaths.h"
+#include "LaserCameraCity.h"
 #include "urbanslam/evaluation/Evaluation.h"
 #include "urbanslam/evaluation/Kidnapping.h"
+#include "urbanslam/io/MemorySource.h"
 #include "urbanslam/sim/SimOptions.h"
 #include "urbanslam/sim/SimulatedSource.h"
 #include "urbanslam/slam/LocalizeInMaps.h"
@@ -20,29 +21,13 @@ using namespace urbanslam;
 
 namespace {
 
-class Replay : public io::DataSource {
- public:
-  explicit Replay(const std::vector<io::Measurement>& m) : io::DataSource("memory"), m_(m) {}
-  bool next(io::Measurement& out) override {
-    if (i_ >= m_.size()) return false;
-    out = m_[i_++];
-    return true;
-  }
-  double progress() const override { return m_.empty() ? 1.0 : static_cast<double>(i_) / static_cast<double>(m_.size()); }
-  std::string format() const override { return "memory"; }
-
- private:
-  const std::vector<io::Measurement>& m_;
-  size_t i_ = 0;
-};
-
 std::vector<slam::LocalizedScan> localize(const slam::Pipeline& map, const std::vector<io::Measurement>& log, const common::Pose2& initial,
                                           bool images, slam::LocalizerStats& stats) {
   slam::LocalizerOptions o = slam::localizerOptions(map.options());
   o.images.enabled = images;
   slam::Localizer loc(map.map(), map.options(), o);
   loc.setInitialPose(initial);
-  Replay source(log);
+  io::MemorySource source(log);
   std::vector<slam::LocalizedScan> scans = slam::localizeInMaps({&loc}, source, nullptr, &map.options()).scans;
   stats = loc.stats();
   return scans;
@@ -51,13 +36,8 @@ std::vector<slam::LocalizedScan> localize(const slam::Pipeline& map, const std::
 }  // namespace
 
 TEST(ImagePlacesCity, TheCameraFindsKidnappedVehiclesThatTheScansAloneDoNot) {
-  sim::SimOptions so = sim::loadSimOptions(test::repoPath("ini/city-1km2.ini"));
-  so.camera = sim::loadSimOptions(test::repoPath("ini/city-camera.ini")).camera;  // the left-looking camera
-  so.city.area_km2 = 0.25;
-  so.route.route_length_km = 1.5;
-  slam::PipelineOptions po = slam::loadPipelineOptions(test::repoPath("ini/default.ini"));
-  slam::resolveDefaultPaths(po, URBANSLAM_SOURCE_DIR);
-  po.image_loop.vocabulary = test::repoPath("share/vision_loop/orb_k10_L4.usvoc");  // ORB: a sixth of SIFT's time
+  const sim::SimOptions so = test::laserCameraCity();
+  const slam::PipelineOptions po = test::laserCameraPipeline();
 
   // The drive in memory; the first half mapped (the truth kept apart).
   std::vector<io::Measurement> log;
@@ -81,7 +61,7 @@ TEST(ImagePlacesCity, TheCameraFindsKidnappedVehiclesThatTheScansAloneDoNot) {
   log.clear();
   slam::Pipeline map(po);
   {
-    Replay source(first);
+    io::MemorySource source(first);
     map.run(source);
     map.finish();
   }
