@@ -374,16 +374,15 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
     std::optional<PlaceSearchRegion> region;
     const double k2 = options_.continuity_sigma_scale * options_.continuity_sigma_scale;
     if (confirmed_ && have_pose_) region = PlaceSearchRegion{{pose_.x, pose_.y}, k2 * cov_.topLeftCorner<2, 2>(), continuity_gate_};
-    const auto admitted = [&](const PlaceHypothesis& h) {
-      if (!h.found || !region) return h.found;
+    PlaceHypothesis h = searchPlaces(points, region ? std::vector<PlaceSearchRegion>{*region} : std::vector<PlaceSearchRegion>{});
+    bool accepted = h.found;
+    if (h.found && region) {
       const Eigen::Vector2d d(h.pose.x - pose_.x, h.pose.y - pose_.y);
       const Eigen::Matrix2d s = region->cov + options_.covariance_scale * h.cov.topLeftCorner<2, 2>();
-      if (d.dot(s.inverse() * d) <= continuity_gate_) return true;
-      ++stats_.fixes_rejected;
-      return false;
-    };
-    PlaceHypothesis h = searchPlaces(points, region ? std::vector<PlaceSearchRegion>{*region} : std::vector<PlaceSearchRegion>{});
-    bool accepted = admitted(h);
+      accepted = d.dot(s.inverse() * d) <= continuity_gate_;
+      if (!accepted) ++stats_.fixes_rejected;
+    }
+    bool by_image = false;
     if (!h.found) {
       // No clear winner from the scan alone: the camera's image narrows the places. Not to the
       // dead reckoning's reach: that rules out the look-alikes of a scan, and an image that
@@ -392,14 +391,14 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
       // each other). The laser's winner must stand out among the image's places.
       if (auto hi = searchImagePlaces(points, t, -HUGE_VAL); hi && hi->found) {
         h = std::move(*hi);
-        accepted = true;
+        accepted = by_image = true;
         ++stats_.image_relocalisations;
       }
     }
     if (accepted) {
       // A fix that the confirmed dead reckoning admitted carries its confirmation on; one from
-      // the whole map has yet to earn it.
-      takeFix(h, region.has_value(), out);
+      // the whole map or the image's places has yet to earn it.
+      takeFix(h, region.has_value() && !by_image, out);
     } else {
       search_interval_s_ =
           searched_ ? std::min(options_.relocalise_max_interval_s, 2 * search_interval_s_) : options_.relocalise_interval_s;
