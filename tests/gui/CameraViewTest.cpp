@@ -39,7 +39,7 @@ TEST(CameraView, ShowsTheMatchedFrameOfAProposal) {
   ASSERT_FALSE(s.image_matches.empty());
   // Every proposal the pipeline recorded is in the model, with its fate.
   size_t image_records = 0;
-  for (const auto& r : records) image_records += r.detector == "image";
+  for (const auto& r : records) image_records += r.detector == slam::Proposer::Image;
   EXPECT_EQ(s.image_matches.size(), image_records);
   for (const auto& m : s.image_matches) {
     // Clicking the proposing keyframe: its frame left, the matched earlier frame right. The

@@ -61,7 +61,7 @@ std::unique_ptr<slam::Pipeline> runExcerpt(slam::LoopClosureOptions::ImageDetect
 std::vector<slam::LoopClosureRecord> imageRecords(const slam::Pipeline& p) {
   std::vector<slam::LoopClosureRecord> out;
   for (const auto& c : p.loopClosures())
-    if (c.detector == "image") out.push_back(c);
+    if (c.detector == slam::Proposer::Image) out.push_back(c);
   return out;
 }
 

@@ -255,7 +255,7 @@ TEST(LoopCloser, AppearanceAddsCandidatesWhenThePoseIsTooUncertain) {
     ASSERT_EQ(c.size(), 5u);  // 108 (109 is the same place), then 93; 120 is no detection
     EXPECT_EQ(c[3].keyframe, 108u);
     ASSERT_TRUE(c[3].detection.has_value());
-    EXPECT_EQ(c[3].detection->detector, "laser");
+    EXPECT_EQ(c[3].detection->detector, slam::Proposer::Laser);
     EXPECT_DOUBLE_EQ(c[3].detection->score, 2.0);
     EXPECT_EQ(c[4].keyframe, 93u);
     ASSERT_TRUE(c[4].detection.has_value());

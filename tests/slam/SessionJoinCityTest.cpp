@@ -90,9 +90,9 @@ TEST(SessionJoinCity, FindsTheSecondHalfOfADriveWhereTheTruthPutsIt) {
   size_t by_classifier = 0, checked = 0;
   for (size_t i : join.agreeing) {
     const slam::SessionFix& f = join.fixes[i];
-    by_classifier += f.detector == "laser" ? 1 : 0;
+    by_classifier += f.detector == slam::Proposer::Laser ? 1 : 0;
     const common::Pose2 truth = truthInMap(h, session.keyframes()[f.keyframe].timestamp);
-    EXPECT_LT(std::hypot(f.pose.x - truth.x, f.pose.y - truth.y), 0.5) << f.detector << " fix of keyframe " << f.keyframe;
+    EXPECT_LT(std::hypot(f.pose.x - truth.x, f.pose.y - truth.y), 0.5) << slam::proposerName(f.detector) << " fix of keyframe " << f.keyframe;
     EXPECT_LT(std::abs(common::wrapToPi(f.pose.phi - truth.phi)), 1.0 * M_PI / 180);
     for (size_t k : f.confirmed) {
       const common::Pose2 placed = common::compose(f.transform, session.keyframes()[k].pose);

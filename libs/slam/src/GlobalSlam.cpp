@@ -113,7 +113,7 @@ void GlobalSlam::closureAdded(size_t current, SteadyTime handed_over) {
 void GlobalSlam::reportClosure(const LoopClosureRecord& r) {
   ++(r.accepted ? stats_.closures_accepted : stats_.closures_rejected);
   closures_.push_back(r);
-  const LoopClosureEvent e{r.from, r.to, r.to_time, r.detector, r.score, r.accepted, reasonName(r.reason)};
+  const LoopClosureEvent e{r.from, r.to, r.to_time, proposerName(r.detector), r.score, r.accepted, reasonName(r.reason)};
   for (auto* o : observers_) o->onLoopClosure(e);
 }
 
@@ -251,7 +251,7 @@ void GlobalSlam::closeLoops(size_t current, SteadyTime handed_over) {
 }
 
 void GlobalSlam::addPlaceFix(size_t earlier, size_t current, const common::Pose2& z, const Eigen::Matrix3d& information, double score,
-                             const std::string& detector) {
+                             Proposer detector) {
   if (!map_.filter()) return;
   ++stats_.closures_tried;
   const Detection detection{detector, score};
@@ -298,7 +298,7 @@ void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double scor
     common::Stopwatch sw;
     expirePending(current);
     const bool confirm = options_.loop_closure.confirm_window > 0;
-    const Detection detection{"image", score};
+    const Detection detection{Proposer::Image, score};
     esdf::Esdf& f = *map_.filter();
     LoopClosureRecord r;
     std::optional<CameraPairView> view;
@@ -328,7 +328,7 @@ void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double scor
     r.to = current;
     r.from_time = map_.keyframes()[earlier].timestamp;
     r.to_time = map_.keyframes()[current].timestamp;
-    r.detector = "image";
+    r.detector = Proposer::Image;
     r.score = score;
     r.reason = !filter                          ? ClosureReason::NoFilter
                : !options_.loop_closure.enabled ? ClosureReason::LoopClosureDisabled

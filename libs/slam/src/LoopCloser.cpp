@@ -69,6 +69,26 @@ const char* confirmationName(Confirmation c) {
   return "";
 }
 
+const char* proposerName(Proposer p) {
+  switch (p) {
+    case Proposer::Pose:
+      return "pose";
+    case Proposer::Laser:
+      return "laser";
+    case Proposer::Image:
+      return "image";
+    case Proposer::Place:
+      return "place";
+  }
+  return "";
+}
+
+std::optional<Proposer> parseProposer(const std::string& name) {
+  for (const Proposer p : {Proposer::Pose, Proposer::Laser, Proposer::Image, Proposer::Place})
+    if (name == proposerName(p)) return p;
+  return std::nullopt;
+}
+
 LoopCloser::LoopCloser(const LoopClosureOptions& options)
     : options_(options),
       chi2_2dof_(esdf::chi2Quantile(options.mahalanobis_probability, 2)),
@@ -162,7 +182,7 @@ std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const Map& map
       return p.keyframe == i || (p.detection && std::hypot(keyframes[i].pose.x - keyframes[p.keyframe].pose.x,
                                                            keyframes[i].pose.y - keyframes[p.keyframe].pose.y) < options_.search_radius_m);
     };
-    if (std::none_of(out.begin(), out.end(), same) && mahalanobis2(i) <= chi2_2dof_) out.push_back({i, Detection{"laser", score}});
+    if (std::none_of(out.begin(), out.end(), same) && mahalanobis2(i) <= chi2_2dof_) out.push_back({i, Detection{Proposer::Laser, score}});
   }
   return out;
 }
@@ -286,7 +306,7 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_
   r.to = current;
   r.from_time = keyframes[earlier].timestamp;
   r.to_time = keyframes[current].timestamp;
-  r.detector = detection ? detection->detector : "pose";
+  r.detector = detection ? detection->detector : Proposer::Pose;
   if (detection) r.score = detection->score;
   // Alignment from the current estimate of the relative pose.
   const esdf::Vec3 xi = filter.mean(static_cast<int>(earlier)), xk = filter.mean(static_cast<int>(current));

@@ -12,7 +12,7 @@ common::Json sessionJson(const std::string& name, const SessionJoin& join, size_
   j["fixes_agreeing"] = join.agreeing.size();
   j["scans_agreeing"] = join.agreeing_scans;
   size_t by_classifier = 0;
-  for (const SessionFix& f : join.fixes) by_classifier += f.detector == "laser" ? 1 : 0;
+  for (const SessionFix& f : join.fixes) by_classifier += f.detector == Proposer::Laser ? 1 : 0;
   j["fixes_laser"] = by_classifier;
   j["fixes_rival"] = join.rival;
   if (join.joined) {

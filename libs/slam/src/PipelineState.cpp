@@ -123,7 +123,7 @@ void writeRecord(BinaryWriter& w, const LoopClosureRecord& c) {
   w.size(c.to);
   w.f64(c.from_time);
   w.f64(c.to_time);
-  w.string(c.detector);
+  w.string(proposerName(c.detector));
   w.f64(c.score);
   w.boolean(c.accepted);
   w.u8(static_cast<std::uint8_t>(c.reason));
@@ -146,7 +146,10 @@ LoopClosureRecord readRecord(BinaryReader& r, size_t keyframes, std::uint32_t fo
     r.fail("loop closure " + std::to_string(c.from) + " -> " + std::to_string(c.to) + " among " + std::to_string(keyframes) + " keyframes");
   c.from_time = r.f64();
   c.to_time = r.f64();
-  c.detector = r.string();
+  const std::string detector = r.string();
+  const std::optional<Proposer> proposer = parseProposer(detector);
+  if (!proposer) r.fail("loop closure detector '" + detector + "'");
+  c.detector = *proposer;
   c.score = r.f64();
   c.accepted = r.boolean();
   const std::uint8_t reason = r.u8();
@@ -162,7 +165,7 @@ LoopClosureRecord readRecord(BinaryReader& r, size_t keyframes, std::uint32_t fo
   // Before version 6 every camera closure measured bearing and heading only: those are the image
   // detections that no scan alignment measured (no alignment residual).
   c.bearing_only = format_version >= 6 ? r.boolean()
-                                       : c.detector == "image" && c.rms_m == 0 && c.reason != ClosureReason::CameraGeometry &&
+                                       : c.detector == Proposer::Image && c.rms_m == 0 && c.reason != ClosureReason::CameraGeometry &&
                                              c.reason != ClosureReason::NoScans;
   // Before version 7 what confirmed a closure was not kept.
   if (format_version >= 7) {

@@ -106,7 +106,7 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
     char buf[512];
     for (const auto& c : p.loopClosures()) {
       std::snprintf(buf, sizeof buf, "%zu,%zu,%.6f,%.6f,%s,%.6g,%d,%s,%.6f,%.6f,%.6f,%.6g,%.6g,%.6g,%.4f,%.4g,%d,%s\n", c.from, c.to,
-                    c.from_time, c.to_time, c.detector.c_str(), c.score, c.accepted ? 1 : 0, reasonName(c.reason), c.measurement.x,
+                    c.from_time, c.to_time, proposerName(c.detector), c.score, c.accepted ? 1 : 0, reasonName(c.reason), c.measurement.x,
                     c.measurement.y, c.measurement.phi, c.rms_m, c.mahalanobis2, c.gate_threshold, c.free_space_conflict, c.prior_sigma_m,
                     c.bearing_only ? 1 : 0, confirmationName(c.confirmed_by));
       f.stream() << buf;

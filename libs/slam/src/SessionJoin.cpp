@@ -89,7 +89,7 @@ void SessionJoiner::appearanceFixes(size_t k, const io::LaserScan& scan) {
     if (r.reason != ClosureReason::None) continue;
     SessionFix f;
     f.keyframe = k;
-    f.detector = "laser";
+    f.detector = Proposer::Laser;
     f.pose = common::compose(p, a.transform);
     f.cov = lc.covariance_scale * a.cov;  // as a loop closure weighs an alignment
     f.margin_per_point = score - threshold;

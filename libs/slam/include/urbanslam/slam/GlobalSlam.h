@@ -69,11 +69,11 @@ class GlobalSlam {
   void proposeImageClosure(size_t earlier, size_t current, double score, const std::optional<CameraMeasurement>& camera,
                            SteadyTime handed_over);
   // A place that a session join recognised: keyframe `current` (the session's) found at `z` from
-  // the map's keyframe `earlier`. Gated and, when it passes, a closure (`detector`: "place" for
-  // the place search, "laser" for the classifier's detection aligned); the fixes that agree with
+  // the map's keyframe `earlier`. Gated and, when it passes, a closure (`detector`: Place for
+  // the place search, Laser for the classifier's detection aligned); the fixes that agree with
   // it are its confirmation.
   void addPlaceFix(size_t earlier, size_t current, const common::Pose2& z, const Eigen::Matrix3d& information, double score,
-                   const std::string& detector);
+                   Proposer detector);
   // How closures the scans measured are confirmed by the camera ([loop_closure]
   // camera_confirmation); without it, only by a second closure.
   void setCameraMeasurer(CameraPairMeasurer measurer) { camera_measurer_ = std::move(measurer); }

@@ -57,13 +57,22 @@ enum class Confirmation : std::uint8_t {
 // Its name in loop_closures.csv ("" for None).
 const char* confirmationName(Confirmation c);
 
+// Which source proposed a pair: the estimate (the nearest keyframes; alignment and gating
+// verify), the laser classifier, the Tree of Words, or a place search joining a session to a map
+// (SessionJoin.h).
+enum class Proposer : std::uint8_t { Pose, Laser, Image, Place };
+// Its name in loop_closures.csv, map.usmap and observer events: "pose", "laser", "image", "place".
+const char* proposerName(Proposer p);
+// The proposer of that name, if any.
+std::optional<Proposer> parseProposer(const std::string& name);
+
 // One loop-closure hypothesis and what became of it (a row of loop_closures.csv).
 struct LoopClosureRecord {
   size_t from = 0, to = 0;  // earlier keyframe, current keyframe
   double from_time = 0, to_time = 0;
-  std::string detector;  // which source proposed it: "pose" (near the estimate; alignment + gating verify), "laser" or "image"
-  double score = 0;      // classifier margin, image normalised score, or alignment matched fraction
+  double score = 0;  // classifier margin, image normalised score, or alignment matched fraction
   bool accepted = false;
+  Proposer detector = Proposer::Pose;                         // which source proposed it
   ClosureReason reason = ClosureReason::None;                 // when not accepted
   common::Pose2 measurement;                                  // aligned relative pose (from -> to)
   Eigen::Matrix3d information = Eigen::Matrix3d::Identity();  // as added to the filter
@@ -84,7 +93,7 @@ using CandidateScorer = std::function<double(size_t earlier, size_t current)>;
 // reach, or a detector outside the loop closer (Tree of Words). Pairs proposed by the estimate
 // alone ("pose") carry none; their score is the alignment's matched fraction.
 struct Detection {
-  std::string detector;
+  Proposer detector = Proposer::Laser;
   double score = 0;
 };
 

@@ -36,6 +36,7 @@
 
 #include "urbanslam/common/Pose2.h"
 #include "urbanslam/io/LaserScan.h"
+#include "urbanslam/slam/LoopCloser.h"
 #include "urbanslam/slam/Map.h"
 #include "urbanslam/slam/PipelineOptions.h"
 
@@ -77,7 +78,7 @@ struct SessionFix {
   size_t keyframe = 0;                                // the session's keyframe
   common::Pose2 pose;                                 // where it was found, map frame
   Eigen::Matrix3d cov = Eigen::Matrix3d::Identity();  // place: as the localizer takes a match; laser: as a loop closure an alignment
-  std::string detector = "place";                     // who found it: the place search ("place") or the classifier and alignment ("laser")
+  Proposer detector = Proposer::Place;                // who found it: the place search, or the classifier and alignment (Laser)
   double margin_per_point = 0;                        // place: the search's margin; laser: the classifier's
   common::Pose2 transform;                            // session frame -> map frame, from this fix
   std::vector<size_t> confirmed;                      // the session's keyframes whose scans landed where this fix puts them
