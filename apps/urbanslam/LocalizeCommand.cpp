@@ -101,7 +101,7 @@ int localizeCommand(const Argv& args) {
   const bool search_maps = !ap.has("separate-map") && !info.initial_pose_given;
   std::vector<std::unique_ptr<slam::Pipeline>> separate;
   std::vector<std::unique_ptr<slam::Pipeline>> maps;
-  maps.push_back(slam::loadMap(info.map_path, nullptr, info.separate_map > 0 || search_maps ? &separate : nullptr));
+  maps.push_back(slam::loadMap(info.map_path, nullptr, info.separate_map > 0 || search_maps ? &separate : nullptr, slam::MapUse::Localize));
   if (info.separate_map > separate.size() && info.separate_map > 0)
     throw common::InputError("localize --separate-map " + std::to_string(info.separate_map) + ": " + info.map_path + " holds " +
                              std::to_string(separate.size()) + " separate map" + (separate.size() == 1 ? "" : "s"));

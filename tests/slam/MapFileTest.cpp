@@ -159,8 +159,9 @@ TEST(MapFile, FinishedRunCannotBeSaved) {
 }
 
 // The Tree of Words database is not in the file: a map that has one is refused on loading, with
-// the reason, rather than continued without the images seen so far.
-TEST(MapFile, MapWithAnImageDatabaseIsRefused) {
+// the reason, rather than continued without the images seen so far; localization, which only
+// reads the keyframes' words, loads it.
+TEST(MapFile, MapWithAnImageDatabaseIsRefusedUnlessOnlyRead) {
   slam::PipelineOptions o;
   o.loop_closure.image_detector = slam::LoopClosureOptions::ImageDetector::TreeOfWords;
   o.image_loop.vocabulary = test::repoPath("share/vision_loop/sift_k10_L4.usvoc");
@@ -169,8 +170,23 @@ TEST(MapFile, MapWithAnImageDatabaseIsRefused) {
   for (int i = 0; i < 4; ++i) p.step(*src);
   p.waitForGlobalSlam(*src);
   ASSERT_GT(p.keyframes().size(), 0u);
-  const std::string e = loadError("images", slam::encodeMap(p));
+  const std::string bytes = slam::encodeMap(p);
+  const std::string e = loadError("images", bytes);
   EXPECT_NE(e.find("image_detector = tree_of_words"), std::string::npos) << e;
+  // Only read (localization), it loads: the keyframes with their images' words, as the run had them.
+  const auto read = slam::loadMap(writeBytes("images_read", bytes), nullptr, nullptr, slam::MapUse::Localize);
+  ASSERT_EQ(read->keyframes().size(), p.keyframes().size());
+  size_t with_words = 0;
+  for (size_t k = 0; k < p.keyframes().size(); ++k) {
+    const auto &a = p.keyframes()[k].image_words.entries, &b = read->keyframes()[k].image_words.entries;
+    with_words += !a.empty();
+    ASSERT_EQ(a.size(), b.size()) << k;
+    for (size_t i = 0; i < a.size(); ++i) {
+      EXPECT_EQ(a[i].word, b[i].word);
+      EXPECT_EQ(a[i].weight, b[i].weight);
+    }
+  }
+  EXPECT_GT(with_words, 0u);
 }
 
 // A file of the format before separate maps (version 3, written by that version: the fuzzing

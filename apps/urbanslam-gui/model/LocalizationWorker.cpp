@@ -9,7 +9,7 @@ namespace urbanslam::gui {
 LocalizationWorker::LocalizationWorker(const std::string& map_path, const std::string& log_path)
     : map_path_(slam::mapFilePath(map_path)), log_path_(log_path) {
   std::vector<std::unique_ptr<slam::Pipeline>> separate;
-  maps_.push_back(slam::loadMap(map_path_, nullptr, &separate));
+  maps_.push_back(slam::loadMap(map_path_, nullptr, &separate, slam::MapUse::Localize));
   for (auto& p : separate) maps_.push_back(std::move(p));
   for (size_t k = 0; k < maps_.size(); ++k) {
     maps_[k]->finish();  // the final estimates of the map's keyframes, as `localize` uses them

@@ -131,7 +131,7 @@ std::string mapFilePath(const std::string& file_or_run_folder) {
 }
 
 std::unique_ptr<Pipeline> loadMap(const std::string& path, const PipelineOptions* options,
-                                  std::vector<std::unique_ptr<Pipeline>>* separate) {
+                                  std::vector<std::unique_ptr<Pipeline>>* separate, MapUse use) {
   const std::string bytes = readWholeFile(path);
   // The signature first: a file that is not a map is told so, even a short one.
   const size_t sig = std::min(bytes.size(), sizeof kMagic);
@@ -162,7 +162,8 @@ std::unique_ptr<Pipeline> loadMap(const std::string& path, const PipelineOptions
   if (options) checkSameAlgorithmOptions(saved, *options, path);
   const PipelineOptions& used = options ? *options : saved;
   auto pipeline = std::make_unique<Pipeline>(used);
-  pipeline->readState(r, version);
+  const bool continued = use == MapUse::Continue;
+  pipeline->readState(r, version, continued);
   if (separate) separate->clear();
   if (version >= 4) {
     common::BinaryReader maps = r.section(kSeparateTag);
@@ -170,7 +171,7 @@ std::unique_ptr<Pipeline> loadMap(const std::string& path, const PipelineOptions
       const size_t n = maps.count(6 * 12);  // a map is at least its six sections' tags and lengths
       for (size_t i = 0; i < n; ++i) {
         separate->push_back(std::make_unique<Pipeline>(used));
-        separate->back()->readState(maps, version);
+        separate->back()->readState(maps, version, continued);
       }
       maps.expectEnd();
     }

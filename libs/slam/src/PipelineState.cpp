@@ -639,7 +639,7 @@ void Pipeline::writeStateNow(BinaryWriter& w) const {
   w.endSection();
 }
 
-void Pipeline::readState(BinaryReader& r, std::uint32_t format_version) {
+void Pipeline::readState(BinaryReader& r, std::uint32_t format_version, bool continued) {
   if (map_.size() != 0 || stats_.measurements != 0 || finished_) throw std::logic_error("Pipeline::readState into a pipeline that has run");
   {
     BinaryReader s = r.section(kStatsTag);
@@ -688,7 +688,7 @@ void Pipeline::readState(BinaryReader& r, std::uint32_t format_version) {
       k = s.size();
       if (k >= map_.size()) s.fail("image of keyframe " + std::to_string(k));
     }
-    if (s.boolean())
+    if (s.boolean() && continued)
       throw common::InputError(r.name() +
                                ": built with [loop_closure] image_detector = tree_of_words over camera images; map files do "
                                "not hold the image database, so this map cannot be continued");

@@ -41,14 +41,20 @@ void saveMap(const Pipeline& pipeline, const std::string& path, const std::vecto
 // The map file named by the user: the file itself, or the run folder holding map.usmap.
 std::string mapFilePath(const std::string& file_or_run_folder);
 
+// What a loaded map is for: continued (run --resume, --map, merge), or only read (localize, whose
+// localizer reads the keyframes and their images' words and never adds to the map).
+enum class MapUse { Continue, Localize };
+
 // The pipeline a map file holds, ready for its next measurement. `options` (optional): the
 // options the continued run asks for, which must equal the map's on every key that changes the
 // result (all but [map] and [output]; InputError naming the key otherwise); the pipeline then
 // runs with them. Without, it runs with the map's own. Throws common::InputError naming the file
 // for a file that is not a map, of another format version, truncated or corrupt. `separate`
 // (optional) receives the file's separate maps, with the same options; without, they are
-// checked by the checksum only and skipped.
+// checked by the checksum only and skipped. A map whose run kept a Tree of Words database over
+// camera images cannot be continued (the file holds the keyframes' words, not the database):
+// InputError, unless `use` is Localize.
 std::unique_ptr<Pipeline> loadMap(const std::string& path, const PipelineOptions* options = nullptr,
-                                  std::vector<std::unique_ptr<Pipeline>>* separate = nullptr);
+                                  std::vector<std::unique_ptr<Pipeline>>* separate = nullptr, MapUse use = MapUse::Continue);
 
 }  // namespace urbanslam::slam

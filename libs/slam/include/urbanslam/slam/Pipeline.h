@@ -66,7 +66,9 @@ class Pipeline {
   // before any step, and throws common::InputError for contents it cannot take. format_version:
   // the map file's (MapFile.h), which says what the sections hold.
   void writeState(common::BinaryWriter& w) const;
-  void readState(common::BinaryReader& r, std::uint32_t format_version);
+  // `continued`: the pipeline will go on (a map with a Tree of Words database over camera images,
+  // which the file does not hold, is refused); false: it is only read (localization).
+  void readState(common::BinaryReader& r, std::uint32_t format_version, bool continued = true);
 
   // Another session's map joined to this one (`join`: SessionJoin.h): its keyframes, scans and
   // odometry constraints appended after this map's, the first tied to this map's keyframe nearest
