@@ -54,7 +54,6 @@ class ImagePlaces {
   // The map holds image words and the options allow their use.
   bool mapHasImages() const { return options_.enabled && images_in_map_ > 0; }
   size_t queries() const { return queries_; }
-  const ImagePlaceOptions& options() const { return options_; }
 
  private:
   void load();
