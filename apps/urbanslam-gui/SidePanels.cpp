@@ -96,7 +96,7 @@ void ClosuresPanel::update(const MapSnapshot& s) {
     const auto& c = s.closures[shown_];
     const long row = list_->InsertItem(list_->GetItemCount(), std::to_string(c.from_keyframe));
     list_->SetItem(row, 1, std::to_string(c.to_keyframe));
-    list_->SetItem(row, 2, c.detector);
+    list_->SetItem(row, 2, slam::proposerName(c.detector));
     list_->SetItem(row, 3, wxString::Format("%.3f", c.score));
     list_->SetItem(row, 4, c.accepted ? wxString("accepted") : wxString("rejected: " + c.reason));
     list_->SetItemTextColour(row, c.accepted ? wxColour(20, 140, 50) : wxColour(170, 40, 150));

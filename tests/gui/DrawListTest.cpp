@@ -61,9 +61,9 @@ TEST(DrawList, AgeColoursRunFromOldToNewAndLayersHideThings) {
 
 TEST(DrawList, ClosuresSplitByOutcomeAndCandidates) {
   MapSnapshot s = threeKeyframes();
-  s.closures.push_back({0, 2, 2.0, "laser", 0.9, true, ""});
-  s.closures.push_back({1, 2, 2.0, "laser", 0.2, false, "gating"});
-  s.closures.push_back({0, 7, 2.0, "laser", 0.2, false, "alignment"});  // unknown keyframe: skipped
+  s.closures.push_back({0, 2, 2.0, slam::Proposer::Laser, 0.9, true, ""});
+  s.closures.push_back({1, 2, 2.0, slam::Proposer::Laser, 0.2, false, "gating"});
+  s.closures.push_back({0, 7, 2.0, slam::Proposer::Laser, 0.2, false, "alignment"});  // unknown keyframe: skipped
   s.candidates = {0, 1};
   const DrawList d = buildDrawList(s, {});
   ASSERT_EQ(d.closures_accepted.size(), 1u);

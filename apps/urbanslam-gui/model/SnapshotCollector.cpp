@@ -27,7 +27,7 @@ void SnapshotCollector::onCandidates(const slam::CandidatesEvent& e) {
 void SnapshotCollector::onLoopClosure(const slam::LoopClosureEvent& e) {
   std::lock_guard<std::mutex> lock(mutex_);
   state_.closures.push_back(e);
-  if (e.detector == "image") {
+  if (e.detector == slam::Proposer::Image) {
     // The final fate of a proposal that was waiting for a confirming closure.
     for (auto it = state_.image_matches.rbegin(); it != state_.image_matches.rend(); ++it)
       if (it->current == e.to_keyframe && it->matched == e.from_keyframe) {

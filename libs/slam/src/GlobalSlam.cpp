@@ -113,7 +113,7 @@ void GlobalSlam::closureAdded(size_t current, SteadyTime handed_over) {
 void GlobalSlam::reportClosure(const LoopClosureRecord& r) {
   ++(r.accepted ? stats_.closures_accepted : stats_.closures_rejected);
   closures_.push_back(r);
-  const LoopClosureEvent e{r.from, r.to, r.to_time, proposerName(r.detector), r.score, r.accepted, reasonName(r.reason)};
+  const LoopClosureEvent e{r.from, r.to, r.to_time, r.detector, r.score, r.accepted, reasonName(r.reason)};
   for (auto* o : observers_) o->onLoopClosure(e);
 }
 

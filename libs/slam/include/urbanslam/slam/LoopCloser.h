@@ -20,6 +20,7 @@
 #include "urbanslam/slam/CameraClosure.h"
 #include "urbanslam/slam/KeyframeGrid.h"
 #include "urbanslam/slam/PipelineOptions.h"
+#include "urbanslam/slam/Proposer.h"
 
 namespace urbanslam::alignment {
 class IndexedReference;
@@ -56,15 +57,6 @@ enum class Confirmation : std::uint8_t {
 };
 // Its name in loop_closures.csv ("" for None).
 const char* confirmationName(Confirmation c);
-
-// Which source proposed a pair: the estimate (the nearest keyframes; alignment and gating
-// verify), the laser classifier, the Tree of Words, or a place search joining a session to a map
-// (SessionJoin.h).
-enum class Proposer : std::uint8_t { Pose, Laser, Image, Place };
-// Its name in loop_closures.csv, map.usmap and observer events: "pose", "laser", "image", "place".
-const char* proposerName(Proposer p);
-// The proposer of that name, if any.
-std::optional<Proposer> parseProposer(const std::string& name);
 
 // One loop-closure hypothesis and what became of it (a row of loop_closures.csv).
 struct LoopClosureRecord {

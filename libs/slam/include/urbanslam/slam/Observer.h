@@ -12,6 +12,7 @@
 #include "urbanslam/common/Pose2.h"
 #include "urbanslam/io/LaserScan.h"
 #include "urbanslam/io/Measurements.h"
+#include "urbanslam/slam/Proposer.h"
 
 namespace urbanslam::slam {
 
@@ -38,7 +39,7 @@ struct PosesUpdatedEvent {
 struct LoopClosureEvent {
   size_t from_keyframe = 0, to_keyframe = 0;  // earlier, current
   double timestamp = 0;
-  std::string detector;  // which source proposed it: "pose", "laser" or "image"
+  Proposer detector = Proposer::Pose;  // which source proposed it
   double score = 0;
   bool accepted = false;
   std::string reason;  // why rejected: reasonName() of slam::ClosureReason (LoopCloser.h); empty if accepted

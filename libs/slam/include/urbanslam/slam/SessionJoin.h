@@ -36,7 +36,7 @@
 
 #include "urbanslam/common/Pose2.h"
 #include "urbanslam/io/LaserScan.h"
-#include "urbanslam/slam/LoopCloser.h"
+#include "urbanslam/slam/Proposer.h"
 #include "urbanslam/slam/Map.h"
 #include "urbanslam/slam/PipelineOptions.h"
 
