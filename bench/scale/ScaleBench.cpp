@@ -1,16 +1,18 @@
-// scale_bench (--city CITY_INI | --log LOG) [--ini PIPELINE_INI] --out DIR
+// scale_bench (--city CITY_INI | --log LOG) [--ini PIPELINE_INI] --out DIR [--progress-every N]
 // Runs the SLAM pipeline on a simulated city streamed from the simulator (no file) or on a log,
 // records every step's time with the map's size at that step, and writes DIR/steps.csv
 // (keyframes, step_ms, wall_s), DIR/step_time.png (p50 / p99 / max of the step time per bin of
 // map size), DIR/corrections.csv and DIR/global_latency.png (each full correction's latency
 // against the keyframe whose closure it brought in), the run's usual outputs (the front end's and global SLAM's figures in stats.json),
 // the CPU time of the mapping (both threads) (so `urbanslam eval DIR --truth SIM_DIR` scores it) and
-// one JSON summary on stdout.
+// one JSON summary on stdout. While it runs, DIR/progress.csv gains a row every N keyframes
+// (10000 unless told; ProgressLog.h): a run stopped early still tells how its cost grew.
 #include <sys/resource.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -27,6 +29,7 @@
 #include "urbanslam/slam/Pipeline.h"
 #include "urbanslam/slam/PipelineOptions.h"
 #include "urbanslam/slam/RunOutputs.h"
+#include "ProgressLog.h"
 
 using namespace urbanslam;
 
@@ -58,11 +61,12 @@ double cpuSeconds() {
 
 }  // namespace
 
-constexpr const char* kUsage = "usage: scale_bench (--city CITY_INI | --log LOG) [--ini PIPELINE_INI] --out DIR\n";
+constexpr const char* kUsage = "usage: scale_bench (--city CITY_INI | --log LOG) [--ini PIPELINE_INI] --out DIR [--progress-every N]\n";
 
 int main(int argc, char** argv) {
   urbanslam::common::keepFreedBuffers();  // as the urbanslam command does
   std::string city, log, ini = std::string(URBANSLAM_SOURCE_DIR) + "/ini/default.ini", out;
+  long progress_every = 10000;
   for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
       std::cout << kUsage << "The pipeline on a simulated city streamed from the simulator, or on a log; prints one JSON line.\n";
@@ -78,8 +82,10 @@ int main(int argc, char** argv) {
       ini = argv[i + 1];
     else if (a == "--out")
       out = argv[i + 1];
+    else if (a == "--progress-every")
+      progress_every = std::atol(argv[i + 1]);
   }
-  if (out.empty() || city.empty() == log.empty()) {
+  if (out.empty() || city.empty() == log.empty() || progress_every <= 0) {
     std::cerr << kUsage;
     return 2;
   }
@@ -89,13 +95,15 @@ int main(int argc, char** argv) {
     slam::resolveDefaultPaths(options, URBANSLAM_SOURCE_DIR);
     std::unique_ptr<io::DataSource> source =
         city.empty() ? io::openDataSource(log) : std::make_unique<sim::SimulatedSource>(sim::loadSimOptions(city));
+    std::filesystem::create_directories(out);
     StepRecorder rec;  // outlives the pipeline, whose global SLAM thread calls it
+    bench::ProgressLog progress(out + "/progress.csv", static_cast<size_t>(progress_every));
     slam::Pipeline pipeline(options);
     pipeline.addObserver(&rec);
+    pipeline.addObserver(&progress);
     const double cpu0 = cpuSeconds();
     pipeline.run(*source);
     const double cpu_s = cpuSeconds() - cpu0;
-    std::filesystem::create_directories(out);
     const common::Json stats =
         slam::writeRunOutputs(pipeline, out, {city.empty() ? log : city, source->format(), ini, resolved, {}, {}, {}});
 

@@ -262,6 +262,7 @@ void GlobalSlam::addPlaceFix(size_t earlier, size_t current, const common::Pose2
 }
 
 void GlobalSlam::recoverAll() {
+  common::Stopwatch sw;
   map_.filter()->recover();
   last_full_size_ = map_.size();
   map_.pullPoses(0);
@@ -271,6 +272,7 @@ void GlobalSlam::recoverAll() {
   for (const auto& k : map_.keyframes()) poses.push_back(k.pose);
   dirty_since_recovery_ = false;
   PosesUpdatedEvent e{&poses};
+  e.recovery_ms = sw.milliseconds();
   if (unrecovered_closure_) {
     e.keyframe = unrecovered_closure_->first;
     e.latency_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - unrecovered_closure_->second).count();

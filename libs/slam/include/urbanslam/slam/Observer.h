@@ -33,6 +33,9 @@ struct PosesUpdatedEvent {
   // after local SLAM handed it over the corrected map was ready.
   size_t keyframe = static_cast<size_t>(-1);
   double latency_ms = 0;
+  // How long the full recovery that produced these poses took (its share of global SLAM's time
+  // grows with the map, which is what a long run's observer watches).
+  double recovery_ms = 0;
 };
 
 // A loop-closure hypothesis between the current keyframe and an earlier one, and its fate.

@@ -1,0 +1,83 @@
+#pragma once
+// A long run's figures as it goes: one CSV row every `every` keyframes (and at 10², 10³), flushed
+// at once, so that a run stopped before its end still says how its cost and memory grew.
+//
+// Columns: keyframes; log_s (log time since the first measurement); wall_s; cpu_s (the whole
+// process: what one core would need); front_cpu_s (the thread that reads the sensors and runs
+// local SLAM, the simulator's ray casting included when the city is streamed); rss_mb (now) and
+// peak_rss_mb; closures (accepted); full_recoveries and full_recovery_s (global SLAM's passes
+// over the whole map, the part of its work that grows with the map).
+#include <time.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+#include "urbanslam/common/Timing.h"
+#include "urbanslam/slam/Observer.h"
+
+namespace urbanslam::bench {
+
+inline double threadCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+inline double processCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+inline double residentMegabytes() {
+  long pages = 0, resident = 0;
+  if (FILE* f = std::fopen("/proc/self/statm", "r")) {
+    if (std::fscanf(f, "%ld %ld", &pages, &resident) != 2) resident = 0;
+    std::fclose(f);
+  }
+  return static_cast<double>(resident) * static_cast<double>(sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
+}
+
+class ProgressLog : public slam::PipelineObserver {
+ public:
+  ProgressLog(const std::string& path, size_t every) : csv_(path), every_(every) {
+    csv_ << "keyframes,log_s,wall_s,cpu_s,front_cpu_s,rss_mb,peak_rss_mb,closures,full_recoveries,full_recovery_s\n" << std::flush;
+  }
+  // From the thread that reads the sensors.
+  void onStep(const slam::StepEvent& e) override {
+    if (first_timestamp_ < 0) first_timestamp_ = e.timestamp;
+    if (e.keyframes == last_row_ || !due(e.keyframes)) return;
+    last_row_ = e.keyframes;
+    char row[256];
+    std::snprintf(row, sizeof row, "%zu,%.1f,%.1f,%.1f,%.1f,%.0f,%.0f,%zu,%zu,%.1f\n", e.keyframes, e.timestamp - first_timestamp_,
+                  wall_.seconds(), processCpuSeconds(), threadCpuSeconds(), residentMegabytes(),
+                  static_cast<double>(common::peakResidentBytes()) / (1024.0 * 1024.0), closures_.load(), recoveries_.load(),
+                  recovery_ms_.load() / 1e3);
+    csv_ << row << std::flush;
+  }
+  // From global SLAM, which may run on its own thread.
+  void onLoopClosure(const slam::LoopClosureEvent& e) override {
+    if (e.accepted) ++closures_;
+  }
+  void onPosesUpdated(const slam::PosesUpdatedEvent& e) override {
+    ++recoveries_;
+    double ms = recovery_ms_.load();
+    while (!recovery_ms_.compare_exchange_weak(ms, ms + e.recovery_ms)) {
+    }
+  }
+
+ private:
+  bool due(size_t keyframes) const { return keyframes == 100 || keyframes == 1000 || (keyframes > 0 && keyframes % every_ == 0); }
+  std::ofstream csv_;
+  size_t every_;
+  size_t last_row_ = 0;
+  double first_timestamp_ = -1;
+  common::Stopwatch wall_;
+  std::atomic<size_t> closures_{0}, recoveries_{0};
+  std::atomic<double> recovery_ms_{0};
+};
+
+}  // namespace urbanslam::bench
