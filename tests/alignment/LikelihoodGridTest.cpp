@@ -91,6 +91,24 @@ TEST(LikelihoodGrid, CoarseGridWithFourFullResolutionLevels) {
   expectMatchesDefinition(o);
 }
 
+// A grid's storage is reused by the next grid of the thread with only the cells it wrote reset:
+// a grid built after a larger one that stamped nearly every cell (other points, another origin,
+// wider rows) holds no trace of it.
+TEST(LikelihoodGrid, AGridBuiltAfterALargerOneHoldsNoTraceOfIt) {
+  LikelihoodGridOptions o;
+  for (int round = 0; round < 2; ++round) {
+    {
+      std::mt19937 rng(5 + round);
+      std::uniform_real_distribution<double> x(-10.0, 13.0), y(-8.0, 12.0);
+      PointSet dense(60000);
+      for (auto& sp : dense) sp.p = {x(rng), y(rng)};
+      const LikelihoodGrid larger(dense, Eigen::Vector2d(1.0, 0.5), o);
+      ASSERT_GT(larger.score({0.3, 0.3}), larger.floorValue());
+    }
+    expectMatchesDefinition(o);
+  }
+}
+
 TEST(LikelihoodGrid, PointsBeyondTheRadiusLeaveTheFloor) {
   LikelihoodGridOptions o;
   o.max_radius_m = 2.0;

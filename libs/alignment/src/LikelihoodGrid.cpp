@@ -89,19 +89,15 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
       for (int i = a0; i <= a1; ++i) row[i] = std::min(row[i], dx2[static_cast<size_t>(i - a0)] + dy2);
     }
   }
-  Cells base(cells);  // every cell written below
+  Cells base = flooredCells(cells, floor_);  // the spans written below, the floor elsewhere
+  written_.emplace_back(static_cast<size_t>(height_));
   for (size_t b = 0; b < static_cast<size_t>(height_); ++b) {
     float* out = base.data() + b * static_cast<size_t>(width_);
     const double* row = nearest_d2.get() + b * static_cast<size_t>(width_);
     const int lo = span_lo[b], hi = span_hi[b];
-    if (lo > hi) {
-      fillFloor(out, width_, floor_);
-      continue;
-    }
-    fillFloor(out, lo, floor_);
+    written_.back()[b] = {lo, hi};
     for (int i = lo; i <= hi; ++i)
       out[i] = row[i] == kNone ? floor_ : std::max(floor_, table[static_cast<size_t>(std::min<double>(kTable, row[i] * to_index + 0.5))]);
-    fillFloor(out + hi + 1, width_ - hi - 1, floor_);
   }
   level_.push_back(std::move(base));
   // Level h from level h-1 by doubling: the block of 2^h starting at (i, j) is four blocks of
@@ -120,20 +116,15 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
   for (int k = 1; k <= std::min(levels, full_levels_); ++k) {
     const int step = 1 << (k - 1);
     const Cells& prev = level_.back();
-    Cells next(prev.size());  // every cell written below
+    Cells next = flooredCells(cells, floor_);  // the spans written below, the floor elsewhere
     for (size_t b = 0; b < h_; ++b) {
+      if (span_lo[b] > span_hi[b]) continue;
       const float* src = prev.data() + b * w_;
       float* dst = next.data() + b * w_;
-      if (span_lo[b] > span_hi[b]) {
-        fillFloor(dst, static_cast<long>(w_), floor_);
-        continue;
-      }
       // The block starting at a reaches the span from a = lo - step on.
       const int a0 = std::max(0, span_lo[b] - step), a1 = span_hi[b], n = std::min(a1 + 1, width_ - step);
-      fillFloor(dst, a0, floor_);
       if (n > a0) Cells1(dst + a0, n - a0) = ConstCells1(src + a0, n - a0).max(ConstCells1(src + a0 + step, n - a0));
       for (int a = std::max(a0, n); a <= a1; ++a) dst[a] = std::max(src[a], floor_);
-      fillFloor(dst + a1 + 1, static_cast<long>(w_) - a1 - 1, floor_);
       span_lo[b] = a0;
     }
     // The last `step` rows' blocks reach past the grid, into the floor: they stay as they are.
@@ -152,6 +143,8 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
     }
     level_.push_back(std::move(next));
     dims_.push_back({width_, height_});
+    written_.emplace_back(static_cast<size_t>(height_));
+    for (size_t b = 0; b < h_; ++b) written_.back()[b] = {span_lo[b], span_hi[b]};
   }
   // Higher levels at 1/2^h of the resolution (Olson's multi-resolution tables): block_max holds
   // the largest value of each aligned block of 2^h cells (from the four blocks of the level
@@ -197,6 +190,64 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
             std::max(std::max(at(a, b), at(a + 1, b)), std::max(at(a, b + 1), at(a + 1, b + 1)));
     level_.push_back(std::move(dilated));
     dims_.push_back({bw, bh});
+  }
+}
+
+struct LikelihoodGrid::Storage {
+  struct Kept {
+    Cells cells;
+    float floor;
+    int width;
+    RowSpans written;
+  };
+  // Local SLAM's steady state keeps three (the levels of the grid before the one in use).
+  static constexpr size_t kMaxKept = 6;
+  std::vector<Kept> kept;
+  ~Storage() { gone() = true; }
+  static Storage& ofThisThread() {
+    thread_local Storage storage;
+    return storage;
+  }
+  // Set once the thread's storage is destroyed (at its exit): a grid destroyed later frees its
+  // own. A plain flag, valid to the thread's end.
+  static bool& gone() {
+    thread_local bool flag = false;
+    return flag;
+  }
+};
+
+LikelihoodGrid::Cells LikelihoodGrid::flooredCells(size_t cells, float floor) {
+  std::vector<Storage::Kept>& kept = Storage::ofThisThread().kept;
+  size_t best = kept.size();  // the smallest kept storage large enough, of the same floor
+  for (size_t k = 0; k < kept.size(); ++k)
+    if (kept[k].floor == floor && kept[k].cells.size() >= cells && (best == kept.size() || kept[k].cells.size() < kept[best].cells.size()))
+      best = k;
+  if (best == kept.size()) {
+    Cells fresh(cells);
+    fillFloor(fresh.data(), static_cast<long>(cells), floor);
+    return fresh;
+  }
+  Storage::Kept k = std::move(kept[best]);
+  kept.erase(kept.begin() + static_cast<long>(best));
+  for (size_t b = 0; b < k.written.size(); ++b) {
+    const auto [lo, hi] = k.written[b];
+    if (lo <= hi) fillFloor(k.cells.data() + b * static_cast<size_t>(k.width) + static_cast<size_t>(lo), hi - lo + 1, floor);
+  }
+  return std::move(k.cells);
+}
+
+LikelihoodGrid::~LikelihoodGrid() {
+  if (Storage::gone()) return;
+  Storage& storage = Storage::ofThisThread();
+  for (size_t k = 0; k < written_.size() && k < level_.size(); ++k) {
+    if (storage.kept.size() >= Storage::kMaxKept) {  // the smallest goes, this one if it is
+      const auto smallest = std::min_element(storage.kept.begin(), storage.kept.end(), [](const Storage::Kept& a, const Storage::Kept& b) {
+        return a.cells.size() < b.cells.size();
+      });
+      if (smallest->cells.size() >= level_[k].size()) continue;
+      storage.kept.erase(smallest);
+    }
+    storage.kept.push_back({std::move(level_[k]), floor_, width_, std::move(written_[k])});
   }
 }
 

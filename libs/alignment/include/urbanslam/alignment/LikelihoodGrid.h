@@ -36,6 +36,12 @@ class LikelihoodGrid {
  public:
   // The reference points (in the reference's frame) around `centre`.
   LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d& centre, const LikelihoodGridOptions& options);
+  // The full-resolution levels' storage goes back to this thread's pool (see Storage).
+  ~LikelihoodGrid();
+  LikelihoodGrid(LikelihoodGrid&&) = default;
+  LikelihoodGrid& operator=(LikelihoodGrid&&) = delete;
+  LikelihoodGrid(const LikelihoodGrid&) = delete;
+  LikelihoodGrid& operator=(const LikelihoodGrid&) = delete;
 
   double resolution() const { return resolution_; }
   int levels() const { return static_cast<int>(level_.size()) - 1; }
@@ -105,6 +111,15 @@ class LikelihoodGrid {
   };
   using Cells = std::vector<float, NoFill<float>>;
   std::vector<Cells> level_;
+  // Local SLAM builds a grid of an 80 m square of 5 cm cells per keyframe, of which stamps
+  // reach about a tenth: writing the floor into the rest of the base and full-resolution levels
+  // was half of the grid's cost. Their storage is kept per thread when a grid is done, with the
+  // span of each row the grid wrote (rows are `width` cells); the next grid resets those spans
+  // to the floor and finds every other cell there already.
+  using RowSpans = std::vector<std::pair<int, int>>;  // per row: first and last cell written
+  struct Storage;
+  static Cells flooredCells(size_t cells, float floor);
+  std::vector<RowSpans> written_;  // per full-resolution level (0 = base)
 };
 
 }  // namespace urbanslam::alignment
