@@ -5,8 +5,10 @@
 // map size), DIR/corrections.csv and DIR/global_latency.png (each full correction's latency
 // against the keyframe whose closure it brought in), the run's usual outputs (the front end's and global SLAM's figures in stats.json),
 // the CPU time of the mapping (both threads) (so `urbanslam eval DIR --truth SIM_DIR` scores it) and
-// one JSON summary on stdout. While it runs, DIR/progress.csv gains a row every N keyframes
-// (10000 unless told; ProgressLog.h): a run stopped early still tells how its cost grew.
+// one JSON summary on stdout. While it runs, DIR.progress.csv (beside DIR, which is replaced as a
+// whole when the outputs are written) gains a row every N keyframes (10000 unless told;
+// ProgressLog.h), so a run stopped early still tells how its cost grew; at the end it moves to
+// DIR/progress.csv.
 #include <sys/resource.h>
 
 #include <algorithm>
@@ -95,9 +97,10 @@ int main(int argc, char** argv) {
     slam::resolveDefaultPaths(options, URBANSLAM_SOURCE_DIR);
     std::unique_ptr<io::DataSource> source =
         city.empty() ? io::openDataSource(log) : std::make_unique<sim::SimulatedSource>(sim::loadSimOptions(city));
-    std::filesystem::create_directories(out);
+    while (out.size() > 1 && out.back() == '/') out.pop_back();
+    const std::string progress_path = out + ".progress.csv";
     StepRecorder rec;  // outlives the pipeline, whose global SLAM thread calls it
-    bench::ProgressLog progress(out + "/progress.csv", static_cast<size_t>(progress_every));
+    bench::ProgressLog progress(progress_path, static_cast<size_t>(progress_every));
     slam::Pipeline pipeline(options);
     pipeline.addObserver(&rec);
     pipeline.addObserver(&progress);
@@ -106,6 +109,7 @@ int main(int argc, char** argv) {
     const double cpu_s = cpuSeconds() - cpu0;
     const common::Json stats =
         slam::writeRunOutputs(pipeline, out, {city.empty() ? log : city, source->format(), ini, resolved, {}, {}, {}});
+    std::filesystem::rename(progress_path, out + "/progress.csv");
 
     std::ofstream csv(out + "/steps.csv");
     csv << "keyframes,step_ms\n";
