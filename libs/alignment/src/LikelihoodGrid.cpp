@@ -200,8 +200,8 @@ struct LikelihoodGrid::Storage {
     int width;
     RowSpans written;
   };
-  // Local SLAM's steady state keeps three (the levels of the grid before the one in use).
-  static constexpr size_t kMaxKept = 6;
+  // One grid's levels: local SLAM's next grid takes those of the grid before the one in use.
+  static constexpr size_t kMaxKept = 3;
   std::vector<Kept> kept;
   ~Storage() { gone() = true; }
   static Storage& ofThisThread() {
@@ -223,6 +223,10 @@ LikelihoodGrid::Cells LikelihoodGrid::flooredCells(size_t cells, float floor) {
     if (kept[k].floor == floor && kept[k].cells.size() >= cells && (best == kept.size() || kept[k].cells.size() < kept[best].cells.size()))
       best = k;
   if (best == kept.size()) {
+    // Kept storage too small for this grid is freed (the submap's grid grows as a run starts):
+    // only what the next grids can use stays pinned.
+    kept.erase(std::remove_if(kept.begin(), kept.end(), [&](const Storage::Kept& k) { return k.floor == floor && k.cells.size() < cells; }),
+               kept.end());
     Cells fresh(cells);
     fillFloor(fresh.data(), static_cast<long>(cells), floor);
     return fresh;
