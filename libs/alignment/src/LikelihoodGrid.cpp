@@ -245,6 +245,7 @@ LikelihoodGrid::~LikelihoodGrid() {
   Storage& storage = Storage::ofThisThread();
   for (size_t k = 0; k < written_.size() && k < level_.size(); ++k) {
     if (storage.kept.size() >= Storage::kMaxKept) {  // the smallest goes, this one if it is
+      if (storage.kept.empty()) break;
       const auto smallest = std::min_element(storage.kept.begin(), storage.kept.end(), [](const Storage::Kept& a, const Storage::Kept& b) {
         return a.cells.size() < b.cells.size();
       });
