@@ -5,8 +5,10 @@
 // Columns: keyframes; log_s (log time since the first measurement); wall_s; cpu_s (the whole
 // process: what one core would need); front_cpu_s (the thread that reads the sensors and runs
 // local SLAM, the simulator's ray casting included when the city is streamed); rss_mb (now) and
-// peak_rss_mb; closures (accepted); full_recoveries and full_recovery_s (global SLAM's passes
-// over the whole map, the part of its work that grows with the map).
+// peak_rss_mb; closures (accepted), attempts (candidates aligned or refused, all proposers) and
+// laser_attempts (those the laser classifier proposed: far from the map each costs CRF-match
+// and ICP); full_recoveries and full_recovery_s (global SLAM's passes over the whole map, the
+// part of its work that grows with the map).
 #include <time.h>
 #include <unistd.h>
 
@@ -44,7 +46,8 @@ inline double residentMegabytes() {
 class ProgressLog : public slam::PipelineObserver {
  public:
   ProgressLog(const std::string& path, size_t every) : csv_(path), every_(every) {
-    csv_ << "keyframes,log_s,wall_s,cpu_s,front_cpu_s,rss_mb,peak_rss_mb,closures,full_recoveries,full_recovery_s\n" << std::flush;
+    csv_ << "keyframes,log_s,wall_s,cpu_s,front_cpu_s,rss_mb,peak_rss_mb,closures,attempts,laser_attempts,full_recoveries,full_recovery_s\n"
+         << std::flush;
   }
   // From the thread that reads the sensors.
   void onStep(const slam::StepEvent& e) override {
@@ -52,14 +55,16 @@ class ProgressLog : public slam::PipelineObserver {
     if (e.keyframes == last_row_ || !due(e.keyframes)) return;
     last_row_ = e.keyframes;
     char row[256];
-    std::snprintf(row, sizeof row, "%zu,%.1f,%.1f,%.1f,%.1f,%.0f,%.0f,%zu,%zu,%.1f\n", e.keyframes, e.timestamp - first_timestamp_,
+    std::snprintf(row, sizeof row, "%zu,%.1f,%.1f,%.1f,%.1f,%.0f,%.0f,%zu,%zu,%zu,%zu,%.1f\n", e.keyframes, e.timestamp - first_timestamp_,
                   wall_.seconds(), processCpuSeconds(), threadCpuSeconds(), residentMegabytes(),
-                  static_cast<double>(common::peakResidentBytes()) / (1024.0 * 1024.0), closures_.load(), recoveries_.load(),
-                  recovery_ms_.load() / 1e3);
+                  static_cast<double>(common::peakResidentBytes()) / (1024.0 * 1024.0), closures_.load(), attempts_.load(),
+                  laser_attempts_.load(), recoveries_.load(), recovery_ms_.load() / 1e3);
     csv_ << row << std::flush;
   }
   // From global SLAM, which may run on its own thread.
   void onLoopClosure(const slam::LoopClosureEvent& e) override {
+    ++attempts_;
+    if (e.detector == slam::Proposer::Laser) ++laser_attempts_;
     if (e.accepted) ++closures_;
   }
   void onPosesUpdated(const slam::PosesUpdatedEvent& e) override {
@@ -76,7 +81,7 @@ class ProgressLog : public slam::PipelineObserver {
   size_t last_row_ = 0;
   double first_timestamp_ = -1;
   common::Stopwatch wall_;
-  std::atomic<size_t> closures_{0}, recoveries_{0};
+  std::atomic<size_t> closures_{0}, attempts_{0}, laser_attempts_{0}, recoveries_{0};
   std::atomic<double> recovery_ms_{0};
 };
 
