@@ -58,7 +58,7 @@ class ProgressLog : public slam::PipelineObserver {
     std::snprintf(row, sizeof row, "%zu,%.1f,%.1f,%.1f,%.1f,%.0f,%.0f,%zu,%zu,%zu,%zu,%.1f\n", e.keyframes, e.timestamp - first_timestamp_,
                   wall_.seconds(), processCpuSeconds(), threadCpuSeconds(), residentMegabytes(),
                   static_cast<double>(common::peakResidentBytes()) / (1024.0 * 1024.0), closures_.load(), attempts_.load(),
-                  laser_attempts_.load(), recoveries_.load(), recovery_ms_.load() / 1e3);
+                  laser_attempts_.load(), recoveries_.load(), static_cast<double>(recovery_us_.load()) / 1e6);
     csv_ << row << std::flush;
   }
   // From global SLAM, which may run on its own thread.
@@ -69,9 +69,7 @@ class ProgressLog : public slam::PipelineObserver {
   }
   void onPosesUpdated(const slam::PosesUpdatedEvent& e) override {
     ++recoveries_;
-    double ms = recovery_ms_.load();
-    while (!recovery_ms_.compare_exchange_weak(ms, ms + e.recovery_ms)) {
-    }
+    recovery_us_ += static_cast<long long>(e.recovery_ms * 1e3);
   }
 
  private:
@@ -82,7 +80,7 @@ class ProgressLog : public slam::PipelineObserver {
   double first_timestamp_ = -1;
   common::Stopwatch wall_;
   std::atomic<size_t> closures_{0}, attempts_{0}, laser_attempts_{0}, recoveries_{0};
-  std::atomic<double> recovery_ms_{0};
+  std::atomic<long long> recovery_us_{0};
 };
 
 }  // namespace urbanslam::bench

@@ -9,7 +9,6 @@
 // whole when the outputs are written) gains a row every N keyframes (10000 unless told;
 // ProgressLog.h), so a run stopped early still tells how its cost grew; at the end it moves to
 // DIR/progress.csv.
-#include <sys/resource.h>
 
 #include <algorithm>
 #include <chrono>
@@ -54,13 +53,6 @@ struct StepRecorder : slam::PipelineObserver {
   }
 };
 
-// CPU time of the whole process (every thread): what one core would need for the run.
-double cpuSeconds() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
-
 }  // namespace
 
 constexpr const char* kUsage = "usage: scale_bench (--city CITY_INI | --log LOG) [--ini PIPELINE_INI] --out DIR [--progress-every N]\n";
@@ -104,9 +96,9 @@ int main(int argc, char** argv) {
     slam::Pipeline pipeline(options);
     pipeline.addObserver(&rec);
     pipeline.addObserver(&progress);
-    const double cpu0 = cpuSeconds();
+    const double cpu0 = bench::processCpuSeconds();
     pipeline.run(*source);
-    const double cpu_s = cpuSeconds() - cpu0;
+    const double cpu_s = bench::processCpuSeconds() - cpu0;
     const common::Json stats =
         slam::writeRunOutputs(pipeline, out, {city.empty() ? log : city, source->format(), ini, resolved, {}, {}, {}});
     std::filesystem::rename(progress_path, out + "/progress.csv");

@@ -242,18 +242,11 @@ LikelihoodGrid::Cells LikelihoodGrid::flooredCells(size_t cells, float floor) {
 
 LikelihoodGrid::~LikelihoodGrid() {
   if (Storage::gone()) return;
-  Storage& storage = Storage::ofThisThread();
-  for (size_t k = 0; k < written_.size() && k < level_.size(); ++k) {
-    if (storage.kept.size() >= Storage::kMaxKept) {  // the smallest goes, this one if it is
-      if (storage.kept.empty()) break;
-      const auto smallest = std::min_element(storage.kept.begin(), storage.kept.end(), [](const Storage::Kept& a, const Storage::Kept& b) {
-        return a.cells.size() < b.cells.size();
-      });
-      if (smallest->cells.size() >= level_[k].size()) continue;
-      storage.kept.erase(smallest);
-    }
-    storage.kept.push_back({std::move(level_[k]), floor_, width_, std::move(written_[k])});
-  }
+  std::vector<Storage::Kept>& kept = Storage::ofThisThread().kept;
+  // A full pool keeps what it holds (storage too small for a later grid is freed when that grid
+  // asks, flooredCells); this grid's levels are then freed.
+  for (size_t k = 0; k < written_.size() && k < level_.size() && kept.size() < Storage::kMaxKept; ++k)
+    kept.push_back({std::move(level_[k]), floor_, width_, std::move(written_[k])});
 }
 
 }  // namespace urbanslam::alignment

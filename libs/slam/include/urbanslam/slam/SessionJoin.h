@@ -36,9 +36,9 @@
 
 #include "urbanslam/common/Pose2.h"
 #include "urbanslam/io/LaserScan.h"
-#include "urbanslam/slam/Proposer.h"
 #include "urbanslam/slam/Map.h"
 #include "urbanslam/slam/PipelineOptions.h"
+#include "urbanslam/slam/Proposer.h"
 
 namespace urbanslam::slam {
 
