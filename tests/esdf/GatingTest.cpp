@@ -89,6 +89,87 @@ TEST(Gating, BoundShortcutNeverAcceptsWhatTheFullTestRejects) {
   EXPECT_GT(full, 0);
 }
 
+TEST(Gating, ConservativeBoundDecidesOnlyWhatTheExactTestWouldDecideAlike) {
+  // The conservative covariance bounds the exact one from above (the last factorisation holds
+  // less information; dead reckoning and the newest closure's path add, never remove), so its
+  // d^2 is never larger: gated with it, a closure is never refused that the exact test admits.
+  // The exact mode refuses by that bound first and computes the exact covariance only for what
+  // the bound admits: its decisions must be the exact test's. Three filters are fed the same
+  // loop with a factorisation midway and a closure after it; one gates conservatively, one
+  // exactly, and the reference's exact joint covariance (H Sigma H', which refactorises only
+  // the reference) decides for comparison.
+  std::mt19937 rng(42);
+  EsdfOptions ex, co;
+  ex.chi2_gate_probability = co.chi2_gate_probability = 0.95;
+  ex.gate_covariance = CovarianceMode::Exact;
+  co.gate_covariance = CovarianceMode::Conservative;
+  Esdf fe(ex), fc(co), fr(ex);
+  const Mat3 odo = Vec3(400.0, 400.0, 4000.0).asDiagonal();
+  const Mat3 omega = Vec3(100.0, 100.0, 1000.0).asDiagonal();
+  const std::vector<Esdf*> all{&fe, &fc, &fr};
+  for (Esdf* f : all) f->initialise(Vec3::Zero(), Mat3::Identity() * 1e-8);
+  for (int k = 1; k <= 80; ++k) {
+    const Vec3 step(1.0, 0.0, (k % 20 == 0) ? M_PI / 2 : 0.0);
+    for (Esdf* f : all) f->augmentRelative(k - 1, step, odo);
+    if (k == 40)
+      for (Esdf* f : all) f->recover();
+    if (k == 60)  // a closure into the dead-reckoned chain, for the conservative path through it
+      for (Esdf* f : all) f->observeRelative(5, 60, between(f->mean(5), f->mean(60)), omega);
+  }
+  int compared = 0, admitted_more = 0, refused_by_bound = 0, exact_accepted = 0, stale_rounds = 0;
+  const long long factorisations_before = fe.factorisations();
+  for (int t = 0; t < 300; ++t) {
+    // A new pose every fifth closure leaves the factor stale again (an exact covariance
+    // refactorises it).
+    if (t % 5 == 0) {
+      for (Esdf* f : all) f->augmentRelative(f->currentPose(), Vec3(1.0, 0.0, 0.0), odo);
+      // ...and a closure into the old poses, so that the bound is looser than the exact value.
+      for (Esdf* f : all) f->observeRelative(t % 40, f->currentPose(), between(f->mean(t % 40), f->mean(f->currentPose())), omega);
+      stale_rounds += 1;
+    }
+    const int i = t % 40, j = 41 + (t * 7) % 39;
+    const Vec3 z = between(fe.mean(i), fe.mean(j)) + Vec3(test::gauss(rng, 1.0), test::gauss(rng, 1.0), test::gauss(rng, 0.2));
+    const GateResult e = fe.gateRelative(i, j, z, omega), c = fc.gateRelative(i, j, z, omega);
+    ASSERT_EQ(e.covariance_used, c.covariance_used);
+    if (!e.covariance_used) continue;
+    ++compared;
+    Mat3 ai, aj;
+    relativePoseErrorJacobians(fr.mean(i), fr.mean(j), z, &ai, &aj);
+    Eigen::Matrix<double, 3, 6> h;
+    h << ai, aj;
+    const Eigen::MatrixXd s = h * fr.jointCovariance(i, j) * h.transpose() + omega.inverse();
+    const GateResult ref = mahalanobisGate(-relativePoseError(fr.mean(i), fr.mean(j), z), s, 0.95);
+    EXPECT_LE(c.mahalanobis2, ref.mahalanobis2 * (1 + 1e-9)) << i << " " << j;
+    if (ref.accepted) {
+      EXPECT_TRUE(c.accepted) << i << " " << j;
+    }
+    admitted_more += c.accepted && !ref.accepted;
+    EXPECT_EQ(e.accepted, ref.accepted) << i << " " << j;
+    if (e.accepted) {
+      EXPECT_NEAR(e.mahalanobis2, ref.mahalanobis2, 1e-9 * ref.mahalanobis2);
+    }
+    refused_by_bound += !e.accepted && e.mahalanobis2 < ref.mahalanobis2 * (1 - 1e-9);
+    exact_accepted += ref.accepted;
+  }
+  EXPECT_GT(compared, 100);
+  EXPECT_GT(exact_accepted, 10);
+  EXPECT_GT(refused_by_bound, 10);
+  // Refactorised only where the bound admitted a closure, not in every round that needed a
+  // covariance (each round's first exact covariance refactorises; the rest reuse it).
+  EXPECT_LT(fe.factorisations() - factorisations_before, stale_rounds / 2);
+  RecordProperty("factorisations", static_cast<int>(fe.factorisations() - factorisations_before));
+  // Not so loose that it admits everything the exact gate refuses.
+  int refused_by_both = 0;
+  for (int t = 0; t < 40; ++t) {
+    const int i = t, j = 41 + t % 39;
+    const Vec3 z = between(fe.mean(i), fe.mean(j)) + Vec3(8.0, -6.0, 1.0);
+    refused_by_both += !fe.gateRelative(i, j, z, omega).accepted && !fc.gateRelative(i, j, z, omega).accepted;
+  }
+  EXPECT_EQ(refused_by_both, 40);
+  RecordProperty("admitted_more", admitted_more);
+  RecordProperty("refused_by_bound", refused_by_bound);
+}
+
 INSTANTIATE_TEST_SUITE_P(Modes, GatingLoop, ::testing::Values(CovarianceMode::Exact, CovarianceMode::Conservative));
 
 }  // namespace

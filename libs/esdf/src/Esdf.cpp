@@ -237,21 +237,34 @@ GateResult Esdf::gateRelative(int i, int j, const Vec3& z, const Mat3& omega) {
     r.covariance_used = false;
     return r;
   }
-  Mat3 ai, aj;
-  relativePoseErrorJacobians(state_.mean(i), state_.mean(j), z, &ai, &aj);
-  const Mat6 sigma = jointCovariance(i, j, options_.gate_covariance);
-  Eigen::Matrix<double, 3, 6> h;
-  h << ai, aj;
-  // S = H Sigma H' + R with the innovation -e0 (the measurement "e = 0").
-  const Mat3 s = h * sigma * h.transpose() + omega.inverse();
-  return mahalanobisGate(-e0, s, gate_probability_);
+  // e = ⊖z ⊕ r with r = ⊖x_i ⊕ x_j: de/dr = diag(Rz', 1), so H Sigma H' = G Cov(r) G'.
+  const double c = std::cos(z.z()), sn = std::sin(z.z());
+  Mat3 g = Mat3::Identity();
+  g.topLeftCorner<2, 2>() << c, sn, -sn, c;
+  const auto test = [&](const Mat3& rel) {
+    // S = G Cov(r) G' + R with the innovation -e0 (the measurement "e = 0").
+    return mahalanobisGate(-e0, g * rel * g.transpose() + omega.inverse(), gate_probability_);
+  };
+  // The conservative covariance bounds the exact one from above, so its d^2 bounds the exact d^2
+  // from below: a closure it rejects, the exact test rejects too. Only the closures it admits
+  // need the exact covariance, which refactorises the whole map when the factor is stale.
+  // (With a current factor the exact covariance is a column solve, cheaper than that bound.)
+  if (options_.gate_covariance == CovarianceMode::Conservative || (!factorCurrent() && conservativeReady())) {
+    const GateResult r = test(relativeCovariance(i, j, CovarianceMode::Conservative));
+    if (options_.gate_covariance == CovarianceMode::Conservative || !r.accepted) return r;
+  }
+  return test(relativeCovariance(i, j, CovarianceMode::Exact));
+}
+
+bool Esdf::factorCurrent() const {
+  return full_factor_.valid() && full_factor_values_ == values_stamp_ && full_factor_.last() == size() &&
+         full_factor_.structureStamp() == state_.structureStamp();
 }
 
 void Esdf::ensureFactor() {
-  if (full_factor_.valid() && full_factor_values_ == values_stamp_ && full_factor_.last() == size() &&
-      full_factor_.structureStamp() == state_.structureStamp())
-    return;
+  if (factorCurrent()) return;
   full_factor_.factorize(state_, 0, size());
+  ++factorisations_;
   full_factor_values_ = values_stamp_;
   // A new reference for conservative covariances: chain restarts after the factored poses.
   chain_base_ = size();

@@ -49,6 +49,8 @@ struct EsdfOptions {
 
   // Innovation gate: the chi-square quantile probability (3 dof) for relative-pose observations.
   double chi2_gate_probability = 0.999;
+  // Exact: the exact test's decision, with the conservative bound refusing first what it can (no
+  // refactorisation); Conservative: the bound alone (admits more).
   CovarianceMode gate_covariance = CovarianceMode::Exact;
 
   // Relinearisation after a full recovery: factors whose poses moved more than these thresholds
@@ -154,6 +156,8 @@ class Esdf {
   size_t factorCount() const { return factors_.size(); }
   long long factorNonZeros() const { return full_factor_.factorNonZeros(); }
   size_t memoryBytes() const;
+  // Factorisations of the whole map so far (recoveries, exact covariances): what grows with it.
+  long long factorisations() const { return factorisations_; }
 
   // Total cost sum e' W e of the kept factors at the current mean (marginalised information
   // excluded): what relinearisation minimises.
@@ -221,6 +225,8 @@ class Esdf {
   Vec3 stabilisingNoise(const MotionModel& m) const;
   // Dead-reckoning propagation for conservative covariances (see jointCovariance).
   void pushChain(int k, int from, const Mat3& f_x, const Mat3& q);
+  // The full factor is of the current Lambda (nothing added or relinearised since).
+  bool factorCurrent() const;
   void ensureFactor();
   Mat3 covarianceColumnsBlock(int i, Eigen::MatrixXd* columns);
   bool conservativeReady() const;
@@ -267,6 +273,7 @@ class Esdf {
   double gate_probability_ = -1, gate_threshold_ = 0;  // cached chi2 quantile
   std::uint64_t values_stamp_ = 0;                     // bumped on every change of Lambda or eta
   std::uint64_t full_factor_values_ = ~std::uint64_t{0};
+  long long factorisations_ = 0;
 
   // Conservative covariance support: for poses k >= chain_base_, x_k = Phi_k x_{base-1} + noise
   // with accumulated noise C_k, valid while every such pose came from its predecessor.

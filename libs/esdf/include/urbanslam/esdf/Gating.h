@@ -20,7 +20,8 @@ struct GateResult {
   double mahalanobis2 = 0;  // d^2
   double threshold = 0;     // chi2 quantile used
   // False when the test was decided by the bound d^2 <= nu' R^-1 nu (S >= R), in which case
-  // mahalanobis2 holds that bound and no covariance was recovered.
+  // mahalanobis2 holds that bound and no covariance was recovered. (A closure refused with a
+  // conservative covariance holds that covariance's d^2, a lower bound of the exact one.)
   bool covariance_used = true;
 };
 
