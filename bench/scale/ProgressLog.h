@@ -8,7 +8,8 @@
 // peak_rss_mb; closures (accepted), attempts (candidates aligned or refused, all proposers) and
 // laser_attempts (those the laser classifier proposed: far from the map each costs CRF-match
 // and ICP); full_recoveries and full_recovery_s (global SLAM's passes over the whole map, the
-// part of its work that grows with the map).
+// part of its work that grows with the map) and factorisations (of the whole map, by the
+// recoveries and the innovation gate's exact covariances, as of the last recovery).
 #include <time.h>
 #include <unistd.h>
 
@@ -46,7 +47,7 @@ inline double residentMegabytes() {
 class ProgressLog : public slam::PipelineObserver {
  public:
   ProgressLog(const std::string& path, size_t every) : csv_(path), every_(every) {
-    csv_ << "keyframes,log_s,wall_s,cpu_s,front_cpu_s,rss_mb,peak_rss_mb,closures,attempts,laser_attempts,full_recoveries,full_recovery_s\n"
+    csv_ << "keyframes,log_s,wall_s,cpu_s,front_cpu_s,rss_mb,peak_rss_mb,closures,attempts,laser_attempts,full_recoveries,full_recovery_s,factorisations\n"
          << std::flush;
   }
   // From the thread that reads the sensors.
@@ -55,10 +56,10 @@ class ProgressLog : public slam::PipelineObserver {
     if (e.keyframes == last_row_ || !due(e.keyframes)) return;
     last_row_ = e.keyframes;
     char row[256];
-    std::snprintf(row, sizeof row, "%zu,%.1f,%.1f,%.1f,%.1f,%.0f,%.0f,%zu,%zu,%zu,%zu,%.1f\n", e.keyframes, e.timestamp - first_timestamp_,
+    std::snprintf(row, sizeof row, "%zu,%.1f,%.1f,%.1f,%.1f,%.0f,%.0f,%zu,%zu,%zu,%zu,%.1f,%lld\n", e.keyframes, e.timestamp - first_timestamp_,
                   wall_.seconds(), processCpuSeconds(), threadCpuSeconds(), residentMegabytes(),
                   static_cast<double>(common::peakResidentBytes()) / (1024.0 * 1024.0), closures_.load(), attempts_.load(),
-                  laser_attempts_.load(), recoveries_.load(), static_cast<double>(recovery_us_.load()) / 1e6);
+                  laser_attempts_.load(), recoveries_.load(), static_cast<double>(recovery_us_.load()) / 1e6, factorisations_.load());
     csv_ << row << std::flush;
   }
   // From global SLAM, which may run on its own thread.
@@ -70,6 +71,7 @@ class ProgressLog : public slam::PipelineObserver {
   void onPosesUpdated(const slam::PosesUpdatedEvent& e) override {
     ++recoveries_;
     recovery_us_ += static_cast<long long>(e.recovery_ms * 1e3);
+    factorisations_ = e.map_factorisations;
   }
 
  private:
@@ -81,6 +83,7 @@ class ProgressLog : public slam::PipelineObserver {
   common::Stopwatch wall_;
   std::atomic<size_t> closures_{0}, attempts_{0}, laser_attempts_{0}, recoveries_{0};
   std::atomic<long long> recovery_us_{0};
+  std::atomic<long long> factorisations_{0};
 };
 
 }  // namespace urbanslam::bench

@@ -273,6 +273,7 @@ void GlobalSlam::recoverAll() {
   dirty_since_recovery_ = false;
   PosesUpdatedEvent e{&poses};
   e.recovery_ms = sw.milliseconds();
+  e.map_factorisations = map_.filter()->factorisations();
   if (unrecovered_closure_) {
     e.keyframe = unrecovered_closure_->first;
     e.latency_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - unrecovered_closure_->second).count();

@@ -36,6 +36,8 @@ struct PosesUpdatedEvent {
   // How long the full recovery that produced these poses took (its share of global SLAM's time
   // grows with the map, which is what a long run's observer watches).
   double recovery_ms = 0;
+  // Factorisations of the whole map so far (recoveries and exact covariances).
+  long long map_factorisations = 0;
 };
 
 // A loop-closure hypothesis between the current keyframe and an earlier one, and its fate.
