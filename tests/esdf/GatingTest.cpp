@@ -22,6 +22,17 @@ TEST(Gating, Chi2QuantilesMatchTables) {
   EXPECT_NEAR(chi2Quantile(0.9, 2), -2 * std::log(0.1), 1e-9);
 }
 
+// The exact test, as the definition writes it: d^2 with S = H Sigma H' + R, Sigma the exact joint
+// covariance of (x_i, x_j) (which refactorises f) and H the error's Jacobians.
+GateResult referenceGate(Esdf& f, int i, int j, const Vec3& z, const Mat3& omega, double probability) {
+  Mat3 ai, aj;
+  relativePoseErrorJacobians(f.mean(i), f.mean(j), z, &ai, &aj);
+  Eigen::Matrix<double, 3, 6> h;
+  h << ai, aj;
+  const Eigen::MatrixXd s = h * f.jointCovariance(i, j) * h.transpose() + omega.inverse();
+  return mahalanobisGate(-relativePoseError(f.mean(i), f.mean(j), z), s, probability);
+}
+
 class GatingLoop : public ::testing::TestWithParam<CovarianceMode> {};
 
 TEST_P(GatingLoop, AcceptsConsistentRejectsInconsistentClosure) {
@@ -70,12 +81,7 @@ TEST(Gating, BoundShortcutNeverAcceptsWhatTheFullTestRejects) {
     const int i = t % 30, j = 30 + t % 30;
     const Vec3 z = between(f.mean(i), f.mean(j)) + Vec3(test::gauss(rng, 0.3), test::gauss(rng, 0.3), test::gauss(rng, 0.1));
     const GateResult g = f.gateRelative(i, j, z, omega);
-    Mat3 ai, aj;
-    relativePoseErrorJacobians(f.mean(i), f.mean(j), z, &ai, &aj);
-    Eigen::Matrix<double, 3, 6> h;
-    h << ai, aj;
-    const Eigen::MatrixXd s = h * f.jointCovariance(i, j) * h.transpose() + omega.inverse();
-    const GateResult ref = mahalanobisGate(-relativePoseError(f.mean(i), f.mean(j), z), s, 0.95);
+    const GateResult ref = referenceGate(f, i, j, z, omega, 0.95);
     EXPECT_EQ(g.accepted, ref.accepted);
     if (!g.covariance_used) {
       EXPECT_LE(ref.mahalanobis2, g.mahalanobis2 + 1e-12);
@@ -133,12 +139,7 @@ TEST(Gating, ConservativeBoundDecidesOnlyWhatTheExactTestWouldDecideAlike) {
     ASSERT_EQ(e.covariance_used, c.covariance_used);
     if (!e.covariance_used) continue;
     ++compared;
-    Mat3 ai, aj;
-    relativePoseErrorJacobians(fr.mean(i), fr.mean(j), z, &ai, &aj);
-    Eigen::Matrix<double, 3, 6> h;
-    h << ai, aj;
-    const Eigen::MatrixXd s = h * fr.jointCovariance(i, j) * h.transpose() + omega.inverse();
-    const GateResult ref = mahalanobisGate(-relativePoseError(fr.mean(i), fr.mean(j), z), s, 0.95);
+    const GateResult ref = referenceGate(fr, i, j, z, omega, 0.95);
     EXPECT_LE(c.mahalanobis2, ref.mahalanobis2 * (1 + 1e-9)) << i << " " << j;
     if (ref.accepted) {
       EXPECT_TRUE(c.accepted) << i << " " << j;
