@@ -237,21 +237,21 @@ GateResult Esdf::gateRelative(int i, int j, const Vec3& z, const Mat3& omega) {
     r.covariance_used = false;
     return r;
   }
-  // e = ⊖z ⊕ r with r = ⊖x_i ⊕ x_j: de/dr = diag(Rz', 1), so H Sigma H' = G Cov(r) G'.
-  const double c = std::cos(z.z()), sn = std::sin(z.z());
-  Mat3 g = Mat3::Identity();
-  g.topLeftCorner<2, 2>() << c, sn, -sn, c;
+  // e = ⊖z ⊕ r with r = ⊖x_i ⊕ x_j, so H Sigma H' = G Cov(r) G' with G = J2⊕(⊖z, r).
+  Mat3 g;
+  composeJacobians(inverse(z), Vec3::Zero(), nullptr, &g);
   const auto test = [&](const Mat3& rel) {
     // S = G Cov(r) G' + R with the innovation -e0 (the measurement "e = 0").
     return mahalanobisGate(-e0, g * rel * g.transpose() + omega.inverse(), gate_probability_);
   };
   // The conservative covariance bounds the exact one from above, so its d^2 bounds the exact d^2
-  // from below: a closure it rejects, the exact test rejects too. Only the closures it admits
-  // need the exact covariance, which refactorises the whole map when the factor is stale.
-  // (With a current factor the exact covariance is a column solve, cheaper than that bound.)
-  if (options_.gate_covariance == CovarianceMode::Conservative || (!factorCurrent() && conservativeReady())) {
+  // from below: a closure it refuses, the exact test refuses too. Only the closures it admits
+  // need the exact covariance, which refactorises the whole map when the factor is stale (with a
+  // current factor the exact covariance is column solves, and the bound is skipped).
+  const bool bound_only = options_.gate_covariance == CovarianceMode::Conservative;
+  if (bound_only || (!factorCurrent() && conservativeReady())) {
     const GateResult r = test(relativeCovariance(i, j, CovarianceMode::Conservative));
-    if (options_.gate_covariance == CovarianceMode::Conservative || !r.accepted) return r;
+    if (bound_only || !r.accepted) return r;
   }
   return test(relativeCovariance(i, j, CovarianceMode::Exact));
 }

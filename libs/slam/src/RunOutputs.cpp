@@ -198,7 +198,8 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   c["loop_closures_rejected"] = s.closures_rejected;
   c["loop_closures_camera_confirmed"] = std::count_if(p.loopClosures().begin(), p.loopClosures().end(),
                                                       [](const LoopClosureRecord& r) { return r.confirmed_by == Confirmation::Camera; });
-  // Factorisations of the whole map (full recoveries, exact covariances): the work that grows with it.
+  // Factorisations of the whole map (full recoveries, exact covariances): the work that grows with
+  // it. This run's only: a resumed map's earlier sessions are not counted.
   c["map_factorisations"] = p.map().filter() ? p.map().filter()->factorisations() : 0;
   c["image_keyframes"] = s.image_keyframes;
   c["image_proposals"] = s.image_proposals;

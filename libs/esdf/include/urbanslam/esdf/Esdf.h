@@ -156,7 +156,8 @@ class Esdf {
   size_t factorCount() const { return factors_.size(); }
   long long factorNonZeros() const { return full_factor_.factorNonZeros(); }
   size_t memoryBytes() const;
-  // Factorisations of the whole map so far (recoveries, exact covariances): what grows with it.
+  // Factorisations of the whole map by this object (recoveries, exact covariances): what grows
+  // with the map. A count of this process's work, not saved with the filter's state.
   long long factorisations() const { return factorisations_; }
 
   // Total cost sum e' W e of the kept factors at the current mean (marginalised information
