@@ -5,11 +5,12 @@
 // Columns: keyframes; log_s (log time since the first measurement); wall_s; cpu_s (the whole
 // process: what one core would need); front_cpu_s (the thread that reads the sensors and runs
 // local SLAM, the simulator's ray casting included when the city is streamed); rss_mb (now) and
-// peak_rss_mb; closures (accepted), attempts (candidates aligned or refused, all proposers) and
-// laser_attempts (those the laser classifier proposed: far from the map each costs CRF-match
-// and ICP); full_recoveries and full_recovery_s (global SLAM's passes over the whole map, the
-// part of its work that grows with the map) and factorisations (of the whole map, by the
-// recoveries and the innovation gate's exact covariances, as of the last recovery).
+// peak_rss_mb; heap_mb (the bytes malloc has handed out and not had back, over all its arenas:
+// what the run's data takes, against which rss_mb shows the allocator's free but kept pages); closures (accepted), attempts (candidates
+// aligned or refused, all proposers) and laser_attempts (those the laser classifier proposed: far from the map each costs CRF-match and
+// ICP); full_recoveries and full_recovery_s (global SLAM's passes over the whole map, the part of its work that grows with the map) and
+// factorisations (of the whole map, by the recoveries and the innovation gate's exact covariances, as of the last recovery).
+#include <malloc.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -44,10 +45,16 @@ inline double residentMegabytes() {
   return static_cast<double>(resident) * static_cast<double>(sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
 }
 
+inline double heapInUseMegabytes() {
+  const struct mallinfo2 m = mallinfo2();
+  return static_cast<double>(m.uordblks + m.hblkhd) / (1024.0 * 1024.0);
+}
+
 class ProgressLog : public slam::PipelineObserver {
  public:
   ProgressLog(const std::string& path, size_t every) : csv_(path), every_(every) {
-    csv_ << "keyframes,log_s,wall_s,cpu_s,front_cpu_s,rss_mb,peak_rss_mb,closures,attempts,laser_attempts,full_recoveries,full_recovery_s,factorisations\n"
+    csv_ << "keyframes,log_s,wall_s,cpu_s,front_cpu_s,rss_mb,peak_rss_mb,heap_mb,closures,attempts,laser_attempts,full_recoveries,full_"
+            "recovery_s,factorisations\n"
          << std::flush;
   }
   // From the thread that reads the sensors.
@@ -56,10 +63,11 @@ class ProgressLog : public slam::PipelineObserver {
     if (e.keyframes == last_row_ || !due(e.keyframes)) return;
     last_row_ = e.keyframes;
     char row[256];
-    std::snprintf(row, sizeof row, "%zu,%.1f,%.1f,%.1f,%.1f,%.0f,%.0f,%zu,%zu,%zu,%zu,%.1f,%lld\n", e.keyframes, e.timestamp - first_timestamp_,
-                  wall_.seconds(), processCpuSeconds(), threadCpuSeconds(), residentMegabytes(),
-                  static_cast<double>(common::peakResidentBytes()) / (1024.0 * 1024.0), closures_.load(), attempts_.load(),
-                  laser_attempts_.load(), recoveries_.load(), static_cast<double>(recovery_us_.load()) / 1e6, factorisations_.load());
+    std::snprintf(row, sizeof row, "%zu,%.1f,%.1f,%.1f,%.1f,%.0f,%.0f,%.0f,%zu,%zu,%zu,%zu,%.1f,%lld\n", e.keyframes,
+                  e.timestamp - first_timestamp_, wall_.seconds(), processCpuSeconds(), threadCpuSeconds(), residentMegabytes(),
+                  static_cast<double>(common::peakResidentBytes()) / (1024.0 * 1024.0), heapInUseMegabytes(), closures_.load(),
+                  attempts_.load(), laser_attempts_.load(), recoveries_.load(), static_cast<double>(recovery_us_.load()) / 1e6,
+                  factorisations_.load());
     csv_ << row << std::flush;
   }
   // From global SLAM, which may run on its own thread.
