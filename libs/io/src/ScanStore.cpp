@@ -1,28 +1,12 @@
 #include "urbanslam/io/ScanStore.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-
-#include <cerrno>
-#include <cstring>
-#include <filesystem>
 #include <stdexcept>
 
 namespace urbanslam::io {
 
-namespace {
+ScanStore::ScanStore(size_t cache_bytes, std::string spill_dir) : cache_bytes_(cache_bytes), spill_("scan store", std::move(spill_dir)) {}
 
-std::runtime_error spillError(const std::string& what, const std::string& dir) {
-  return std::runtime_error("scan store: " + what + " the spill file in " + dir + ": " + std::strerror(errno));
-}
-
-}  // namespace
-
-ScanStore::ScanStore(size_t cache_bytes, std::string spill_dir) : cache_bytes_(cache_bytes), spill_dir_(std::move(spill_dir)) {}
-
-ScanStore::~ScanStore() {
-  if (spill_fd_ >= 0) ::close(spill_fd_);
-}
+ScanStore::~ScanStore() = default;
 
 size_t ScanStore::add(CompactScan scan) {
   std::lock_guard<std::mutex> lock(mutex_);
@@ -70,7 +54,7 @@ size_t ScanStore::residentBytes() const {
 
 size_t ScanStore::spilledBytes() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return spill_end_;
+  return spill_.size();
 }
 
 void ScanStore::clear() {
@@ -78,11 +62,7 @@ void ScanStore::clear() {
   entries_.clear();
   lru_.clear();
   resident_bytes_ = 0;
-  spill_end_ = 0;
-  if (spill_fd_ >= 0 && ::ftruncate(spill_fd_, 0) != 0) {
-    ::close(spill_fd_);  // a fresh file at the next spill
-    spill_fd_ = -1;
-  }
+  spill_.clear();
 }
 
 void ScanStore::holdLocked(size_t id, std::shared_ptr<const CompactScan> scan) const {
@@ -105,50 +85,18 @@ void ScanStore::evictLocked() const {
 }
 
 void ScanStore::spillLocked(Entry& e) const {
-  if (spill_fd_ < 0) openSpillFileLocked();
   common::BinaryWriter w;
   e.scan->write(w);
-  const std::string& bytes = w.bytes();
-  size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t n = ::pwrite(spill_fd_, bytes.data() + done, bytes.size() - done, static_cast<off_t>(spill_end_ + done));
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) throw spillError("cannot write", spill_dir_);
-    done += static_cast<size_t>(n);
-  }
-  e.offset = spill_end_;
-  e.length = static_cast<std::uint32_t>(bytes.size());
-  spill_end_ += bytes.size();
+  e.offset = spill_.append(w.bytes());
+  e.length = static_cast<std::uint32_t>(w.bytes().size());
 }
 
 std::shared_ptr<const CompactScan> ScanStore::readBackLocked(const Entry& e) const {
-  std::string bytes(e.length, '\0');
-  size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t n = ::pread(spill_fd_, bytes.data() + done, bytes.size() - done, static_cast<off_t>(e.offset + done));
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) throw spillError("cannot read back", spill_dir_);
-    done += static_cast<size_t>(n);
-  }
+  const std::string bytes = spill_.read(e.offset, e.length);
   common::BinaryReader r(bytes.data(), bytes.size(), "scan store spill file");
   auto scan = std::make_shared<const CompactScan>(CompactScan::read(r));
   r.expectEnd();
   return scan;
-}
-
-void ScanStore::openSpillFileLocked() const {
-  if (spill_dir_.empty()) spill_dir_ = std::filesystem::temp_directory_path().string();
-    // Unlinked from the start: nothing to clean up after a crash, nothing a run folder shows.
-#ifdef O_TMPFILE
-  spill_fd_ = ::open(spill_dir_.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
-#endif
-  if (spill_fd_ < 0) {
-    // File systems without O_TMPFILE: a named file, unlinked as soon as it is open.
-    std::string path = (std::filesystem::path(spill_dir_) / "urbanslam-scans-XXXXXX").string();
-    spill_fd_ = ::mkostemp(path.data(), O_CLOEXEC);
-    if (spill_fd_ < 0) throw spillError("cannot create", spill_dir_);
-    ::unlink(path.c_str());
-  }
 }
 
 }  // namespace urbanslam::io

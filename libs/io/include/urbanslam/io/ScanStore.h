@@ -11,6 +11,7 @@
 // never mixes with a run's outputs. The store is thread-safe: a scan handed out stays valid
 // for as long as its holder keeps it, whatever is evicted meanwhile.
 #include <cstdint>
+#include <deque>
 #include <list>
 #include <memory>
 #include <mutex>
@@ -18,6 +19,7 @@
 #include <vector>
 
 #include "urbanslam/io/CompactScan.h"
+#include "urbanslam/io/ScratchFile.h"
 
 namespace urbanslam::io {
 
@@ -66,16 +68,15 @@ class ScanStore {
   void evictLocked() const;
   void spillLocked(Entry& e) const;
   std::shared_ptr<const CompactScan> readBackLocked(const Entry& e) const;
-  void openSpillFileLocked() const;
 
   size_t cache_bytes_;
-  mutable std::string spill_dir_;  // resolved at the first spill
   mutable std::mutex mutex_;
-  mutable std::vector<Entry> entries_;
+  // One per scan, up to millions: grown by fixed blocks (a vector's doubling leaves up to half
+  // its capacity unused and holds three times its size while it moves).
+  mutable std::deque<Entry> entries_;
   mutable std::list<size_t> lru_;  // ids in memory, most recently used first
   mutable size_t resident_bytes_ = 0;
-  mutable std::uint64_t spill_end_ = 0;
-  mutable int spill_fd_ = -1;
+  mutable ScratchFile spill_;
 };
 
 }  // namespace urbanslam::io
