@@ -57,6 +57,9 @@ void LoopDetector::reserve(size_t n) {
 size_t LoopDetector::addKeyframe(const FeatureVector& f) {
   for (size_t c = 0; c < columns_.size(); ++c) {
     const double v = f[static_cast<size_t>(used_features_[c])];
+    // Grown by an eighth, not doubled: a column of a million keyframes would leave up to half
+    // its capacity unused. The screening reads each column as one array, so no blocks.
+    if (columns_[c].size() == columns_[c].capacity()) columns_[c].reserve(columns_[c].size() + columns_[c].size() / 8 + 1024);
     columns_[c].push_back(static_cast<float>(v));
   }
   return count_++;
