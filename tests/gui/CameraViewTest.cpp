@@ -25,7 +25,7 @@ gui::MapSnapshot runExcerpt(slam::LoopClosureOptions::ImageDetector image_detect
   p.addObserver(&c);
   auto src = io::openDataSource(test::repoPath("rawlogs/rtabmap-loop-excerpt"));
   p.run(*src);
-  if (records) records->assign(p.loopClosures().begin(), p.loopClosures().end());
+  if (records) *records = p.loopClosures();
   return c.snapshot();
 }
 

@@ -89,11 +89,12 @@ TEST(EsdfPipeline, SpilledScansMakeTheSameMap) {
     ASSERT_EQ(a->keyframes()[i].pose.x, b->keyframes()[i].pose.x) << i;
     ASSERT_EQ(a->keyframes()[i].pose.phi, b->keyframes()[i].pose.phi) << i;
   }
-  ASSERT_EQ(a->loopClosures().size(), b->loopClosures().size());
+  const auto a_closures = a->loopClosures(), b_closures = b->loopClosures();
+  ASSERT_EQ(a_closures.size(), b_closures.size());
   size_t accepted = 0;
-  for (size_t i = 0; i < a->loopClosures().size(); ++i) {
-    EXPECT_EQ(a->loopClosures()[i].accepted, b->loopClosures()[i].accepted) << i;
-    accepted += a->loopClosures()[i].accepted;
+  for (size_t i = 0; i < a_closures.size(); ++i) {
+    EXPECT_EQ(a_closures[i].accepted, b_closures[i].accepted) << i;
+    accepted += a_closures[i].accepted;
   }
   EXPECT_GT(accepted, 0u);  // the closures read earlier keyframes' scans back
 }

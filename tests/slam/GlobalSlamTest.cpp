@@ -182,7 +182,8 @@ TEST(GlobalSlam, AClosureIsConfirmedByTheCameraWhenTheImagesMeasureTheSamePose) 
     return std::make_pair(std::move(r), asked);
   };
   const auto accepted_at = [](const ::Run& r, size_t keyframe, slam::Confirmation by) {
-    return std::count_if(r.global->closures().begin(), r.global->closures().end(),
+    const auto closures = r.global->closures();
+    return std::count_if(closures.begin(), closures.end(),
                          [&](const slam::LoopClosureRecord& c) { return c.accepted && c.to == keyframe && c.confirmed_by == by; });
   };
   const auto [agree, asked_agree] = run(0.0, true);

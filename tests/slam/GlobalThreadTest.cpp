@@ -67,11 +67,12 @@ TEST(GlobalThread, SameMapAsGlobalSlamInline) {
     EXPECT_EQ(a.keyframes()[i].pose.y, b.keyframes()[i].pose.y) << i;
     EXPECT_EQ(a.keyframes()[i].pose.phi, b.keyframes()[i].pose.phi) << i;
   }
-  ASSERT_EQ(a.loopClosures().size(), b.loopClosures().size());
-  for (size_t i = 0; i < a.loopClosures().size(); ++i) {
-    EXPECT_EQ(a.loopClosures()[i].from, b.loopClosures()[i].from) << i;
-    EXPECT_EQ(a.loopClosures()[i].to, b.loopClosures()[i].to) << i;
-    EXPECT_EQ(a.loopClosures()[i].accepted, b.loopClosures()[i].accepted) << i;
+  const auto a_closures = a.loopClosures(), b_closures = b.loopClosures();
+  ASSERT_EQ(a_closures.size(), b_closures.size());
+  for (size_t i = 0; i < a_closures.size(); ++i) {
+    EXPECT_EQ(a_closures[i].from, b_closures[i].from) << i;
+    EXPECT_EQ(a_closures[i].to, b_closures[i].to) << i;
+    EXPECT_EQ(a_closures[i].accepted, b_closures[i].accepted) << i;
   }
   const auto ta = a.odometryTrajectory(), tb = b.odometryTrajectory();
   ASSERT_EQ(ta.size(), tb.size());

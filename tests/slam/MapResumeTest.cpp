@@ -78,9 +78,10 @@ void expectResumeEqualsWholeRun(const Case& c) {
   EXPECT_GT(closures_after, 0u);
 
   ASSERT_EQ(whole->keyframes().size(), resumed->keyframes().size());
-  ASSERT_EQ(whole->loopClosures().size(), resumed->loopClosures().size());
-  for (size_t i = 0; i < whole->loopClosures().size(); ++i) {
-    const auto &a = whole->loopClosures()[i], &b = resumed->loopClosures()[i];
+  const auto whole_closures = whole->loopClosures(), resumed_closures = resumed->loopClosures();
+  ASSERT_EQ(whole_closures.size(), resumed_closures.size());
+  for (size_t i = 0; i < whole_closures.size(); ++i) {
+    const auto &a = whole_closures[i], &b = resumed_closures[i];
     EXPECT_EQ(a.from, b.from) << i;
     EXPECT_EQ(a.to, b.to) << i;
     EXPECT_EQ(a.accepted, b.accepted) << i;

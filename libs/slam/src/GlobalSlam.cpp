@@ -16,7 +16,12 @@ constexpr double kDeg = M_PI / 180.0;
 }  // namespace
 
 GlobalSlam::GlobalSlam(const PipelineOptions& options, Map& map, PipelineStats& stats, const std::vector<PipelineObserver*>& observers)
-    : options_(options), map_(map), stats_(stats), observers_(observers), closer_(options.loop_closure) {
+    : options_(options),
+      map_(map),
+      stats_(stats),
+      observers_(observers),
+      closer_(options.loop_closure),
+      closures_("loop closure records", 4096, options.map.scan_spill_dir) {
   if (options_.loop_closure.enabled && options_.loop_closure.detector == LoopClosureOptions::Detector::Laser) {
     // The AdaBoost classifier adds candidates where the estimate is too uncertain to pick them. Its
     // score is the margin above the model's decision factor (eq. 3.30), so laser_threshold = 0

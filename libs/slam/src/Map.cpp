@@ -15,7 +15,11 @@ constexpr size_t kNone = std::numeric_limits<size_t>::max();
 }  // namespace
 
 Map::Map(std::unique_ptr<esdf::Esdf> filter, double index_cell_m, size_t scan_cache_bytes, std::string spill_dir)
-    : scans_(scan_cache_bytes, std::move(spill_dir)), index_(index_cell_m), filter_(std::move(filter)) {}
+    : scans_(scan_cache_bytes, spill_dir),
+      edges_("pose graph edges", 4096, spill_dir),
+      index_(index_cell_m),
+      filter_(std::move(filter)),
+      odometry_("odometry readings", 4096, spill_dir) {}
 
 Map::~Map() = default;
 
@@ -42,7 +46,11 @@ void Map::addAnchor(const ScanAnchor& anchor) {
   anchors_.push_back(anchor);
   // Odometry readings taken at the scan's time hang from it: the trajectory at that time is the
   // scan's pose, not the odometry prediction from the anchor before.
-  for (auto it = odometry_.rbegin(); it != odometry_.rend() && it->timestamp == anchor.timestamp; ++it) it->anchor = anchors_.size() - 1;
+  odometry_.amendNewest([&](OdometrySample& s) {
+    if (s.timestamp != anchor.timestamp) return false;
+    s.anchor = anchors_.size() - 1;
+    return true;
+  });
 }
 
 void Map::addOdometry(double timestamp, const common::Pose2& odom) {
@@ -56,10 +64,10 @@ void Map::appendTrajectory(const Map& other, size_t keyframe_offset) {
     anchors_.push_back(a);
   }
   // A reading before the other map's first anchor hangs from that anchor, not from this map's.
-  for (OdometrySample s : other.odometry_) {
+  other.odometry_.forEach([&](OdometrySample s) {
     s.anchor = s.anchor == kNone ? anchor_offset : s.anchor + anchor_offset;
     odometry_.push_back(s);
-  }
+  });
 }
 
 std::vector<io::StampedPose> Map::odometryTrajectory() const {
@@ -69,24 +77,24 @@ std::vector<io::StampedPose> Map::odometryTrajectory() const {
   const auto via = [&](size_t i, const common::Pose2& odom) {
     return common::compose(anchorPose(anchors_[i]), common::between(anchors_[i].odom, odom));
   };
-  for (const auto& s : odometry_) {
-    if (anchors_.empty()) break;
-    // Before the first keyframe the map frame is the odometry frame of that keyframe.
-    const size_t a = s.anchor == kNone || s.anchor >= anchors_.size() ? 0 : s.anchor;
-    common::Pose2 p = via(a, s.odom);
-    // Between two anchors (keyframes or matched scans), the odometry drift is spread over the
-    // interval: the pose from the earlier anchor forwards and from the later one backwards,
-    // blended by time.
-    const size_t b = a + 1;
-    if (s.anchor != kNone && b < anchors_.size()) {
-      const double ta = anchors_[a].timestamp, tb = anchors_[b].timestamp;
-      if (tb > ta) {
-        const double f = std::clamp((s.timestamp - ta) / (tb - ta), 0.0, 1.0);
-        p = common::interpolate(p, via(b, s.odom), f);
+  if (!anchors_.empty())
+    odometry_.forEach([&](const OdometrySample& s) {
+      // Before the first keyframe the map frame is the odometry frame of that keyframe.
+      const size_t a = s.anchor == kNone || s.anchor >= anchors_.size() ? 0 : s.anchor;
+      common::Pose2 p = via(a, s.odom);
+      // Between two anchors (keyframes or matched scans), the odometry drift is spread over the
+      // interval: the pose from the earlier anchor forwards and from the later one backwards,
+      // blended by time.
+      const size_t b = a + 1;
+      if (s.anchor != kNone && b < anchors_.size()) {
+        const double ta = anchors_[a].timestamp, tb = anchors_[b].timestamp;
+        if (tb > ta) {
+          const double f = std::clamp((s.timestamp - ta) / (tb - ta), 0.0, 1.0);
+          p = common::interpolate(p, via(b, s.odom), f);
+        }
       }
-    }
-    out.push_back({s.timestamp, p});
-  }
+      out.push_back({s.timestamp, p});
+    });
   // In time order for TUM readers: the Intel log writes about one odometry reading in 20 out of
   // time order.
   std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.timestamp < b.timestamp; });

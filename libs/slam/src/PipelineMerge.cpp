@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 #include "urbanslam/common/Error.h"
 #include "urbanslam/slam/Pipeline.h"
@@ -37,9 +38,10 @@ void Pipeline::appendSession(const Pipeline& session, const SessionJoin& join) {
   // The session's odometry constraints, by the keyframe they lead to. A session that is itself
   // a merge (a map kept separate in a file, then linked) has its later sessions' first
   // keyframes hang from an earlier keyframe by their join: that constraint is kept as it is.
-  std::vector<const GraphEdge*> chain(other.size(), nullptr);
-  for (const GraphEdge& e : other.edges())
-    if (!e.loop_closure && e.from < e.to && e.to < chain.size() && (!chain[e.to] || e.from > chain[e.to]->from)) chain[e.to] = &e;
+  std::vector<std::optional<GraphEdge>> chain(other.size());
+  other.edges().forEach([&](const GraphEdge& e) {
+    if (!e.loop_closure && e.from < e.to && e.to < chain.size() && (!chain[e.to] || e.from > chain[e.to]->from)) chain[e.to] = e;
+  });
 
   const auto now = std::chrono::steady_clock::now();
   for (const Keyframe& k : other.keyframes()) {
@@ -55,7 +57,7 @@ void Pipeline::appendSession(const Pipeline& session, const SessionJoin& join) {
       c.cov = join.transform_cov;
       global_.addKeyframeFrom(from, Keyframe{n0, k.timestamp, {}, false, k.has_image, k.image_words}, io::CompactScan(other.scan(0)), c);
     } else {
-      const GraphEdge* e = chain[k.index];
+      const std::optional<GraphEdge>& e = chain[k.index];
       if (!e)
         throw common::InputError("the session's keyframe " + std::to_string(k.index) + " has no odometry constraint from the one before");
       c.z = e->measurement;
@@ -79,7 +81,7 @@ void Pipeline::appendSession(const Pipeline& session, const SessionJoin& join) {
     global_.closeLoops(n0 + k.index, now);
   }
   map_.appendTrajectory(other, n0);
-  reference_.insert(reference_.end(), session.reference_.begin(), session.reference_.end());
+  session.reference_.forEach([&](const io::StampedPose& p) { reference_.push_back(p); });
 
   // Local SLAM continues the session: its state (motion, submap in its own frame) with the
   // keyframes counted in the merged map, and global SLAM's estimate of the submap it will take.

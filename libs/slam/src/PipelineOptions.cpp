@@ -167,7 +167,8 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("point_decimation", o.map.point_decimation, 1, 1000, "", "keep every n-th point in the point clouds");
   s.add("scan_cache_mb", o.map.scan_cache_mb, 0, 1e6, "MB", "keyframe scans held in memory at most; the rest wait in a spill file");
   s.add("scan_spill_dir", o.map.scan_spill_dir, {},
-        "folder of the spill file (deleted with the run); empty: the system's temporary folder");
+        "folder of the spill files (scans, older closure records and odometry readings; deleted with the run); empty: the system's "
+        "temporary folder");
   s.add("remove_moving_points", o.map.remove_moving_points,
         "leave out of the point clouds the points another keyframe's scan saw through (cars, people, doors that moved)");
   s.add("moving_points_reach_m", o.map.moving_points_reach_m, 1.0, 1000.0, "m", "keyframes within this distance judge a keyframe's points");

@@ -13,6 +13,7 @@
 #include "urbanslam/common/Error.h"
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/laser_loop/LoopDetector.h"
+#include "urbanslam/slam/MapFile.h"
 #include "urbanslam/slam/Pipeline.h"
 #include "urbanslam/vision_loop/LoopDetector.h"
 
@@ -288,6 +289,42 @@ constexpr std::uint32_t kImagesTag = common::sectionTag("IMGS");
 
 }  // namespace
 
+void LoopClosureRecordCodec::write(BinaryWriter& w, const LoopClosureRecord& c) { writeRecord(w, c); }
+
+LoopClosureRecord LoopClosureRecordCodec::read(BinaryReader& r) {
+  return readRecord(r, std::numeric_limits<size_t>::max(), kMapFormatVersion);
+}
+
+void Pipeline::StampedPoseCodec::write(BinaryWriter& w, const io::StampedPose& p) {
+  w.f64(p.timestamp);
+  writePose(w, p.pose);
+}
+
+io::StampedPose Pipeline::StampedPoseCodec::read(BinaryReader& r) {
+  io::StampedPose p;
+  p.timestamp = r.f64();
+  p.pose = readPose(r);
+  return p;
+}
+
+void GraphEdgeCodec::write(BinaryWriter& w, const GraphEdge& e) {
+  w.size(e.from);
+  w.size(e.to);
+  writePose(w, e.measurement);
+  w.matrix(Eigen::Matrix3d(e.information));
+  w.boolean(e.loop_closure);
+}
+
+GraphEdge GraphEdgeCodec::read(BinaryReader& r) {
+  GraphEdge e;
+  e.from = r.size();
+  e.to = r.size();
+  e.measurement = readPose(r);
+  e.information = r.matrix<3, 3>();
+  e.loop_closure = r.boolean();
+  return e;
+}
+
 // --- Map ---
 
 void KeyframeGrid::writeState(BinaryWriter& w) const {
@@ -335,13 +372,7 @@ void Map::writeState(BinaryWriter& w) const {
     }
   }
   w.size(edges_.size());
-  for (const GraphEdge& e : edges_) {
-    w.size(e.from);
-    w.size(e.to);
-    writePose(w, e.measurement);
-    w.matrix(Eigen::Matrix3d(e.information));
-    w.boolean(e.loop_closure);
-  }
+  edges_.forEach([&](const GraphEdge& e) { GraphEdgeCodec::write(w, e); });
   index_.writeState(w);
   w.size(anchors_.size());
   for (const ScanAnchor& a : anchors_) {
@@ -351,11 +382,22 @@ void Map::writeState(BinaryWriter& w) const {
     writePose(w, a.odom);
   }
   w.size(odometry_.size());
-  for (const OdometrySample& s : odometry_) {
-    w.f64(s.timestamp);
-    writePose(w, s.odom);
-    w.u64(s.anchor == kNone ? ~std::uint64_t{0} : static_cast<std::uint64_t>(s.anchor));
-  }
+  odometry_.forEach([&](const OdometrySample& s) { OdometryCodec::write(w, s); });
+}
+
+void Map::OdometryCodec::write(BinaryWriter& w, const OdometrySample& s) {
+  w.f64(s.timestamp);
+  writePose(w, s.odom);
+  w.u64(s.anchor == kNone ? ~std::uint64_t{0} : static_cast<std::uint64_t>(s.anchor));
+}
+
+Map::OdometrySample Map::OdometryCodec::read(BinaryReader& r) {
+  OdometrySample s;
+  s.timestamp = r.f64();
+  s.odom = readPose(r);
+  const std::uint64_t a = r.u64();
+  s.anchor = a == ~std::uint64_t{0} ? kNone : static_cast<size_t>(a);
+  return s;
 }
 
 void Map::readState(BinaryReader& r) {
@@ -378,14 +420,11 @@ void Map::readState(BinaryReader& r) {
     }
   }
   const size_t n = keyframes_.size();
-  edges_.resize(r.count(8 + 8 + 24 + 72 + 1));
-  for (GraphEdge& e : edges_) {
-    e.from = r.size();
-    e.to = r.size();
+  edges_.clear();
+  for (size_t i = 0, count = r.count(8 + 8 + 24 + 72 + 1); i < count; ++i) {
+    const GraphEdge e = GraphEdgeCodec::read(r);
     if (e.from >= n || e.to >= n) r.fail("graph edge " + std::to_string(e.from) + " -> " + std::to_string(e.to));
-    e.measurement = readPose(r);
-    e.information = r.matrix<3, 3>();
-    e.loop_closure = r.boolean();
+    edges_.push_back(e);
   }
   index_.readState(r, n);
   anchors_.resize(r.count(8 + 8 + 48));
@@ -396,13 +435,11 @@ void Map::readState(BinaryReader& r) {
     a.offset = readPose(r);
     a.odom = readPose(r);
   }
-  odometry_.resize(r.count(8 + 24 + 8));
-  for (OdometrySample& s : odometry_) {
-    s.timestamp = r.f64();
-    s.odom = readPose(r);
-    const std::uint64_t a = r.u64();
-    s.anchor = a == ~std::uint64_t{0} ? kNone : static_cast<size_t>(a);
-    if (s.anchor != kNone && s.anchor >= anchors_.size()) r.fail("odometry sample after anchor " + std::to_string(a));
+  odometry_.clear();
+  for (size_t i = 0, count = r.count(8 + 24 + 8); i < count; ++i) {
+    const OdometrySample s = OdometryCodec::read(r);
+    if (s.anchor != kNone && s.anchor >= anchors_.size()) r.fail("odometry sample after anchor " + std::to_string(s.anchor));
+    odometry_.push_back(s);
   }
 }
 
@@ -548,7 +585,7 @@ void GlobalSlam::writeState(BinaryWriter& w) const {
   w.size(pending_.size());
   for (const auto& c : pending_) writeRecord(w, c);
   w.size(closures_.size());
-  for (const auto& c : closures_) writeRecord(w, c);
+  closures_.forEach([&](const LoopClosureRecord& c) { writeRecord(w, c); });
   w.boolean(dirty_since_recovery_);
   w.size(last_full_size_);
 }
@@ -606,10 +643,7 @@ void Pipeline::writeStateNow(BinaryWriter& w) const {
   writeStats(w, stats_);
   w.boolean(have_first_ts_);
   w.size(reference_.size());
-  for (const auto& p : reference_) {
-    w.f64(p.timestamp);
-    writePose(w, p.pose);
-  }
+  reference_.forEach([&](const io::StampedPose& p) { StampedPoseCodec::write(w, p); });
   w.endSection();
 
   w.beginSection(kMapTag);
@@ -645,11 +679,8 @@ void Pipeline::readState(BinaryReader& r, std::uint32_t format_version, bool con
     BinaryReader s = r.section(kStatsTag);
     readStats(s, stats_, format_version);
     have_first_ts_ = s.boolean();
-    reference_.resize(s.count(32));
-    for (auto& p : reference_) {
-      p.timestamp = s.f64();
-      p.pose = readPose(s);
-    }
+    reference_.clear();
+    for (size_t i = 0, count = s.count(32); i < count; ++i) reference_.push_back(StampedPoseCodec::read(s));
     s.expectEnd();
   }
   {

@@ -56,8 +56,9 @@ bool isRunFolder(const std::string& dir) {
 void writePoseGraphG2o(const Pipeline& p, const std::string& path) {
   esdf::PoseGraph g;
   for (const auto& k : p.keyframes()) g.vertices.push_back({static_cast<long>(k.index), esdf::toVec(k.pose)});
-  for (const auto& e : p.graphEdges())
+  p.map().edges().forEach([&](const GraphEdge& e) {
     g.edges.push_back({static_cast<long>(e.from), static_cast<long>(e.to), esdf::toVec(e.measurement), e.information});
+  });
   esdf::writePoseGraph(g, path, esdf::PoseGraphFormat::G2o);
 }
 
@@ -88,8 +89,8 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   files.push("trajectory_odometry.tum");
   io::writeTum(path("trajectory_scans.tum"), p.scanTrajectory());
   files.push("trajectory_scans.tum");
-  if (!p.referenceTrajectory().empty()) {
-    io::writeTum(path("reference.tum"), p.referenceTrajectory());
+  if (const auto reference = p.referenceTrajectory(); !reference.empty()) {
+    io::writeTum(path("reference.tum"), reference);
     files.push("reference.tum");
   }
 
@@ -104,13 +105,13 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
     f.stream() << "from_keyframe,to_keyframe,from_time,to_time,detector,score,accepted,reason,x,y,phi,rms_m,mahalanobis2,gate_threshold,"
                   "free_space_conflict,prior_sigma_m,bearing_only,confirmed_by\n";
     char buf[512];
-    for (const auto& c : p.loopClosures()) {
+    p.loopClosureLog().forEach([&](const LoopClosureRecord& c) {
       std::snprintf(buf, sizeof buf, "%zu,%zu,%.6f,%.6f,%s,%.6g,%d,%s,%.6f,%.6f,%.6f,%.6g,%.6g,%.6g,%.4f,%.4g,%d,%s\n", c.from, c.to,
                     c.from_time, c.to_time, proposerName(c.detector), c.score, c.accepted ? 1 : 0, reasonName(c.reason), c.measurement.x,
                     c.measurement.y, c.measurement.phi, c.rms_m, c.mahalanobis2, c.gate_threshold, c.free_space_conflict, c.prior_sigma_m,
                     c.bearing_only ? 1 : 0, confirmationName(c.confirmed_by));
       f.stream() << buf;
-    }
+    });
     f.commit();
     files.push("loop_closures.csv");
   }
@@ -196,8 +197,9 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   c["loop_closures_tried"] = s.closures_tried;
   c["loop_closures_accepted"] = s.closures_accepted;
   c["loop_closures_rejected"] = s.closures_rejected;
-  c["loop_closures_camera_confirmed"] = std::count_if(p.loopClosures().begin(), p.loopClosures().end(),
-                                                      [](const LoopClosureRecord& r) { return r.confirmed_by == Confirmation::Camera; });
+  size_t camera_confirmed = 0;
+  p.loopClosureLog().forEach([&](const LoopClosureRecord& r) { camera_confirmed += r.confirmed_by == Confirmation::Camera; });
+  c["loop_closures_camera_confirmed"] = camera_confirmed;
   // Factorisations of the whole map (full recoveries, exact covariances): the work that grows with
   // it. This run's only: a resumed map's earlier sessions are not counted.
   c["map_factorisations"] = p.map().filter() ? p.map().filter()->factorisations() : 0;

@@ -80,7 +80,9 @@ class GlobalSlam {
   // End of input: hypotheses still awaiting confirmation are dropped, the last poses recovered.
   void finish();
 
-  const PerKeyframe<LoopClosureRecord>& closures() const { return closures_; }
+  const LoopClosureLog& closureLog() const { return closures_; }
+  // Every record read back whole (small runs and tests).
+  std::vector<LoopClosureRecord> closures() const { return closures_.toVector(); }
 
   // Closure records, hypotheses awaiting confirmation, the loop closer's cache and whether a
   // full recovery is owed. Read after the map: the laser detector's keyframe features are
@@ -120,7 +122,7 @@ class GlobalSlam {
   std::unique_ptr<laser_loop::LoopDetector> laser_detector_;  // [loop_closure] detector = laser, once read
   std::deque<LoopClosureRecord> pending_;                     // passed alignment + gate, awaiting confirmation
   CameraPairMeasurer camera_measurer_;
-  PerKeyframe<LoopClosureRecord> closures_;  // every hypothesis and its fate
+  LoopClosureLog closures_;  // every hypothesis and its fate
   bool dirty_since_recovery_ = false;
   size_t last_full_size_ = 0;  // keyframes at the last full recovery
   // The first closure since the last full recovery: its keyframe and when local SLAM handed

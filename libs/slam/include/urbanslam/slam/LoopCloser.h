@@ -17,6 +17,7 @@
 #include "urbanslam/common/BinaryStream.h"
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/io/LaserScan.h"
+#include "urbanslam/io/SpillLog.h"
 #include "urbanslam/slam/CameraClosure.h"
 #include "urbanslam/slam/KeyframeGrid.h"
 #include "urbanslam/slam/PipelineOptions.h"
@@ -76,6 +77,16 @@ struct LoopClosureRecord {
   bool bearing_only = false;
   Confirmation confirmed_by = Confirmation::None;
 };
+
+// A record as the map file holds it (the current format), for the records' spill file.
+// PipelineState.cpp.
+struct LoopClosureRecordCodec {
+  static void write(common::BinaryWriter& w, const LoopClosureRecord& c);
+  static LoopClosureRecord read(common::BinaryReader& r);
+};
+// Every hypothesis of a run, oldest first: millions in a city, so all but the newest wait in a
+// spill file (io::SpillLog).
+using LoopClosureLog = io::SpillLog<LoopClosureRecord, LoopClosureRecordCodec>;
 
 // Appearance similarity of a pair of keyframes (the laser classifier's margin above its
 // decision factor: >= 0 is a detection).

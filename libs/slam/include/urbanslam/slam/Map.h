@@ -7,6 +7,8 @@
 //
 // The keyframes' own scans live in a scan store (io::ScanStore): compact, in memory up to a
 // bound and in a spill file beyond it, so a city of a million keyframes does not hold them all.
+// The pose graph's edges and the odometry readings, read only for the outputs, wait in spill
+// files too.
 #include <Eigen/Core>
 #include <deque>
 #include <memory>
@@ -16,6 +18,7 @@
 #include "urbanslam/io/CompactScan.h"
 #include "urbanslam/io/MapOutputs.h"
 #include "urbanslam/io/ScanStore.h"
+#include "urbanslam/io/SpillLog.h"
 #include "urbanslam/slam/KeyframeGrid.h"
 #include "urbanslam/vision_loop/BagOfWords.h"
 
@@ -50,6 +53,14 @@ struct GraphEdge {
   Eigen::Matrix3d information = Eigen::Matrix3d::Identity();
   bool loop_closure = false;
 };
+// As the map file holds it, for the edges' spill file. PipelineState.cpp.
+struct GraphEdgeCodec {
+  static void write(common::BinaryWriter& w, const GraphEdge& e);
+  static GraphEdge read(common::BinaryReader& r);
+};
+// One or two per keyframe, read only for the outputs and a merge: all but the newest wait in a
+// spill file.
+using GraphEdgeLog = io::SpillLog<GraphEdge, GraphEdgeCodec>;
 
 // A scan whose pose is known relative to a keyframe: every keyframe (offset identity) and the
 // scans between keyframes that matched the local submap. The trajectory between keyframes is
@@ -84,7 +95,7 @@ class Map {
   void scanInto(size_t k, io::LaserScan& out) const { scans_.expandInto(k, out); }
   const io::ScanStore& scans() const { return scans_; }
 
-  const PerKeyframe<GraphEdge>& edges() const { return edges_; }
+  const GraphEdgeLog& edges() const { return edges_; }
   void addEdge(const GraphEdge& e) { edges_.push_back(e); }
 
   // Spatial index over the keyframes' current positions.
@@ -124,14 +135,20 @@ class Map {
     common::Pose2 odom;  // odometry pose at the reading
     size_t anchor;       // last anchor before it (npos: none yet)
   };
+  struct OdometryCodec {
+    static void write(common::BinaryWriter& w, const OdometrySample& s);
+    static OdometrySample read(common::BinaryReader& r);
+  };
 
   PerKeyframe<Keyframe> keyframes_;
   io::ScanStore scans_;  // keyframe k's scan has id k
-  PerKeyframe<GraphEdge> edges_;
+  GraphEdgeLog edges_;
   KeyframeGrid index_;
   std::unique_ptr<esdf::Esdf> filter_;
   PerKeyframe<ScanAnchor> anchors_;
-  PerKeyframe<OdometrySample> odometry_;
+  // Several per keyframe, read only when the trajectory is written: all but the newest wait in a
+  // spill file.
+  io::SpillLog<OdometrySample, OdometryCodec> odometry_;
 };
 
 }  // namespace urbanslam::slam

@@ -18,6 +18,7 @@
 #include "urbanslam/common/SerialWorker.h"
 #include "urbanslam/io/DataSource.h"
 #include "urbanslam/io/MapOutputs.h"
+#include "urbanslam/io/SpillLog.h"
 #include "urbanslam/slam/GlobalSlam.h"
 #include "urbanslam/slam/InputFilter.h"
 #include "urbanslam/slam/KeyframeImages.h"
@@ -92,9 +93,14 @@ class Pipeline {
   // odometry times has only the odometry.
   std::vector<io::StampedPose> scanTrajectory() const { return map_.scanTrajectory(); }
   // The log's reference trajectory, when it has one (e.g. a corrected CARMEN log).
-  const std::vector<io::StampedPose>& referenceTrajectory() const { return reference_; }
-  const PerKeyframe<LoopClosureRecord>& loopClosures() const { return global_.closures(); }
-  const PerKeyframe<GraphEdge>& graphEdges() const { return map_.edges(); }
+  // The log's reference poses (ground truth, the simulator's truth), read back whole.
+  std::vector<io::StampedPose> referenceTrajectory() const { return reference_.toVector(); }
+  // Every hypothesis and its fate, oldest first; loopClosures() reads them back whole (small
+  // runs and tests).
+  const LoopClosureLog& loopClosureLog() const { return global_.closureLog(); }
+  std::vector<LoopClosureRecord> loopClosures() const { return global_.closures(); }
+  // The pose graph's edges read back whole (small runs and tests); map().edges() streams them.
+  std::vector<GraphEdge> graphEdges() const { return map_.edges().toVector(); }
   const PipelineStats& stats() const { return stats_; }
   const PipelineOptions& options() const { return options_; }
   std::string estimatorName() const { return slam::estimatorName(options_.estimator.type); }
@@ -152,7 +158,12 @@ class Pipeline {
   PipelineOptions options_;
   std::vector<PipelineObserver*> observers_;
   InputFilter input_;
-  std::vector<io::StampedPose> reference_;
+  struct StampedPoseCodec {
+    static void write(common::BinaryWriter& w, const io::StampedPose& p);
+    static io::StampedPose read(common::BinaryReader& r);
+  };
+  // One per reference reading, read only for the outputs: all but the newest in a spill file.
+  io::SpillLog<io::StampedPose, StampedPoseCodec> reference_;
   PipelineStats stats_;
   Map map_;
   LocalSlam local_;
