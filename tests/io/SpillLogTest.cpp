@@ -58,7 +58,7 @@ void expectEqual(const std::vector<Reading>& a, const std::vector<Reading>& b) {
 // appended, in order, across the chunks written to the file and those still in memory.
 TEST(SpillLog, GivesBackEveryEntryInOrderAcrossTheFileAndMemory) {
   const auto readings = randomReadings(1000);
-  Log log("readings", 16);
+  Log log("readings", {}, 16);
   for (size_t i = 0; i < readings.size(); ++i) {
     log.push_back(readings[i]);
     ASSERT_EQ(log.size(), i + 1);
@@ -73,7 +73,7 @@ TEST(SpillLog, GivesBackEveryEntryInOrderAcrossTheFileAndMemory) {
 
 // What stays in memory is bounded by the chunk, whatever was appended: the rest is in the file.
 TEST(SpillLog, HoldsAtMostTwoChunksInMemory) {
-  Log log("readings", 8);
+  Log log("readings", {}, 8);
   for (const Reading& r : randomReadings(203)) log.push_back(r);
   size_t in_memory = 0;
   log.amendNewest([&](Reading&) { return ++in_memory, true; });
@@ -85,7 +85,7 @@ TEST(SpillLog, HoldsAtMostTwoChunksInMemory) {
 // The newest entries can be amended until they reach the file, and only as far as asked.
 TEST(SpillLog, AmendsTheNewestEntriesWhileAsked) {
   auto readings = randomReadings(100);
-  Log log("readings", 10);
+  Log log("readings", {}, 10);
   for (const Reading& r : readings) log.push_back(r);
   int calls = 0;
   log.amendNewest([&](Reading& r) {
@@ -99,7 +99,7 @@ TEST(SpillLog, AmendsTheNewestEntriesWhileAsked) {
 }
 
 TEST(SpillLog, ClearedStartsAgainEmpty) {
-  Log log("readings", 4);
+  Log log("readings", {}, 4);
   for (const Reading& r : randomReadings(50)) log.push_back(r);
   log.clear();
   EXPECT_TRUE(log.empty());
@@ -110,7 +110,7 @@ TEST(SpillLog, ClearedStartsAgainEmpty) {
 }
 
 TEST(SpillLog, ASpillFolderThatCannotBeWrittenIsNamed) {
-  Log log("odometry readings", 4, "/nonexistent/spill");
+  Log log("odometry readings", "/nonexistent/spill", 4);
   try {
     for (const Reading& r : randomReadings(20)) log.push_back(r);
     FAIL() << "no error";

@@ -50,6 +50,7 @@ std::uint64_t ScratchFile::append(const std::string& bytes) {
 
 std::string ScratchFile::read(std::uint64_t offset, size_t length) const {
   std::string bytes(length, '\0');
+  if (fd_ < 0 && length > 0) errno = EBADF;  // nothing was ever appended: the error says so
   size_t done = 0;
   while (done < length) {
     const ssize_t n = fd_ < 0 ? -1 : ::pread(fd_, bytes.data() + done, length - done, static_cast<off_t>(offset + done));

@@ -21,7 +21,7 @@ GlobalSlam::GlobalSlam(const PipelineOptions& options, Map& map, PipelineStats& 
       stats_(stats),
       observers_(observers),
       closer_(options.loop_closure),
-      closures_("loop closure records", 4096, options.map.scan_spill_dir) {
+      closures_("loop closure records", options.map.scan_spill_dir) {
   if (options_.loop_closure.enabled && options_.loop_closure.detector == LoopClosureOptions::Detector::Laser) {
     // The AdaBoost classifier adds candidates where the estimate is too uncertain to pick them. Its
     // score is the margin above the model's decision factor (eq. 3.30), so laser_threshold = 0

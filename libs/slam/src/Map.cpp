@@ -16,10 +16,10 @@ constexpr size_t kNone = std::numeric_limits<size_t>::max();
 
 Map::Map(std::unique_ptr<esdf::Esdf> filter, double index_cell_m, size_t scan_cache_bytes, std::string spill_dir)
     : scans_(scan_cache_bytes, spill_dir),
-      edges_("pose graph edges", 4096, spill_dir),
+      edges_("pose graph edges", spill_dir),
       index_(index_cell_m),
       filter_(std::move(filter)),
-      odometry_("odometry readings", 4096, spill_dir) {}
+      odometry_("odometry readings", spill_dir) {}
 
 Map::~Map() = default;
 

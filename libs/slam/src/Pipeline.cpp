@@ -39,7 +39,7 @@ std::unique_ptr<esdf::Esdf> makeFilter(const PipelineOptions& options) {
 Pipeline::Pipeline(PipelineOptions options)
     : options_(std::move(options)),
       input_(options_.input),
-      reference_("reference poses", 4096, options_.map.scan_spill_dir),
+      reference_("reference poses", options_.map.scan_spill_dir),
       map_(makeFilter(options_), std::max(1.0, options_.loop_closure.search_radius_m),
            static_cast<size_t>(options_.map.scan_cache_mb * 1024 * 1024), options_.map.scan_spill_dir),
       local_(options_),

@@ -23,9 +23,13 @@ namespace urbanslam::io {
 template <class T, class Codec>
 class SpillLog {
  public:
+  // Entries written to the file at a time: a few hundred kilobytes of records, and as many
+  // always in memory for amendNewest.
+  static constexpr size_t kDefaultChunk = 4096;
+
   // `owner` names the scratch file in error messages; `dir` empty: the system's temporary
   // folder.
-  explicit SpillLog(std::string owner, size_t chunk = 4096, std::string dir = {})
+  explicit SpillLog(std::string owner, std::string dir = {}, size_t chunk = kDefaultChunk)
       : chunk_(chunk == 0 ? 1 : chunk), file_(std::move(owner), std::move(dir)) {}
 
   size_t size() const { return spilled_ + recent_.size(); }
