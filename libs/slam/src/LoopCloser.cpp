@@ -246,9 +246,8 @@ alignment::AlignmentResult LoopCloser::verifyAlignment(const io::LaserScan& earl
   const alignment::IndexedReference earlier_points(std::move(earlier_set));
   // Below min_matched_fraction an alignment is refused: its ICP runs (from CRF-match's
   // hypotheses and the guess) that cannot reach it are given up early. The ambiguity test's
-  // restarts below run in full: they look for another minimum matching more points than the one
-  // accepted, a safeguard against aliasing left whole (giving them up too changed no closure on
-  // Intel or FR079, and would save little: they follow accepted alignments only).
+  // restarts below are given up the same way below the count that would make them another
+  // minimum (`findsOtherMinimum`).
   alignment::AlignerOptions first = ao;
   first.icp.abandon_below_fraction = options_.min_matched_fraction;
   const alignment::AlignmentResult a = alignment::alignPointSets(earlier_points, current_points, guess, first);
