@@ -70,8 +70,8 @@ TEST(ShiftedRestarts, FindTheStreetsOtherPeriodAndNoneInARoom) {
     pl.method = ua::Method::PlIcp;
     const ua::AlignmentResult result = ua::alignPointSets(a, b, uc::between(c.from, c.to), pl);
     ASSERT_TRUE(result.converged) << result.failure_reason;
-    // The scans' own ambiguity test (clearly more points elsewhere) and the path submaps' (nearly
-    // as many), as far as 6 m.
+    // The scans' own ambiguity test (clearly more points elsewhere) and looser ones like the path
+    // submaps' (nearly as many), as far as 6 m.
     for (const double ratio : {1.05, 0.9, 0.8}) {
       ua::ShiftedRestarts r;
       r.first_shift_m = 0.75;

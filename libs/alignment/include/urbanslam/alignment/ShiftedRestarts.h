@@ -22,6 +22,9 @@ struct ShiftedRestarts {
 };
 
 // Whether a restart of `result` (b aligned onto a, `options` but by PL-ICP) finds another minimum.
+// A restart that cannot reach min_match_ratio times the result's matches is given up once settled
+// near the final gate (IcpOptions::abandon_below_fraction), a rule, not a proof: on the tested
+// scans and the 1, 10 and 100 km² cities it gave the answer of restarts run in full.
 bool findsOtherMinimum(const IndexedReference& a, const PointSet& b, const AlignmentResult& result, AlignerOptions options,
                        const ShiftedRestarts& restarts);
 
