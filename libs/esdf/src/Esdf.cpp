@@ -277,10 +277,11 @@ void Esdf::ensureFactor() {
   anchor_paths_from_ = -1;
 }
 
-RecoveryStats Esdf::recover(int max_passes) {
+RecoveryStats Esdf::recover(int max_passes, double cost_tolerance) {
   common::Stopwatch sw;
   RecoveryStats st;
   if (max_passes < 0) max_passes = options_.relinearise_max_passes;
+  if (cost_tolerance < 0) cost_tolerance = options_.relinearise_cost_tolerance;
   const int n = size();
   Eigen::VectorXd old(3 * n);
   double c_known = -1;  // cost at the current mean, once known (relinearising leaves the mean)
@@ -307,7 +308,7 @@ RecoveryStats Esdf::recover(int max_passes) {
     if (c_new > c_old * (1 + 1e-12))
       for (int p = 0; p < n; ++p) state_.setMean(p, old.segment<3>(3 * p));
     c_known = c_new > c_old * (1 + 1e-12) ? c_old : c_new;
-    if (pass > 0 && c_old - c_known <= options_.relinearise_cost_tolerance * c_old) {
+    if (pass > 0 && c_old - c_known <= cost_tolerance * c_old) {
       st.converged = true;  // a relinearised step that no longer pays
       break;
     }

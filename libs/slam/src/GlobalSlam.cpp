@@ -95,18 +95,19 @@ void GlobalSlam::finish() {
     reportClosure(r);
   }
   pending_.clear();
-  if (dirty_since_recovery_) recoverAll();
+  if (dirty_since_recovery_) recoverAll(true);
 }
 
 void GlobalSlam::closureAdded(size_t current, SteadyTime handed_over) {
   if (!unrecovered_closure_) unrecovered_closure_ = std::make_pair(current, handed_over);
-  // A full recovery costs O(n): after a closure only once the map has grown by a fraction of
-  // what it was at the last one, which bounds its amortised cost per keyframe by a constant
-  // however large the map. Between them the closure's information is in the filter, and the
-  // recent poses (where the next candidates and closures are) are recovered.
+  // A full recovery costs O(n) and more (a factorisation of the whole map): after a closure
+  // only once the map has grown by a fraction of what it was at the last one, which spreads its
+  // cost over that many keyframes, so that the cost per keyframe grows only as a factorisation's
+  // cost per pose does. Between them the closure's information is in the filter, and the recent
+  // poses (where the next candidates and closures are) are recovered.
   const double growth = options_.estimator.full_recovery_min_growth;
   if (static_cast<double>(map_.size() - last_full_size_) >= growth * static_cast<double>(last_full_size_)) {
-    recoverAll();
+    recoverAll(false);
     return;
   }
   const size_t window = static_cast<size_t>(options_.estimator.recent_window);
@@ -266,16 +267,23 @@ void GlobalSlam::addPlaceFix(size_t earlier, size_t current, const common::Pose2
   if (r.accepted) closureAdded(current, std::chrono::steady_clock::now());
 }
 
-void GlobalSlam::recoverAll() {
+void GlobalSlam::recoverAll(bool converge) {
   common::Stopwatch sw;
-  map_.filter()->recover();
+  // Each Gauss-Newton step is a factorisation of the whole map, superlinear in its size. The last
+  // steps of a recovery that goes on until nothing moves past a millimetre gain next to nothing;
+  // what they would have moved, the next recovery moves.
+  if (converge)
+    map_.filter()->recover();
+  else
+    map_.filter()->recover(-1, options_.estimator.full_recovery_cost_tolerance);
   last_full_size_ = map_.size();
   map_.pullPoses(0);
   map_.reindex();
   std::vector<common::Pose2> poses;
   poses.reserve(map_.size());
   for (const auto& k : map_.keyframes()) poses.push_back(k.pose);
-  dirty_since_recovery_ = false;
+  // What a recovery stopped short of, the run's last recovery still owes.
+  dirty_since_recovery_ = !converge;
   PosesUpdatedEvent e{&poses};
   e.recovery_ms = sw.milliseconds();
   e.map_factorisations = map_.filter()->factorisations();

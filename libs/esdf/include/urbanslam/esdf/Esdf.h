@@ -124,7 +124,8 @@ class Esdf {
   // max_relinearise_passes rounds of relinearise + re-solve (-1: options().relinearise_max_passes).
   // With relinearisation each solve is a Gauss-Newton step from the current mean, shortened
   // (halved) while it would increase cost().
-  RecoveryStats recover(int max_relinearise_passes = -1);
+  // `cost_tolerance` >= 0 replaces options().relinearise_cost_tolerance for this recovery.
+  RecoveryStats recover(int max_relinearise_passes = -1, double cost_tolerance = -1);
   // Relinearises the factors whose poses moved past the thresholds since their linearisation
   // (Lambda and eta updated exactly); returns how many. The mean is left as it is.
   long long relinearise();

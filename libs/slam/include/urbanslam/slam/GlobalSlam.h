@@ -109,8 +109,10 @@ class GlobalSlam {
   // After an accepted closure of keyframe `current`: a full recovery when the map has grown
   // enough since the last one ([estimator] full_recovery_min_growth), else the recent poses.
   void closureAdded(size_t current, SteadyTime handed_over);
-  // Full recovery; the latency of the oldest closure it brings into the whole map is recorded.
-  void recoverAll();
+  // Full recovery, to [estimator] full_recovery_cost_tolerance or (`converge`, the run's last)
+  // until nothing moves; the latency of the oldest closure it brings into the whole map is
+  // recorded.
+  void recoverAll(bool converge = false);
   // The laser classifier with the features of every keyframe so far.
   laser_loop::LoopDetector& laserDetector();
 

@@ -159,8 +159,12 @@ struct EstimatorOptions {
   // reads global SLAM's estimates, so the results are the same either way.
   bool global_thread = true;
   // A full recovery after a loop closure only once the map has grown by this fraction since the
-  // last one (0: after every closure): amortised constant time per keyframe at any map size.
+  // last one (0: after every closure): its cost spread over that many keyframes.
   double full_recovery_min_growth = 0.01;
+  // Such a recovery stops relinearising once a Gauss-Newton step lowers the cost by less than
+  // this fraction of it (each step is a factorisation of the whole map); the next recovery goes
+  // on from there. The run's last recovery goes on until nothing moves past 1 mm and 1e-4 rad.
+  double full_recovery_cost_tolerance = 1e-6;
 };
 
 struct MapOptions {
