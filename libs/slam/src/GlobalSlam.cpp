@@ -283,7 +283,7 @@ void GlobalSlam::recoverAll(bool converge) {
   poses.reserve(map_.size());
   for (const auto& k : map_.keyframes()) poses.push_back(k.pose);
   // What a recovery stopped short of, the run's last recovery still owes.
-  dirty_since_recovery_ = !converge;
+  dirty_since_recovery_ = !converge && options_.estimator.full_recovery_cost_tolerance > 0;
   PosesUpdatedEvent e{&poses};
   e.recovery_ms = sw.milliseconds();
   e.map_factorisations = map_.filter()->factorisations();

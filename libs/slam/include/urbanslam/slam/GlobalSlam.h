@@ -112,7 +112,7 @@ class GlobalSlam {
   // Full recovery, to [estimator] full_recovery_cost_tolerance or (`converge`, the run's last)
   // until nothing moves; the latency of the oldest closure it brings into the whole map is
   // recorded.
-  void recoverAll(bool converge = false);
+  void recoverAll(bool converge);
   // The laser classifier with the features of every keyframe so far.
   laser_loop::LoopDetector& laserDetector();
 
