@@ -93,8 +93,10 @@ void Esdf::apply(const Factor& f, double sign) {
 }
 
 void Esdf::addFactor(Factor f) {
+  const bool explained = explained_stamp_ == values_stamp_;
   apply(f, +1.0);
   factors_.push_back(std::move(f));
+  if (explained) explained_stamp_ = values_stamp_;  // still the factor plus what came after it
 }
 
 int Esdf::initialise(const Vec3& mean, const Mat3& covariance) {
@@ -266,6 +268,11 @@ void Esdf::ensureFactor() {
   full_factor_.factorize(state_, 0, size());
   ++factorisations_;
   full_factor_values_ = values_stamp_;
+  factors_at_factor_ = factors_.size();
+  explained_stamp_ = values_stamp_;
+  involved_.clear();
+  involved_at_.clear();
+  involved_cov_.resize(0, 0);
   // A new reference for conservative covariances: chain restarts after the factored poses.
   chain_base_ = size();
   chain_phi_.clear();
@@ -425,6 +432,7 @@ Mat3 Esdf::relativeCovariance(int i, int j, CovarianceMode mode) {
 Mat6 Esdf::jointCovariance(int i, int j, CovarianceMode mode) {
   if (i < 0 || j < 0 || i >= size() || j >= size()) throw std::out_of_range("jointCovariance: bad pose");
   if (mode == CovarianceMode::Conservative && conservativeReady()) return conservativeJoint(i, j, nullptr);
+  if (Mat6 s; !factorCurrent() && updatedJoint(i, j, &s)) return s;
   ensureFactor();
   const int n = size();
   Eigen::MatrixXd e = Eigen::MatrixXd::Zero(3 * n, 6);
@@ -524,7 +532,7 @@ const Esdf::ChainAnchor& Esdf::chainAnchor() {
 size_t Esdf::memoryBytes() const {
   // (The factors grow by fixed blocks: their size is their memory, to a block.)
   return state_.memoryBytes() + factors_.size() * sizeof(Factor) + first_factor_of_pose_.capacity() * sizeof(int) +
-         (chain_phi_.capacity() + chain_cov_.capacity()) * sizeof(Mat3);
+         (chain_phi_.capacity() + chain_cov_.capacity()) * sizeof(Mat3) + static_cast<size_t>(involved_cov_.size()) * sizeof(double);
 }
 
 }  // namespace urbanslam::esdf

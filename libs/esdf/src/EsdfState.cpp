@@ -111,9 +111,11 @@ void Esdf::writeState(common::BinaryWriter& w) const {
   for (const Mat3& c : chain_cov_) w.matrix(c);
   w.boolean(chain_valid_);
   w.dense(base_columns_);
+  w.size(factors_at_factor_);
+  w.boolean(explained_stamp_ == values_stamp_);
 }
 
-void Esdf::readState(common::BinaryReader& r) {
+void Esdf::readState(common::BinaryReader& r, bool with_updates) {
   if (size() != 0) throw std::logic_error("Esdf::readState into a filter that has poses");
   state_.read(r);
   const int n = state_.size();
@@ -183,6 +185,12 @@ void Esdf::readState(common::BinaryReader& r) {
   factors_indexed_ = 0;
   if (base_columns_.size() != 0 && (!full_factor_.valid() || base_columns_.rows() != 3 * full_factor_.last() || base_columns_.cols() != 3))
     r.fail("filter covariance columns");
+  explained_stamp_ = ~std::uint64_t{0};
+  if (with_updates) {
+    factors_at_factor_ = r.size();
+    if (factors_at_factor_ > factors_.size()) r.fail("filter factors since the factorisation");
+    if (r.boolean()) explained_stamp_ = values_stamp_;
+  }
 }
 
 }  // namespace urbanslam::esdf

@@ -694,7 +694,7 @@ void Pipeline::readState(BinaryReader& r, std::uint32_t format_version, bool con
     if (has_filter != (map_.filter() != nullptr))
       s.fail(has_filter ? "it holds a filter, but [estimator] type is dead_reckoning" : "it holds no filter, but [estimator] type is esdf");
     if (map_.filter()) {
-      map_.filter()->readState(s);
+      map_.filter()->readState(s, format_version >= 9);
       if (static_cast<size_t>(map_.filter()->size()) != map_.size())
         s.fail("a filter of " + std::to_string(map_.filter()->size()) + " poses for " + std::to_string(map_.size()) + " keyframes");
     }

@@ -37,7 +37,8 @@ namespace urbanslam::esdf {
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 
 enum class CovarianceMode {
-  Exact,        // refactorise the current Lambda if needed, then column solves
+  Exact,        // the current Lambda's: from the last factor and the few factors added since
+                // (ExactUpdates.cpp), else refactorised; then column solves
   Conservative  // last factorisation + dead-reckoning propagation: no refactorisation, never smaller
 };
 
@@ -177,8 +178,9 @@ class Esdf {
   // (predictAugment) cannot be written (std::logic_error): a model is code, not data.
   void writeState(common::BinaryWriter& w) const;
   // Into a filter with no poses yet. Throws common::InputError (naming the reader's file) for
-  // inconsistent contents.
-  void readState(common::BinaryReader& r);
+  // inconsistent contents. `with_updates`: the state records which factors came after the last
+  // factorisation (written since map format 9; older states refactorise at the next exact query).
+  void readState(common::BinaryReader& r, bool with_updates = true);
 
  private:
   struct Factor {
@@ -262,6 +264,16 @@ class Esdf {
   static void factorStep(const Factor& f, bool from_a, Mat3* d_x, Mat3* d_e);
   void indexFactors();
   void markChanged() { ++values_stamp_; }
+  // The exact joint covariance of poses i and j without refactorising (ExactUpdates.cpp): the
+  // last factor, the dead-reckoning chain after it, and the factors added since as a low-rank
+  // update (Woodbury). False when Lambda changed otherwise since the factorisation, or the
+  // update needs more column solves than a refactorisation is worth.
+  bool updatedJoint(int i, int j, Mat6* joint);
+  // Sigma(p, q) of the factorised Lambda with the chain after it (p, q factored or chain poses).
+  Mat3 chainedCovariance(int p, int q);
+  // Makes the blocks of Sigma among `poses` (factored) available: one multi-column solve for
+  // those not solved for yet.
+  void solveInvolved(const std::vector<int>& poses);
 
   EsdfOptions options_;
   InformationState state_;
@@ -276,6 +288,13 @@ class Esdf {
   std::uint64_t values_stamp_ = 0;                     // bumped on every change of Lambda or eta
   std::uint64_t full_factor_values_ = ~std::uint64_t{0};
   long long factorisations_ = 0;
+  // Lambda = the factorised one + the chain's links + factors_[factors_at_factor_, end) while
+  // values_stamp_ == explained_stamp_ (every change but addFactor leaves it behind).
+  size_t factors_at_factor_ = 0;
+  std::uint64_t explained_stamp_ = ~std::uint64_t{0};
+  std::vector<int> involved_;               // factored poses whose Sigma blocks are known ...
+  std::unordered_map<int, int> involved_at_;  // ... their place in involved_
+  Eigen::MatrixXd involved_cov_;            // ... the blocks among them (3|involved| square)
 
   // Conservative covariance support: for poses k >= chain_base_, x_k = Phi_k x_{base-1} + noise
   // with accumulated noise C_k, valid while every such pose came from its predecessor.

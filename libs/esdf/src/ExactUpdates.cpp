@@ -1,0 +1,132 @@
+// Exact covariances between factorisations. The innovation gate needs the exact covariance of a
+// closure's two poses whenever its conservative bound admits it; driving along an earlier visit,
+// the closures come one per keyframe, and refactorising the whole map for each (then its sparse
+// inverse for the next candidates) made the gate's cost per keyframe grow with the map. Since
+// the last factorisation Lambda changed only by the chain's links (each pose added from its
+// predecessor: exact dead reckoning, as the conservative covariance has it) and a few closures,
+// each a rank-3 term H' W H. Woodbury then gives the current covariance from the old one:
+//   (Lambda_c + H' W H)^-1 = Sigma_c - Sigma_c H' (I + W H Sigma_c H')^-1 W H Sigma_c,
+// which needs Sigma_c only among the poses of the closures and of the asked pair: column solves
+// of the old factor for the factored ones (kept until the next factorisation), the chain's
+// propagation for the newer ones.
+#include <Eigen/LU>
+#include <algorithm>
+
+#include "urbanslam/esdf/Esdf.h"
+
+namespace urbanslam::esdf {
+
+namespace {
+// A solve of 3k columns passes over the factor twice with k times the work per entry; beyond a
+// few poses a refactorisation (which the queries after it reuse) costs less.
+constexpr size_t kMaxNewSolvedPoses = 4;
+// The update's dense system is 3K square: closures since the factorisation beyond this, and the
+// factorisation is due anyway.
+constexpr size_t kMaxUpdateFactors = 64;
+}  // namespace
+
+Mat3 Esdf::chainedCovariance(int p, int q) {
+  if (p > q) return chainedCovariance(q, p).transpose();
+  const int m = chain_base_;
+  if (q < m) return involved_cov_.block<3, 3>(3 * involved_at_.at(p), 3 * involved_at_.at(q));
+  // x_q = Phi_q x_{m-1} + n_q, with n_q independent of the factored poses.
+  const Mat3& phi_q = chain_phi_[static_cast<size_t>(q - m)];
+  if (p < m) return base_columns_.block<3, 3>(3 * p, 0) * phi_q.transpose();
+  const Mat3& phi_p = chain_phi_[static_cast<size_t>(p - m)];
+  const Mat3 spp = phi_p * base_columns_.block<3, 3>(3 * (m - 1), 0) * phi_p.transpose() + chain_cov_[static_cast<size_t>(p - m)];
+  if (p == q) return spp;
+  // x_q = Phi_q Phi_p^-1 x_p + noise of the links after p.
+  return spp * (phi_q * phi_p.inverse()).transpose();
+}
+
+void Esdf::solveInvolved(const std::vector<int>& poses) {
+  if (poses.empty()) return;
+  const int m = full_factor_.last();
+  const int u = static_cast<int>(poses.size());
+  Eigen::MatrixXd e = Eigen::MatrixXd::Zero(3 * m, 3 * u);
+  for (int c = 0; c < u; ++c) e.block<3, 3>(3 * poses[static_cast<size_t>(c)], 3 * c).setIdentity();
+  const Eigen::MatrixXd x = full_factor_.solve(e);
+  const int k = static_cast<int>(involved_.size());
+  for (int p : poses) {
+    involved_at_[p] = static_cast<int>(involved_.size());
+    involved_.push_back(p);
+  }
+  Eigen::MatrixXd grown(3 * (k + u), 3 * (k + u));
+  grown.topLeftCorner(3 * k, 3 * k) = involved_cov_;
+  for (int c = 0; c < u; ++c)
+    for (int b = 0; b < k + u; ++b) {
+      const Mat3 s = x.block<3, 3>(3 * involved_[static_cast<size_t>(b)], 3 * c);  // Sigma(b, new c)
+      grown.block<3, 3>(3 * b, 3 * (k + c)) = s;
+      grown.block<3, 3>(3 * (k + c), 3 * b) = s.transpose();
+    }
+  involved_cov_ = std::move(grown);
+}
+
+bool Esdf::updatedJoint(int i, int j, Mat6* joint) {
+  if (!full_factor_.valid() || explained_stamp_ != values_stamp_ || !conservativeReady()) return false;
+  const int m = chain_base_;
+  struct Update {
+    int a, b;  // b = -1: a prior
+    Mat3 ja, jb, w;
+  };
+  std::vector<Update> updates;
+  for (size_t k = factors_at_factor_; k < factors_.size(); ++k) {
+    const Factor& f = factors_[k];
+    const int newer = std::max(f.a, f.b);
+    if (newer >= m && first_factor_of_pose_[static_cast<size_t>(newer)] == static_cast<int>(k)) continue;  // a chain link
+    if (f.kind == Factor::Kind::Motion || updates.size() == kMaxUpdateFactors) return false;
+    const Linearisation l = linearise(f, f.lin_a, f.lin_b);  // what contribution() added
+    updates.push_back({f.a, f.kind == Factor::Kind::Prior ? -1 : f.b, l.a_a, l.a_b, l.w});
+  }
+  std::vector<int> unsolved;
+  const auto need = [&](int p) {
+    if (p >= 0 && p < m && !involved_at_.count(p) && std::find(unsolved.begin(), unsolved.end(), p) == unsolved.end())
+      unsolved.push_back(p);
+  };
+  need(i);
+  need(j);
+  for (const Update& u : updates) {
+    need(u.a);
+    need(u.b);
+  }
+  if (unsolved.size() > kMaxNewSolvedPoses) return false;
+  if (base_columns_.size() == 0) covarianceColumnsBlock(m - 1, &base_columns_);
+  solveInvolved(unsolved);
+
+  const int n_u = static_cast<int>(updates.size());
+  const int targets[2] = {i, j};
+  // H_u Sigma_c(., t) for update u and pose t.
+  const auto hs = [&](const Update& u, int t) -> Mat3 {
+    Mat3 r = u.ja * chainedCovariance(u.a, t);
+    if (u.b >= 0) r += u.jb * chainedCovariance(u.b, t);
+    return r;
+  };
+  Mat6 s;
+  for (int a = 0; a < 2; ++a)
+    for (int b = 0; b < 2; ++b) s.block<3, 3>(3 * a, 3 * b) = chainedCovariance(targets[a], targets[b]);
+  if (n_u > 0) {
+    Eigen::MatrixXd hsh(3 * n_u, 3 * n_u), hst(3 * n_u, 6), w_hst(3 * n_u, 6), m_mat(3 * n_u, 3 * n_u);
+    for (int k = 0; k < n_u; ++k) {
+      const Update& uk = updates[static_cast<size_t>(k)];
+      for (int l = 0; l < n_u; ++l) {
+        const Update& ul = updates[static_cast<size_t>(l)];
+        Mat3 b = hs(uk, ul.a) * ul.ja.transpose();
+        if (ul.b >= 0) b += hs(uk, ul.b) * ul.jb.transpose();
+        hsh.block<3, 3>(3 * k, 3 * l) = b;
+      }
+      for (int t = 0; t < 2; ++t) hst.block<3, 3>(3 * k, 3 * t) = hs(uk, targets[t]);
+    }
+    // I + W H Sigma_c H' and W H Sigma_c E_T, W block-diagonal.
+    for (int k = 0; k < n_u; ++k) {
+      const Mat3& w = updates[static_cast<size_t>(k)].w;
+      m_mat.middleRows(3 * k, 3) = w * hsh.middleRows(3 * k, 3);
+      w_hst.middleRows(3 * k, 3) = w * hst.middleRows(3 * k, 3);
+    }
+    m_mat += Eigen::MatrixXd::Identity(3 * n_u, 3 * n_u);
+    s -= hst.transpose() * m_mat.partialPivLu().solve(w_hst);
+  }
+  *joint = 0.5 * (s + s.transpose());
+  return true;
+}
+
+}  // namespace urbanslam::esdf
