@@ -445,16 +445,29 @@ Mat6 Esdf::jointCovariance(int i, int j, CovarianceMode mode) {
   return 0.5 * (s + s.transpose());
 }
 
+Mat3 Esdf::chainedCovariance(int p, int q) {
+  if (p > q) return chainedCovariance(q, p).transpose();
+  const int m = chain_base_;
+  if (q < m) return involved_cov_.block<3, 3>(3 * involved_at_.at(p), 3 * involved_at_.at(q));
+  // x_q = Phi_q x_{m-1} + n_q, with n_q independent of the factored poses.
+  const Mat3& phi_q = chain_phi_[static_cast<size_t>(q - m)];
+  if (p < m) return base_columns_.block<3, 3>(3 * p, 0) * phi_q.transpose();
+  const Mat3& phi_p = chain_phi_[static_cast<size_t>(p - m)];
+  const Mat3 spp = phi_p * base_columns_.block<3, 3>(3 * (m - 1), 0) * phi_p.transpose() + chain_cov_[static_cast<size_t>(p - m)];
+  if (p == q) return spp;
+  // x_q = Phi_q Phi_p^-1 x_p + noise of the links after p.
+  return spp * (phi_q * phi_p.inverse()).transpose();
+}
+
 Mat6 Esdf::conservativeJoint(int i, int j, Mat3* relative) {
   // The last factorisation is of an older Lambda, which holds less information than the current
   // one (if no relinearisation happened since): its inverse bounds the current covariance from
   // above. Poses added after it are reached by dead reckoning from the last factored pose m-1.
   const int m = chain_base_;
   if (base_columns_.size() == 0) covarianceColumnsBlock(m - 1, &base_columns_);
-  const Mat3 base = base_columns_.block<3, 3>(3 * (m - 1), 0);
   auto chainPhi = [&](int p) -> const Mat3& { return chain_phi_[static_cast<size_t>(p - m)]; };
   auto marginal = [&](int p) -> Mat3 {
-    if (p >= m) return chainPhi(p) * base * chainPhi(p).transpose() + chain_cov_[static_cast<size_t>(p - m)];
+    if (p >= m) return chainedCovariance(p, p);
     // Every factored pose's at once, from the factor's sparse inverse, on the first one asked:
     // while the vehicle drives along an earlier visit its keyframes are candidates one after
     // another, and a column solve each would pass over the whole map each time.
@@ -467,9 +480,7 @@ Mat6 Esdf::conservativeJoint(int i, int j, Mat3* relative) {
       covarianceColumnsBlock(b, &cols);
       return cols.block<3, 3>(3 * a, 0);
     }
-    if (a < m) return base_columns_.block<3, 3>(3 * a, 0) * chainPhi(b).transpose();
-    // Both dead-reckoned: x_b = Phi_b Phi_a^-1 x_a + independent noise.
-    return marginal(a) * (chainPhi(b) * chainPhi(a).inverse()).transpose();
+    return chainedCovariance(a, b);
   };
   const auto joint = [&](const Mat3& saa, const Mat3& sbb, const Mat3& sab) {
     Mat6 s;

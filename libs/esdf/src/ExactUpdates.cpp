@@ -25,20 +25,6 @@ constexpr size_t kMaxNewSolvedPoses = 4;
 constexpr size_t kMaxUpdateFactors = 64;
 }  // namespace
 
-Mat3 Esdf::chainedCovariance(int p, int q) {
-  if (p > q) return chainedCovariance(q, p).transpose();
-  const int m = chain_base_;
-  if (q < m) return involved_cov_.block<3, 3>(3 * involved_at_.at(p), 3 * involved_at_.at(q));
-  // x_q = Phi_q x_{m-1} + n_q, with n_q independent of the factored poses.
-  const Mat3& phi_q = chain_phi_[static_cast<size_t>(q - m)];
-  if (p < m) return base_columns_.block<3, 3>(3 * p, 0) * phi_q.transpose();
-  const Mat3& phi_p = chain_phi_[static_cast<size_t>(p - m)];
-  const Mat3 spp = phi_p * base_columns_.block<3, 3>(3 * (m - 1), 0) * phi_p.transpose() + chain_cov_[static_cast<size_t>(p - m)];
-  if (p == q) return spp;
-  // x_q = Phi_q Phi_p^-1 x_p + noise of the links after p.
-  return spp * (phi_q * phi_p.inverse()).transpose();
-}
-
 void Esdf::solveInvolved(const std::vector<int>& poses) {
   if (poses.empty()) return;
   const int m = full_factor_.last();

@@ -269,7 +269,9 @@ class Esdf {
   // update (Woodbury). False when Lambda changed otherwise since the factorisation, or the
   // update needs more column solves than a refactorisation is worth.
   bool updatedJoint(int i, int j, Mat6* joint);
-  // Sigma(p, q) of the factorised Lambda with the chain after it (p, q factored or chain poses).
+  // Sigma(p, q) of the factorised Lambda with the chain after it: for a chain pose, the
+  // conservative covariance's dead reckoning (exact while no closure came since); for two
+  // factored poses, the blocks solveInvolved kept.
   Mat3 chainedCovariance(int p, int q);
   // Makes the blocks of Sigma among `poses` (factored) available: one multi-column solve for
   // those not solved for yet.
