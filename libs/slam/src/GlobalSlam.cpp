@@ -269,21 +269,23 @@ void GlobalSlam::addPlaceFix(size_t earlier, size_t current, const common::Pose2
 
 void GlobalSlam::recoverAll(bool converge) {
   common::Stopwatch sw;
-  // Each Gauss-Newton step is a factorisation of the whole map, superlinear in its size. The last
-  // steps of a recovery that goes on until nothing moves past a millimetre gain next to nothing;
-  // what they would have moved, the next recovery moves.
+  // Each Gauss-Newton step is a factorisation of the whole map, superlinear in its size. A
+  // recovery after a closure takes a fixed number of them and leaves relinearising what they
+  // moved to the next recovery: relinearising at its end would leave the factor stale, and the
+  // next closure's exact gate would pay another factorisation for it.
+  map_.filter()->relinearise();
   if (converge)
     map_.filter()->recover();
   else
-    map_.filter()->recover(-1, options_.estimator.full_recovery_cost_tolerance);
+    map_.filter()->recover(options_.estimator.full_recovery_steps - 1);
   last_full_size_ = map_.size();
   map_.pullPoses(0);
   map_.reindex();
   std::vector<common::Pose2> poses;
   poses.reserve(map_.size());
   for (const auto& k : map_.keyframes()) poses.push_back(k.pose);
-  // What a recovery stopped short of, the run's last recovery still owes.
-  dirty_since_recovery_ = !converge && options_.estimator.full_recovery_cost_tolerance > 0;
+  // What a recovery stopped short of (at least the relinearisation it left), the run's last owes.
+  dirty_since_recovery_ = !converge;
   PosesUpdatedEvent e{&poses};
   e.recovery_ms = sw.milliseconds();
   e.map_factorisations = map_.filter()->factorisations();

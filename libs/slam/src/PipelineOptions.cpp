@@ -159,9 +159,9 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("global_thread", o.estimator.global_thread, "global SLAM on a thread of its own: local SLAM never waits (same results)");
   s.add("full_recovery_min_growth", o.estimator.full_recovery_min_growth, 0.0, 10.0, "",
         "full recovery after a closure once the map grew by this fraction since the last (0: every closure)");
-  s.add("full_recovery_cost_tolerance", o.estimator.full_recovery_cost_tolerance, 0.0, 1.0, "",
-        "a full recovery after a closure stops relinearising once a Gauss-Newton step lowers the cost by less than this fraction of it "
-        "(0: once nothing moves past 1 mm and 1e-4 rad, as the run's last recovery does)");
+  s.add("full_recovery_steps", o.estimator.full_recovery_steps, 1, 100, "",
+        "Gauss-Newton steps of a full recovery after a closure, each a factorisation of the whole map; what they move is relinearised "
+        "when the next recovery starts (the run's last goes on until nothing moves past 1 mm and 1e-4 rad)");
 
   s.section("map", "Map products");
   s.add("grid_resolution_m", o.map.grid_resolution_m, 0.01, 2.0, "m", "occupancy grid cell size");

@@ -109,9 +109,9 @@ class GlobalSlam {
   // After an accepted closure of keyframe `current`: a full recovery when the map has grown
   // enough since the last one ([estimator] full_recovery_min_growth), else the recent poses.
   void closureAdded(size_t current, SteadyTime handed_over);
-  // Full recovery, to [estimator] full_recovery_cost_tolerance or (`converge`, the run's last)
-  // until nothing moves; the latency of the oldest closure it brings into the whole map is
-  // recorded.
+  // Full recovery: the factors the last one moved relinearised, then [estimator]
+  // full_recovery_steps Gauss-Newton steps or (`converge`, the run's last) steps until nothing
+  // moves; the latency of the oldest closure it brings into the whole map is recorded.
   void recoverAll(bool converge);
   // The laser classifier with the features of every keyframe so far.
   laser_loop::LoopDetector& laserDetector();

@@ -161,10 +161,12 @@ struct EstimatorOptions {
   // A full recovery after a loop closure only once the map has grown by this fraction since the
   // last one (0: after every closure): its cost spread over that many keyframes.
   double full_recovery_min_growth = 0.01;
-  // Such a recovery stops relinearising once a Gauss-Newton step lowers the cost by less than
-  // this fraction of it (each step is a factorisation of the whole map); the next recovery goes
-  // on from there. The run's last recovery goes on until nothing moves past 1 mm and 1e-4 rad.
-  double full_recovery_cost_tolerance = 1e-6;
+  // Gauss-Newton steps of such a recovery, each a factorisation of the whole map. The factors a
+  // step moves are relinearised at the start of the next recovery, not at the end of this one:
+  // the factor the last step leaves is then the current information's, which the innovation
+  // gate's exact covariances start from until the next recovery. The run's last recovery goes
+  // on until nothing moves past 1 mm and 1e-4 rad.
+  int full_recovery_steps = 1;
 };
 
 struct MapOptions {
