@@ -278,10 +278,9 @@ std::vector<Eigen::Vector3d> denseOptimum(const std::vector<slam::GraphEdge>& ed
 
 // A full recovery after a closure takes [estimator] full_recovery_steps Gauss-Newton steps; the
 // run's last one goes on until nothing moves, even when nothing came after the closure's own
-// recovery. A lap of a 20 m square, the odometry 1 cm
-// and 0.3° short of the truth at every metre (24° of heading by the lap's end), closed at its end
-// at the true relative pose: with one step or three, the poses after finish() are the optimum
-// of the map's edges.
+// recovery. A lap of a 20 m square, the odometry 1 cm and 0.3° short of the truth at every metre
+// (24° of heading by the lap's end), closed at its end at the true relative pose: with one step
+// or three, the poses after finish() are the optimum of the map's edges.
 TEST(GlobalSlam, TheLastRecoveryReachesTheOptimumWhateverTheStepsBefore) {
   const auto truth = [](size_t k) {
     const double s = static_cast<double>(k % 80);  // metres along the square
