@@ -91,6 +91,29 @@ TEST(Recovery, InverseDiagonalBlocksEqualTheDenseInverse) {
   }
 }
 
+// A simplicial factor is read in place by the sparse inverse (packed within its own arrays):
+// the solves after it, and a factorisation reusing its analysis, are still those of the matrix.
+TEST(Recovery, ASimplicialFactorReadByTheSparseInverseStillSolvesAndRefactorises) {
+  LinearGraph g(33, 60, 3);
+  const Eigen::MatrixXd lambda = g.f.state().denseInformation();
+  const Eigen::MatrixXd sigma = lambda.inverse();
+  std::mt19937 rng(7);
+  Eigen::MatrixXd b(lambda.rows(), 2);
+  for (int i = 0; i < b.size(); ++i) b(i) = test::gauss(rng, 1.0);
+  const Eigen::MatrixXd x_ref = lambda.ldlt().solve(b);
+  SparseCholesky chol;
+  for (int round = 0; round < 2; ++round) {
+    chol.factorize(g.f.state(), 0, g.f.size());
+    ASSERT_FALSE(chol.supernodal());
+    const std::vector<Mat3> blocks = chol.inverseDiagonalBlocks();
+    double worst = 0;
+    for (int p = 0; p < g.f.size(); ++p)
+      worst = std::max(worst, (blocks[static_cast<size_t>(p)] - blk(sigma, p, p)).cwiseAbs().maxCoeff() / blk(sigma, p, p).norm());
+    EXPECT_LT(worst, 1e-9) << "round " << round;
+    EXPECT_LT((chol.solve(b) - x_ref).cwiseAbs().maxCoeff() / x_ref.cwiseAbs().maxCoeff(), 1e-9) << "round " << round;
+  }
+}
+
 TEST(Recovery, EnvelopeCholeskySolvesEveryWindowLikeDenseLlt) {
   // Windows with links leaving them (ignored), short in-window loops and, for first = 0, a link
   // from the newest to the oldest pose (the dense worst case of the envelope).

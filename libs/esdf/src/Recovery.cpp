@@ -278,24 +278,22 @@ std::vector<Mat3> SparseCholesky::inverseDiagonalBlocks() const {
     v.values = static_cast<const double*>(f->x);
     return esdf::inverseDiagonalBlocks(v);
   }
-  // A simplicial factor is LDL' with its columns anywhere in memory: a packed LL' copy has one
-  // column per supernode, in order (the solves keep using the factor as it is).
-  cholmod_factor* ll = cholmod_copy_factor(impl_->factor, cm);
-  if (!ll || !cholmod_change_factor(CHOLMOD_REAL, 1, 0, 1, 1, ll, cm)) {
-    if (ll) cholmod_free_factor(&ll, cm);
-    throw std::runtime_error("CHOLMOD could not convert the factor to LL'");
-  }
   std::vector<int> columns(f->n + 1);
   for (size_t c = 0; c <= f->n; ++c) columns[c] = static_cast<int>(c);
   v.supernodes = v.columns;
   v.first_column = columns.data();
-  v.row_begin = static_cast<const int*>(ll->p);
-  v.rows = static_cast<const int*>(ll->i);
-  v.value_begin = static_cast<const int*>(ll->p);
-  v.values = static_cast<const double*>(ll->x);
-  std::vector<Mat3> blocks = esdf::inverseDiagonalBlocks(v);
-  cholmod_free_factor(&ll, cm);
-  return blocks;
+  // A simplicial factor is read in place, its columns made to lie in order, each where the next
+  // begins (one column per supernode); CHOLMOD packs them within the factor's own arrays (the
+  // solves read it either way). A copy would hold a second factor while the inverse runs.
+  cholmod_factor* l = impl_->factor;
+  if (!cholmod_change_factor(static_cast<int>(l->xtype), static_cast<int>(l->is_ll), 0, 1, 1, l, cm))
+    throw std::runtime_error("CHOLMOD could not pack the factor (status " + std::to_string(cm->status) + ")");
+  v.unit_diagonal_ldl = !l->is_ll;
+  v.row_begin = static_cast<const int*>(l->p);
+  v.rows = static_cast<const int*>(l->i);
+  v.value_begin = static_cast<const int*>(l->p);
+  v.values = static_cast<const double*>(l->x);
+  return esdf::inverseDiagonalBlocks(v);
 }
 
 long long SparseCholesky::factorNonZeros() const {

@@ -1,6 +1,7 @@
 #include "SparseInverse.h"
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <stdexcept>
 
 namespace urbanslam::esdf {
@@ -29,36 +30,45 @@ std::vector<Mat3> inverseDiagonalBlocks(const SupernodalFactorView& l) {
   // Z = A^-1 in L's layout. With L's supernode S (columns) over its rows S and R below:
   //   L' Z = L^-1 gives Z_RS = -Z_RR W and Z_SS = (L_SS L_SS')^-1 - W' Z_RS, W = L_RS L_SS^-1,
   // where Z_RR lies in the pattern of later supernodes (R is a clique of the filled graph).
-  std::vector<double> z(static_cast<size_t>(l.value_begin[l.supernodes]));
+  // A supernode's Z is read only by the supernodes processed after it that have rows in its
+  // columns (its descendants in the elimination tree): each Z is released after its last
+  // reader, so what is held at once is about the Z of one path from the root, not a second
+  // factor.
+  std::vector<int> last_reader(static_cast<size_t>(l.supernodes));
+  for (int s = 0; s < l.supernodes; ++s) last_reader[static_cast<size_t>(s)] = s;
+  for (int s = 0; s < l.supernodes; ++s) {
+    const int nc = l.first_column[s + 1] - l.first_column[s];
+    for (int k = l.row_begin[s] + nc; k < l.row_begin[s + 1]; ++k) {
+      int& last = last_reader[static_cast<size_t>(supernode_of[static_cast<size_t>(l.rows[k])])];
+      last = std::min(last, s);
+    }
+  }
+  // The supernodes released after supernode s: freed[freed_begin[s] .. freed_begin[s + 1]).
+  std::vector<int> freed_begin(static_cast<size_t>(l.supernodes) + 1, 0), freed(static_cast<size_t>(l.supernodes));
+  for (const int r : last_reader) ++freed_begin[static_cast<size_t>(r) + 1];
+  for (int s = 0; s < l.supernodes; ++s) freed_begin[static_cast<size_t>(s) + 1] += freed_begin[static_cast<size_t>(s)];
+  {
+    std::vector<int> next(freed_begin.begin(), freed_begin.end() - 1);
+    for (int s = 0; s < l.supernodes; ++s) freed[static_cast<size_t>(next[static_cast<size_t>(last_reader[static_cast<size_t>(s)])]++)] = s;
+  }
+  std::vector<std::vector<double>> z(static_cast<size_t>(l.supernodes));
   std::vector<Mat3> blocks(static_cast<size_t>(n / 3), Mat3::Zero());
   Eigen::MatrixXd zrr, w, zrs;
-  for (int s = l.supernodes - 1; s >= 0; --s) {
-    const int c0 = l.first_column[s], nc = l.first_column[s + 1] - c0;
-    const int nr = l.row_begin[s + 1] - l.row_begin[s], nb = nr - nc;
-    const int* rows = l.rows + l.row_begin[s];
-    const Block ls(l.values + l.value_begin[s], nr, nc);
-    MutableBlock zs(z.data() + l.value_begin[s], nr, nc);
-    const auto lss = ls.topRows(nc).triangularView<Eigen::Lower>();
-    Eigen::MatrixXd inv_lss = Eigen::MatrixXd::Identity(nc, nc);
-    lss.solveInPlace(inv_lss);
-    zs.topRows(nc).noalias() = inv_lss.transpose() * inv_lss;
-    if (nb > 0) {
-      // Gather Z_RR, column t of it from the supernode that holds row nc + t as a column.
-      zrr.resize(nb, nb);
-      for (int t = 0; t < nb; ++t) {
-        const int c = rows[nc + t];
-        const int sc = supernode_of[static_cast<size_t>(c)];
-        scatter(sc);
-        const int ld = l.row_begin[sc + 1] - l.row_begin[sc];
-        const double* col = z.data() + l.value_begin[sc] + static_cast<long>(c - l.first_column[sc]) * ld;
-        for (int u = t; u < nb; ++u) zrr(u, t) = zrr(t, u) = col[position_of[static_cast<size_t>(rows[nc + u])]];
-      }
-      w = ls.bottomRows(nb) * inv_lss;
-      zrs.noalias() = -zrr * w;
-      zs.bottomRows(nb) = zrs;
-      zs.topRows(nc).noalias() -= w.transpose() * zrs;
+  // Z_RR of a supernode with nc columns whose rows below them are rows[nc .. nc + nb), column t
+  // of it from the supernode that holds row nc + t as a column.
+  const auto gather = [&](int nc, int nb, const int* rows) {
+    zrr.resize(nb, nb);
+    for (int t = 0; t < nb; ++t) {
+      const int c = rows[nc + t];
+      const int sc = supernode_of[static_cast<size_t>(c)];
+      scatter(sc);
+      const int ld = l.row_begin[sc + 1] - l.row_begin[sc];
+      const double* col = z[static_cast<size_t>(sc)].data() + static_cast<long>(c - l.first_column[sc]) * ld;
+      for (int u = t; u < nb; ++u) zrr(u, t) = zrr(t, u) = col[position_of[static_cast<size_t>(rows[nc + u])]];
     }
-    // The diagonal blocks: entry (k1, k2) of a pose's block is stored in column min(k1, k2).
+  };
+  // The diagonal blocks: entry (k1, k2) of a pose's block is stored in column min(k1, k2).
+  const auto storeDiagonal = [&](int s, int c0, int nc, const MutableBlock& zs) {
     scatter(s);
     for (int c = c0; c < c0 + nc; ++c) {
       const int a = l.perm[c], pose = a / 3;
@@ -69,6 +79,46 @@ std::vector<Mat3> inverseDiagonalBlocks(const SupernodalFactorView& l) {
         blocks[static_cast<size_t>(pose)](a % 3, b) = blocks[static_cast<size_t>(pose)](b, a % 3) = v;
       }
     }
+  };
+  for (int s = l.supernodes - 1; s >= 0; --s) {
+    const int c0 = l.first_column[s], nc = l.first_column[s + 1] - c0;
+    const int nr = l.row_begin[s + 1] - l.row_begin[s], nb = nr - nc;
+    const int* rows = l.rows + l.row_begin[s];
+    const Block ls(l.values + l.value_begin[s], nr, nc);
+    std::vector<double>& zbuf = z[static_cast<size_t>(s)];
+    zbuf.resize(static_cast<size_t>(nr) * static_cast<size_t>(nc));
+    MutableBlock zs(zbuf.data(), nr, nc);
+    const auto release = [&] {
+      for (int k = freed_begin[static_cast<size_t>(s)]; k < freed_begin[static_cast<size_t>(s) + 1]; ++k)
+        std::vector<double>().swap(z[static_cast<size_t>(freed[static_cast<size_t>(k)])]);
+    };
+    if (l.unit_diagonal_ldl) {
+      if (nc != 1) throw std::invalid_argument("inverseDiagonalBlocks: an LDL' factor has one column per supernode");
+      zs(0, 0) = 1.0 / ls(0, 0);
+      if (nb > 0) {
+        gather(nc, nb, rows);
+        const auto wl = ls.bottomRows(nb);
+        zrs.noalias() = -zrr * wl;
+        zs.bottomRows(nb) = zrs;
+        zs(0, 0) -= wl.col(0).dot(zrs.col(0));
+      }
+      storeDiagonal(s, c0, nc, zs);
+      release();
+      continue;
+    }
+    const auto lss = ls.topRows(nc).triangularView<Eigen::Lower>();
+    Eigen::MatrixXd inv_lss = Eigen::MatrixXd::Identity(nc, nc);
+    lss.solveInPlace(inv_lss);
+    zs.topRows(nc).noalias() = inv_lss.transpose() * inv_lss;
+    if (nb > 0) {
+      gather(nc, nb, rows);
+      w = ls.bottomRows(nb) * inv_lss;
+      zrs.noalias() = -zrr * w;
+      zs.bottomRows(nb) = zrs;
+      zs.topRows(nc).noalias() -= w.transpose() * zrs;
+    }
+    storeDiagonal(s, c0, nc, zs);
+    release();
   }
   return blocks;
 }

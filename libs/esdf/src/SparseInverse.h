@@ -15,7 +15,12 @@ namespace urbanslam::esdf {
 // are a column-major block of (row count) x (column count) at values[value_begin[s]], of which
 // the lower triangle of the top square and everything below it are L. A simplicial factor is
 // the same with one column per supernode. perm[k] is the row of A that L's row k stands for.
+// A simplicial LDL' factor (A = P' L D L' P, L with a unit diagonal) is read as it is stored,
+// one column per supernode with D's entry in place of L's diagonal (unit_diagonal_ldl): its
+// recurrences are the LL' ones with W = L_RS and (L_SS L_SS')^-1 = 1 / D, so no LL' copy of the
+// factor is made to read it.
 struct SupernodalFactorView {
+  bool unit_diagonal_ldl = false;
   int columns = 0;
   int supernodes = 0;
   const int* first_column = nullptr;
