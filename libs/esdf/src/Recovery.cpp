@@ -123,11 +123,19 @@ void SparseCholesky::factorize(const InformationState& s, int first, int last) {
   // diagonal block, then the blocks Lambda(o, p) of linked poses o > p in the range (sorted).
   // (CHOLMOD's supernodal factorisation transposes a lower-stored matrix once, an upper-stored
   // one twice.)
+  // Sized exactly first: grown by doubling, the arrays held up to half as much again as the
+  // matrix while CHOLMOD factorised it, when the whole map's memory peaks.
+  size_t entries = 0;
+  for (int p = first; p < last; ++p) {
+    entries += 6;
+    for (const auto& l : s.links(p))
+      if (l.other > p && l.other < last) entries += 9;
+  }
   std::vector<int> colptr(n + 1, 0);
   std::vector<int> rowind;
   std::vector<double> values;
-  rowind.reserve(n * 6);
-  values.reserve(n * 6);
+  rowind.reserve(entries);
+  values.reserve(entries);
   std::vector<std::pair<int, const Mat3*>> higher;
   for (int p = first; p < last; ++p) {
     higher.clear();
@@ -174,7 +182,13 @@ void SparseCholesky::factorizeLower(std::vector<int> colptr, std::vector<int> ro
   cholmod_common* cm = &impl_->common;
   const SerialOpenMp serial;
   const bool same_pattern = impl_->factor && colptr == impl_->last_p && rowind == impl_->last_i;
-  if (!same_pattern) {
+  if (same_pattern) {
+    // The kept pattern is the same: the new copy goes before the factorisation.
+    a.p = impl_->last_p.data();
+    a.i = impl_->last_i.data();
+    std::vector<int>().swap(colptr);
+    std::vector<int>().swap(rowind);
+  } else {
     if (impl_->factor) cholmod_free_factor(&impl_->factor, cm);
     impl_->factor = cholmod_analyze(&a, cm);
     if (!impl_->factor) throw std::runtime_error("CHOLMOD analyze failed (status " + std::to_string(cm->status) + ")");
@@ -188,12 +202,6 @@ void SparseCholesky::factorizeLower(std::vector<int> colptr, std::vector<int> ro
     throw NotPositiveDefinite("information matrix is not positive definite (CHOLMOD status " + std::to_string(cm->status) + ")");
   }
   impl_->last_x.keep(std::move(values));
-  // Built with room to grow, kept as long as the pattern lasts (not before the factorisation:
-  // `a` points into them).
-  if (!same_pattern) {
-    impl_->last_p.shrink_to_fit();
-    impl_->last_i.shrink_to_fit();
-  }
 }
 
 SparseCholesky::Matrix SparseCholesky::matrix() const {
