@@ -9,6 +9,32 @@ namespace urbanslam::esdf {
 namespace {
 using Block = Eigen::Map<const Eigen::MatrixXd>;
 using MutableBlock = Eigen::Map<Eigen::MatrixXd>;
+
+// When each supernode's Z can go. Z of supernode p is read only by the supernodes processed
+// after it (lower ones) that have rows in its columns, its descendants in the elimination tree;
+// it goes once the lowest of them is done, or after its own step when none reads it. The
+// supernodes released after supernode s are supernodes[begin[s] .. begin[s + 1]).
+struct ReleaseSchedule {
+  std::vector<int> begin, supernodes;
+};
+
+ReleaseSchedule releaseSchedule(const SupernodalFactorView& l, const std::vector<int>& supernode_of) {
+  const auto at = [](int i) { return static_cast<size_t>(i); };
+  std::vector<int> last_reader(at(l.supernodes));
+  for (int s = 0; s < l.supernodes; ++s) last_reader[at(s)] = s;
+  for (int s = 0; s < l.supernodes; ++s)
+    for (int k = l.row_begin[s] + l.first_column[s + 1] - l.first_column[s]; k < l.row_begin[s + 1]; ++k) {
+      int& last = last_reader[at(supernode_of[at(l.rows[k])])];
+      last = std::min(last, s);
+    }
+  // Bucketed by their last reader (a counting sort).
+  ReleaseSchedule r{std::vector<int>(at(l.supernodes) + 1, 0), std::vector<int>(at(l.supernodes))};
+  for (const int reader : last_reader) ++r.begin[at(reader) + 1];
+  for (int s = 0; s < l.supernodes; ++s) r.begin[at(s) + 1] += r.begin[at(s)];
+  std::vector<int> next(r.begin.begin(), r.begin.end() - 1);
+  for (int s = 0; s < l.supernodes; ++s) r.supernodes[at(next[at(last_reader[at(s)])]++)] = s;
+  return r;
+}
 }  // namespace
 
 std::vector<Mat3> inverseDiagonalBlocks(const SupernodalFactorView& l) {
@@ -30,27 +56,9 @@ std::vector<Mat3> inverseDiagonalBlocks(const SupernodalFactorView& l) {
   // Z = A^-1 in L's layout. With L's supernode S (columns) over its rows S and R below:
   //   L' Z = L^-1 gives Z_RS = -Z_RR W and Z_SS = (L_SS L_SS')^-1 - W' Z_RS, W = L_RS L_SS^-1,
   // where Z_RR lies in the pattern of later supernodes (R is a clique of the filled graph).
-  // A supernode's Z is read only by the supernodes processed after it that have rows in its
-  // columns (its descendants in the elimination tree): each Z is released after its last
-  // reader, so what is held at once is about the Z of one path from the root, not a second
-  // factor.
-  std::vector<int> last_reader(static_cast<size_t>(l.supernodes));
-  for (int s = 0; s < l.supernodes; ++s) last_reader[static_cast<size_t>(s)] = s;
-  for (int s = 0; s < l.supernodes; ++s) {
-    const int nc = l.first_column[s + 1] - l.first_column[s];
-    for (int k = l.row_begin[s] + nc; k < l.row_begin[s + 1]; ++k) {
-      int& last = last_reader[static_cast<size_t>(supernode_of[static_cast<size_t>(l.rows[k])])];
-      last = std::min(last, s);
-    }
-  }
-  // The supernodes released after supernode s: freed[freed_begin[s] .. freed_begin[s + 1]).
-  std::vector<int> freed_begin(static_cast<size_t>(l.supernodes) + 1, 0), freed(static_cast<size_t>(l.supernodes));
-  for (const int r : last_reader) ++freed_begin[static_cast<size_t>(r) + 1];
-  for (int s = 0; s < l.supernodes; ++s) freed_begin[static_cast<size_t>(s) + 1] += freed_begin[static_cast<size_t>(s)];
-  {
-    std::vector<int> next(freed_begin.begin(), freed_begin.end() - 1);
-    for (int s = 0; s < l.supernodes; ++s) freed[static_cast<size_t>(next[static_cast<size_t>(last_reader[static_cast<size_t>(s)])]++)] = s;
-  }
+  // Each Z is released after its last reader (releaseSchedule), so what is held at once is about
+  // the Z of one path from the root, not a second factor.
+  const ReleaseSchedule release_after = releaseSchedule(l, supernode_of);
   std::vector<std::vector<double>> z(static_cast<size_t>(l.supernodes));
   std::vector<Mat3> blocks(static_cast<size_t>(n / 3), Mat3::Zero());
   Eigen::MatrixXd zrr, w, zrs;
@@ -88,10 +96,6 @@ std::vector<Mat3> inverseDiagonalBlocks(const SupernodalFactorView& l) {
     std::vector<double>& zbuf = z[static_cast<size_t>(s)];
     zbuf.resize(static_cast<size_t>(nr) * static_cast<size_t>(nc));
     MutableBlock zs(zbuf.data(), nr, nc);
-    const auto release = [&] {
-      for (int k = freed_begin[static_cast<size_t>(s)]; k < freed_begin[static_cast<size_t>(s) + 1]; ++k)
-        std::vector<double>().swap(z[static_cast<size_t>(freed[static_cast<size_t>(k)])]);
-    };
     if (l.unit_diagonal_ldl) {
       if (nc != 1) throw std::invalid_argument("inverseDiagonalBlocks: an LDL' factor has one column per supernode");
       zs(0, 0) = 1.0 / ls(0, 0);
@@ -102,23 +106,22 @@ std::vector<Mat3> inverseDiagonalBlocks(const SupernodalFactorView& l) {
         zs.bottomRows(nb) = zrs;
         zs(0, 0) -= wl.col(0).dot(zrs.col(0));
       }
-      storeDiagonal(s, c0, nc, zs);
-      release();
-      continue;
-    }
-    const auto lss = ls.topRows(nc).triangularView<Eigen::Lower>();
-    Eigen::MatrixXd inv_lss = Eigen::MatrixXd::Identity(nc, nc);
-    lss.solveInPlace(inv_lss);
-    zs.topRows(nc).noalias() = inv_lss.transpose() * inv_lss;
-    if (nb > 0) {
-      gather(nc, nb, rows);
-      w = ls.bottomRows(nb) * inv_lss;
-      zrs.noalias() = -zrr * w;
-      zs.bottomRows(nb) = zrs;
-      zs.topRows(nc).noalias() -= w.transpose() * zrs;
+    } else {
+      const auto lss = ls.topRows(nc).triangularView<Eigen::Lower>();
+      Eigen::MatrixXd inv_lss = Eigen::MatrixXd::Identity(nc, nc);
+      lss.solveInPlace(inv_lss);
+      zs.topRows(nc).noalias() = inv_lss.transpose() * inv_lss;
+      if (nb > 0) {
+        gather(nc, nb, rows);
+        w = ls.bottomRows(nb) * inv_lss;
+        zrs.noalias() = -zrr * w;
+        zs.bottomRows(nb) = zrs;
+        zs.topRows(nc).noalias() -= w.transpose() * zrs;
+      }
     }
     storeDiagonal(s, c0, nc, zs);
-    release();
+    for (int k = release_after.begin[static_cast<size_t>(s)]; k < release_after.begin[static_cast<size_t>(s) + 1]; ++k)
+      std::vector<double>().swap(z[static_cast<size_t>(release_after.supernodes[static_cast<size_t>(k)])]);
   }
   return blocks;
 }
