@@ -116,6 +116,8 @@ TEST(ExactUpdates, AFilterReadBackAnswersAsTheOneWritten) {
   f.recover();
   extend(f, 6);
   close(f, 5, 55);
+  f.augmentRelative(20, Vec3(0.5, 0.2, 0.1), kOdoInfo);  // a lineage of the chain from pose 20
+  extend(f, 2);
   common::BinaryWriter w;
   f.writeState(w);
   Esdf g(linearOptions());
@@ -129,6 +131,7 @@ TEST(ExactUpdates, AFilterReadBackAnswersAsTheOneWritten) {
     EXPECT_LT(relativeDifference(exact, denseJoint(f, 7, 55)), 1e-8);
   }
   EXPECT_EQ(f.jointCovariance(7, 55, CovarianceMode::Exact), g.jointCovariance(7, 55, CovarianceMode::Exact));
+  EXPECT_EQ(f.jointCovariance(58, 53, CovarianceMode::Conservative), g.jointCovariance(58, 53, CovarianceMode::Conservative));
   // A state from before the record (format 8) refactorises at its first exact covariance.
   common::BinaryReader old(w.bytes().data(), w.bytes().size() - 9, "filter state");
   Esdf h(linearOptions());

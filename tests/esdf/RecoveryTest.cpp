@@ -410,5 +410,63 @@ TEST(Relinearisation, BacktrackingNeverIncreasesTheCostOnAnInconsistentGraph) {
   }
 }
 
+// A pose added from an older factored pose (a keyframe leaving mapped ground in a reduced pose
+// graph) starts a lineage of the dead-reckoning chain from that pose. Conservative covariances
+// stay exact without new information, across lineages too, and need no refactorisation; with a
+// closure they stay upper bounds.
+TEST(Recovery, AChainLineageFromAnOlderPoseKeepsTheConservativeCovarianceExact) {
+  LinearGraph g(38, 50, 6);
+  Esdf& f = g.f;
+  f.recover();
+  for (int k = 50; k < 56; ++k) f.augmentRelative(k - 1, Vec3(1, 0, 0.05), kOdoInfo);
+  f.augmentRelative(20, Vec3(0.5, 0.2, 0.1), kOdoInfo);  // pose 56, from factored pose 20
+  for (int k = 57; k < 62; ++k) f.augmentRelative(k - 1, Vec3(1, 0, -0.05), kOdoInfo);
+  const long long factorisations = f.factorisations();
+  const std::vector<std::pair<int, int>> pairs{{56, 60}, {53, 61}, {10, 61}, {61, 61}, {58, 3}, {20, 57}, {55, 55}};
+  std::vector<Mat6> cons;
+  for (auto [i, j] : pairs) cons.push_back(f.jointCovariance(i, j, CovarianceMode::Conservative));
+  EXPECT_EQ(f.factorisations(), factorisations);
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const Mat6 e = f.jointCovariance(pairs[k].first, pairs[k].second, CovarianceMode::Exact);
+    EXPECT_LT((cons[k] - e).cwiseAbs().maxCoeff() / e.cwiseAbs().maxCoeff(), 1e-9) << k;
+  }
+  f.recover();
+  for (int k = 62; k < 66; ++k) f.augmentRelative(k - 1, Vec3(1, 0, 0.05), kOdoInfo);
+  f.augmentRelative(30, Vec3(0.5, 0.2, 0.1), kOdoInfo);  // pose 66
+  f.augmentRelative(66, Vec3(1, 0, 0), kOdoInfo);
+  f.observeRelative(40, 67, between(f.mean(40), f.mean(67)), kLoopInfo);
+  f.observeRelative(5, 64, between(f.mean(5), f.mean(64)), kLoopInfo);
+  const std::vector<std::pair<int, int>> after{{66, 64}, {40, 67}, {12, 65}, {67, 67}};
+  cons.clear();
+  for (auto [i, j] : after) cons.push_back(f.jointCovariance(i, j, CovarianceMode::Conservative));
+  for (size_t k = 0; k < after.size(); ++k) {
+    const Mat6 e = f.jointCovariance(after[k].first, after[k].second, CovarianceMode::Exact);
+    EXPECT_GT(minEigen<6>(cons[k] - e), -1e-9 * e.norm()) << k;
+  }
+}
+
+// The factors on the tightest path between two poses bound their relative covariance: on a
+// chain (no closure) the path holds all that is known about the pair, so the bound is the exact
+// covariance; with closures it is an upper bound, tightest for poses a few factors apart.
+TEST(Recovery, ThePathBoundIsExactOnAChainAndAnUpperBoundWithClosures) {
+  LinearGraph chain(36, 40, 0);
+  Mat3 path;
+  for (auto [i, j] : std::vector<std::pair<int, int>>{{3, 9}, {25, 12}, {0, 39}}) {
+    ASSERT_TRUE(chain.f.pathRelativeCovariance(i, j, &path));
+    const Mat3 e = chain.f.relativeCovariance(i, j, CovarianceMode::Exact);
+    EXPECT_LT((path - e).cwiseAbs().maxCoeff(), 1e-9 * e.norm()) << i << "," << j;
+  }
+  LinearGraph loops(37, 60, 8);
+  for (auto [i, j] : std::vector<std::pair<int, int>>{{3, 5}, {20, 33}, {59, 1}}) {
+    ASSERT_TRUE(loops.f.pathRelativeCovariance(i, j, &path));
+    const Mat3 e = loops.f.relativeCovariance(i, j, CovarianceMode::Exact);
+    EXPECT_GT(minEigen<3>(path - e), -1e-9 * e.norm()) << i << "," << j;
+  }
+  // Beyond the settled poses asked for, no bound (a new search: another pair).
+  EXPECT_FALSE(chain.f.pathRelativeCovariance(1, 38, &path, 10));
+  // The search from 38 goes on where it stopped when asked again.
+  EXPECT_TRUE(chain.f.pathRelativeCovariance(1, 38, &path));
+}
+
 }  // namespace
 }  // namespace urbanslam::esdf

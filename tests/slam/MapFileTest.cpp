@@ -210,10 +210,19 @@ TEST(MapFile, AVersion3FileIsReadAsAMapWithoutSeparateMaps) {
     ASSERT_TRUE(a.count(tag) && b.count(tag)) << tag;
     EXPECT_TRUE(a.at(tag) == b.at(tag)) << "section " << tag << " differs";
   }
-  // The filter as it was, then no record of factors since its factorisation (a count of 0 and
-  // false: it refactorises at its next exact covariance).
+  // The filter as it was, with its chain's lineages (each pose's root and lineage, 8 bytes) and
+  // then no record of factors since its factorisation (a count of 0 and false: it refactorises at
+  // its next exact covariance) and every keyframe its own filter pose (false).
   ASSERT_TRUE(a.count("ESDF") && b.count("ESDF"));
-  EXPECT_TRUE(b.at("ESDF") == a.at("ESDF") + std::string(9, '\0')) << "section ESDF differs beyond the factors since the factorisation";
+  const std::string& filter_old = a.at("ESDF") + std::string(10, '\0');
+  const std::string& filter_now = b.at("ESDF");
+  ASSERT_GE(filter_now.size(), filter_old.size());
+  const size_t lineages = filter_now.size() - filter_old.size();
+  EXPECT_EQ(lineages % 8, 0u);
+  bool as_it_was = lineages == 0 && filter_now == filter_old;
+  for (size_t i = 0; i + lineages <= filter_now.size() && !as_it_was && lineages > 0; ++i)
+    as_it_was = filter_now.substr(0, i) + filter_now.substr(i + lineages) == filter_old;
+  EXPECT_TRUE(as_it_was) << "section ESDF differs beyond the chain's lineages, the factors since the factorisation and the keyframe nodes";
   ASSERT_TRUE(a.count("LOCL") && b.count("LOCL"));
   const std::string& local_old = a.at("LOCL");
   const std::string& local_now = b.at("LOCL");

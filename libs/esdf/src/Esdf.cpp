@@ -110,19 +110,36 @@ int Esdf::initialise(const Vec3& mean, const Mat3& covariance) {
 
 void Esdf::pushChain(int k, int from, const Mat3& f_x, const Mat3& q) {
   if (!chain_valid_) return;
-  if (from != k - 1 || k < chain_base_ || static_cast<size_t>(k - chain_base_) != chain_phi_.size()) {
+  const bool extends = from == k - 1 && from >= chain_base_;
+  const bool lineage = from < chain_base_ && (from == chain_base_ - 1 || root_columns_.size() + 1 < kMaxLineages);
+  if (k < chain_base_ || static_cast<size_t>(k - chain_base_) != chain_phi_.size() || !(extends || lineage)) {
     chain_valid_ = false;
     return;
   }
-  if (k == chain_base_) {
+  if (lineage) {
     chain_phi_.push_back(f_x);
     chain_cov_.push_back(q);
+    chain_root_.push_back(from);
+    chain_lineage_.push_back(k);
+    if (from != chain_base_ - 1) root_columns_.emplace(from, Eigen::MatrixXd());
   } else {
-    const Mat3& phi = chain_phi_.back();
-    const Mat3& cov = chain_cov_.back();
+    const Mat3 phi = chain_phi_.back();
+    const Mat3 cov = chain_cov_.back();
     chain_phi_.push_back(f_x * phi);
     chain_cov_.push_back(f_x * cov * f_x.transpose() + q);
+    chain_root_.push_back(chain_root_.back());
+    chain_lineage_.push_back(chain_lineage_.back());
   }
+}
+
+const Eigen::MatrixXd& Esdf::rootColumns(int r) {
+  if (r == chain_base_ - 1) {
+    if (base_columns_.size() == 0) covarianceColumnsBlock(r, &base_columns_);
+    return base_columns_;
+  }
+  Eigen::MatrixXd& c = root_columns_[r];
+  if (c.size() == 0) covarianceColumnsBlock(r, &c);
+  return c;
 }
 
 int Esdf::predictAugment(std::shared_ptr<const MotionModel> model, const VecU& u, const MatQ& q_v, double dt_s) {
@@ -277,8 +294,11 @@ void Esdf::ensureFactor() {
   chain_base_ = size();
   chain_phi_.clear();
   chain_cov_.clear();
+  chain_root_.clear();
+  chain_lineage_.clear();
   chain_valid_ = true;
   base_columns_.resize(0, 0);
+  root_columns_.clear();
   factored_marginals_.clear();
   anchor_base_ = -1;  // the anchor is looked for again in the new chain
   anchor_paths_from_ = -1;
@@ -449,11 +469,17 @@ Mat3 Esdf::chainedCovariance(int p, int q) {
   if (p > q) return chainedCovariance(q, p).transpose();
   const int m = chain_base_;
   if (q < m) return involved_cov_.block<3, 3>(3 * involved_at_.at(p), 3 * involved_at_.at(q));
-  // x_q = Phi_q x_{m-1} + n_q, with n_q independent of the factored poses.
-  const Mat3& phi_q = chain_phi_[static_cast<size_t>(q - m)];
-  if (p < m) return base_columns_.block<3, 3>(3 * p, 0) * phi_q.transpose();
-  const Mat3& phi_p = chain_phi_[static_cast<size_t>(p - m)];
-  const Mat3 spp = phi_p * base_columns_.block<3, 3>(3 * (m - 1), 0) * phi_p.transpose() + chain_cov_[static_cast<size_t>(p - m)];
+  // x_q = Phi_q x_r + n_q, with n_q independent of the factored poses.
+  const size_t iq = static_cast<size_t>(q - m);
+  const Mat3& phi_q = chain_phi_[iq];
+  const int r_q = chain_root_[iq];
+  if (p < m) return rootColumns(r_q).block<3, 3>(3 * p, 0) * phi_q.transpose();
+  const size_t ip = static_cast<size_t>(p - m);
+  const Mat3& phi_p = chain_phi_[ip];
+  const int r_p = chain_root_[ip];
+  // Two lineages: independent noises, the roots' covariance between them.
+  if (chain_lineage_[ip] != chain_lineage_[iq]) return phi_p * rootColumns(r_q).block<3, 3>(3 * r_p, 0) * phi_q.transpose();
+  const Mat3 spp = phi_p * rootColumns(r_p).block<3, 3>(3 * r_p, 0) * phi_p.transpose() + chain_cov_[ip];
   if (p == q) return spp;
   // x_q = Phi_q Phi_p^-1 x_p + noise of the links after p.
   return spp * (phi_q * phi_p.inverse()).transpose();
@@ -464,7 +490,6 @@ Mat6 Esdf::conservativeJoint(int i, int j, Mat3* relative) {
   // one (if no relinearisation happened since): its inverse bounds the current covariance from
   // above. Poses added after it are reached by dead reckoning from the last factored pose m-1.
   const int m = chain_base_;
-  if (base_columns_.size() == 0) covarianceColumnsBlock(m - 1, &base_columns_);
   auto chainPhi = [&](int p) -> const Mat3& { return chain_phi_[static_cast<size_t>(p - m)]; };
   auto marginal = [&](int p) -> Mat3 {
     if (p >= m) return chainedCovariance(p, p);
@@ -499,6 +524,8 @@ Mat6 Esdf::conservativeJoint(int i, int j, Mat3* relative) {
   // the relative pose) tighter is returned.
   const ChainAnchor& an = chainAnchor();
   if (an.a < 0 || b < an.b || (a >= m && i != j)) return s;
+  // The chain after the closure carries it to b only within the closure's lineage.
+  if (chain_lineage_[static_cast<size_t>(b - m)] != chain_lineage_[static_cast<size_t>(an.b - m)]) return s;
   const Mat3 sa = marginal(an.a);
   const Mat3 step = chainPhi(b) * chainPhi(an.b).inverse();  // x_b from x_{an.b} by the chain
   const Mat3 to_b = step * an.phi;                           // d x_b / d x_{an.a}
@@ -527,8 +554,9 @@ const Esdf::ChainAnchor& Esdf::chainAnchor() {
   for (size_t k = factors_.size(); k-- > 0;) {
     const Factor& f = factors_[k];
     if (std::max(f.a, f.b) < m) break;
-    // (b = a + 1 from a = m - 1 is the chain's own first link.)
-    if (f.kind != Factor::Kind::Relative || f.a >= m || f.b < m || f.b == f.a + 1) continue;
+    // (A chain pose's first factor is its own link: from its predecessor or its lineage's root.)
+    if (f.kind != Factor::Kind::Relative || f.a >= m || f.b < m || first_factor_of_pose_[static_cast<size_t>(f.b)] == static_cast<int>(k))
+      continue;
     Mat3 d_a, d_e;
     factorStep(f, true, &d_a, &d_e);
     anchor_.a = f.a;
@@ -543,7 +571,8 @@ const Esdf::ChainAnchor& Esdf::chainAnchor() {
 size_t Esdf::memoryBytes() const {
   // (The factors grow by fixed blocks: their size is their memory, to a block.)
   return state_.memoryBytes() + factors_.size() * sizeof(Factor) + first_factor_of_pose_.capacity() * sizeof(int) +
-         (chain_phi_.capacity() + chain_cov_.capacity()) * sizeof(Mat3) + static_cast<size_t>(involved_cov_.size()) * sizeof(double);
+         (chain_phi_.capacity() + chain_cov_.capacity()) * sizeof(Mat3) + (chain_root_.capacity() + chain_lineage_.capacity()) * sizeof(int) +
+         static_cast<size_t>(involved_cov_.size()) * sizeof(double);
 }
 
 }  // namespace urbanslam::esdf

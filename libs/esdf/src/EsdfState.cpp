@@ -109,13 +109,17 @@ void Esdf::writeState(common::BinaryWriter& w) const {
   for (const Mat3& p : chain_phi_) w.matrix(p);
   w.size(chain_cov_.size());
   for (const Mat3& c : chain_cov_) w.matrix(c);
+  for (size_t k = 0; k < chain_phi_.size(); ++k) {
+    w.i32(chain_root_[k]);
+    w.i32(chain_lineage_[k]);
+  }
   w.boolean(chain_valid_);
   w.dense(base_columns_);
   w.size(factors_at_factor_);
   w.boolean(explained_stamp_ == values_stamp_);
 }
 
-void Esdf::readState(common::BinaryReader& r, bool with_updates) {
+void Esdf::readState(common::BinaryReader& r, bool with_updates, bool with_lineages) {
   if (size() != 0) throw std::logic_error("Esdf::readState into a filter that has poses");
   state_.read(r);
   const int n = state_.size();
@@ -173,10 +177,21 @@ void Esdf::readState(common::BinaryReader& r, bool with_updates) {
   for (Mat3& p : chain_phi_) p = r.matrix<3, 3>();
   chain_cov_.resize(r.count(9 * 8));
   for (Mat3& c : chain_cov_) c = r.matrix<3, 3>();
-  chain_valid_ = r.boolean();
   if (chain_base_ < 0 || chain_base_ > n || chain_phi_.size() != chain_cov_.size() ||
       chain_phi_.size() > static_cast<size_t>(n - chain_base_))
     r.fail("filter dead-reckoning chain");
+  chain_root_.assign(chain_phi_.size(), chain_base_ - 1);
+  chain_lineage_.assign(chain_phi_.size(), chain_base_);
+  root_columns_.clear();
+  for (size_t k = 0; with_lineages && k < chain_phi_.size(); ++k) {
+    chain_root_[k] = r.i32();
+    chain_lineage_[k] = r.i32();
+    const int pose = chain_base_ + static_cast<int>(k);
+    if (chain_root_[k] < 0 || chain_root_[k] >= chain_base_ || chain_lineage_[k] < chain_base_ || chain_lineage_[k] > pose)
+      r.fail("filter dead-reckoning chain lineage");
+    if (chain_root_[k] != chain_base_ - 1) root_columns_.emplace(chain_root_[k], Eigen::MatrixXd());
+  }
+  chain_valid_ = r.boolean();
   base_columns_ = r.dense();
   factored_marginals_.clear();
   anchor_base_ = -1;

@@ -76,7 +76,6 @@ bool Esdf::updatedJoint(int i, int j, Mat6* joint) {
     need(u.b);
   }
   if (unsolved.size() > kMaxNewSolvedPoses) return false;
-  if (base_columns_.size() == 0) covarianceColumnsBlock(m - 1, &base_columns_);
   solveInvolved(unsolved);
 
   const int n_u = static_cast<int>(updates.size());

@@ -60,29 +60,34 @@ std::array<double, 9> GlobalSlam::addKeyframe(Keyframe kf, io::CompactScan scan,
 std::array<double, 9> GlobalSlam::addKeyframeFrom(size_t from, Keyframe kf, io::CompactScan scan, const KeyframeConstraint& constraint) {
   const size_t k = map_.size();
   esdf::Esdf* filter = map_.filter();
+  KeyframeNodes* nodes = map_.nodes();
   if (k == 0) {
     // The first keyframe anchors the map at the origin.
-    if (filter) filter->initialise(esdf::Vec3::Zero(), esdf::Mat3::Identity() * 1e-9);
+    if (filter) {
+      filter->initialise(esdf::Vec3::Zero(), esdf::Mat3::Identity() * 1e-9);
+      nodes->addFirst();
+    }
   } else {
     const Eigen::Matrix3d info = constraint.cov.inverse();
     map_.addEdge({from, k, constraint.z, info, false});
     if (filter) {
       // ESDF prediction with augmentation: the keyframe becomes a delayed pose, O(1); then the
-      // recent poses are recovered (a bounded window: constant time between closures).
-      filter->augmentRelative(static_cast<int>(from), esdf::toVec(constraint.z), info);
-      filter->recoverRecent(std::max(0, static_cast<int>(k) - options_.estimator.recent_window));
-      dirty_since_recovery_ = true;
+      // recent poses are recovered (a bounded window: constant time between closures). On mapped
+      // ground (a reduced pose graph) it hangs from a pose there instead, the filter unchanged.
+      if (nodes->add(from, esdf::toVec(constraint.z), info)) {
+        filter->recoverRecent(std::max(0, filter->size() - 1 - options_.estimator.recent_window));
+        dirty_since_recovery_ = true;
+      }
     }
   }
-  kf.pose = filter ? esdf::toPose(filter->mean(static_cast<int>(k)))
-                   : (k == 0 ? common::Pose2{} : common::compose(map_.keyframes()[from].pose, constraint.z));
+  kf.pose = filter ? esdf::toPose(nodes->mean(k)) : (k == 0 ? common::Pose2{} : common::compose(map_.keyframes()[from].pose, constraint.z));
   // Window recovery moved the last `recent_window` keyframes too.
   const size_t window = static_cast<size_t>(options_.estimator.recent_window);
   if (filter && k > 0) map_.pullPoses(k > window ? k - window : 0);
   map_.addKeyframe(std::move(kf), std::move(scan));
   std::array<double, 9> c{};
   if (filter && k > 0) {
-    const esdf::Mat3 m = filter->marginalCovariance(static_cast<int>(k), esdf::CovarianceMode::Conservative);
+    const esdf::Mat3 m = nodes->marginalCovariance(k, esdf::CovarianceMode::Conservative);
     for (int i = 0; i < 9; ++i) c[static_cast<size_t>(i)] = m(i / 3, i % 3);
   }
   return c;
@@ -110,13 +115,33 @@ void GlobalSlam::closureAdded(size_t current, SteadyTime handed_over) {
     recoverAll(false);
     return;
   }
-  const size_t window = static_cast<size_t>(options_.estimator.recent_window);
-  const size_t first = map_.size() > window ? map_.size() - window : 0;
-  map_.filter()->recoverRecent(static_cast<int>(first));
+  recoverRecent();
+}
+
+void GlobalSlam::recoverRecent() {
+  const int window = options_.estimator.recent_window;
+  const int nodes = map_.filter()->size();
+  map_.filter()->recoverRecent(nodes > window ? nodes - window : 0);
+  const size_t first = map_.size() > static_cast<size_t>(window) ? map_.size() - static_cast<size_t>(window) : 0;
   map_.pullPoses(first);
 }
 
+void GlobalSlam::settleTail() {
+  KeyframeNodes* nodes = map_.nodes();
+  if (!nodes || nodes->tailSize() == 0) return;
+  // The tail waits while one of its keyframes has a closure awaiting confirmation (the window
+  // bounds how long); otherwise the vehicle has left mapped ground, or its closures failed: the
+  // tail's keyframes get poses of their own, linked as they came.
+  const size_t first = map_.size() - nodes->tailSize();
+  const bool awaited = std::any_of(pending_.begin(), pending_.end(), [&](const LoopClosureRecord& p) { return p.to >= first; });
+  if (awaited && nodes->tailSize() <= static_cast<size_t>(options_.loop_closure.confirm_window) + 1) return;
+  nodes->promoteTail();
+  dirty_since_recovery_ = true;
+  recoverRecent();
+}
+
 void GlobalSlam::reportClosure(const LoopClosureRecord& r) {
+  if (r.accepted && !r.bearing_only && map_.nodes()) map_.nodes()->closed(r.from, r.to, esdf::toVec(r.measurement), r.information.inverse());
   ++(r.accepted ? stats_.closures_accepted : stats_.closures_rejected);
   closures_.push_back(r);
   const LoopClosureEvent e{r.from, r.to, r.to_time, r.detector, r.score, r.accepted, reasonName(r.reason)};
@@ -192,8 +217,7 @@ GlobalSlam::Admission GlobalSlam::admit(LoopClosureRecord r, size_t current, Mea
 GlobalSlam::Admission GlobalSlam::commit(std::initializer_list<LoopClosureRecord*> records) {
   bool accepted = false;
   for (LoopClosureRecord* c : records) {
-    const auto res = map_.filter()->observeRelative(static_cast<int>(c->from), static_cast<int>(c->to), esdf::toVec(c->measurement),
-                                                    c->information, true);
+    const auto res = map_.nodes()->observeRelative(c->from, c->to, esdf::toVec(c->measurement), c->information, true);
     c->accepted = res.accepted;
     c->mahalanobis2 = res.gate.mahalanobis2;
     if (!res.accepted) {
@@ -227,15 +251,19 @@ bool GlobalSlam::cameraConfirms(const LoopClosureRecord& r, const std::optional<
 }
 
 void GlobalSlam::closeLoops(size_t current, SteadyTime handed_over) {
-  if (!map_.filter() || !options_.loop_closure.enabled || current % static_cast<size_t>(options_.loop_closure.every_n_keyframes) != 0)
-    return;
+  if (map_.filter() && options_.loop_closure.enabled && current % static_cast<size_t>(options_.loop_closure.every_n_keyframes) == 0)
+    searchLoops(current, handed_over);
+  settleTail();
+}
+
+void GlobalSlam::searchLoops(size_t current, SteadyTime handed_over) {
   common::Stopwatch sw;
   expirePending(current);
   // 6. Candidates: initial set near the estimate, final set by Mahalanobis distance, and where
   // the estimate is too uncertain the classifier's detections (keyframes with scans only:
   // alignment needs both).
   std::vector<Candidate> cands;
-  if (map_.keyframes()[current].hasScan()) cands = closer_.candidates(*map_.filter(), map_, current, !pending_.empty());
+  if (map_.keyframes()[current].hasScan()) cands = closer_.candidates(*map_.nodes(), map_, current, !pending_.empty());
   std::vector<size_t> keyframes;
   for (const Candidate& c : cands) keyframes.push_back(c.keyframe);
   for (auto* o : observers_) o->onCandidates({current, &keyframes});
@@ -245,7 +273,7 @@ void GlobalSlam::closeLoops(size_t current, SteadyTime handed_over) {
     // 7-9. Alignment and gating (the update itself waits for a confirmation).
     ++stats_.closures_tried;
     const Detection* detection = c.detection ? &*c.detection : nullptr;
-    if (admit(closer_.tryClose(*map_.filter(), map_, c.keyframe, current, !confirm, detection), current) == Admission::Accepted) {
+    if (admit(closer_.tryClose(*map_.nodes(), map_, c.keyframe, current, !confirm, detection), current) == Admission::Accepted) {
       accepted = true;
       break;  // one closure per keyframe; the next keyframe sees the corrected map
     }
@@ -261,7 +289,7 @@ void GlobalSlam::addPlaceFix(size_t earlier, size_t current, const common::Pose2
   if (!map_.filter()) return;
   ++stats_.closures_tried;
   const Detection detection{detector, score};
-  LoopClosureRecord r = closer_.tryCloseMeasured(*map_.filter(), map_, earlier, current, esdf::toVec(z), information, true, detection);
+  LoopClosureRecord r = closer_.tryCloseMeasured(*map_.nodes(), map_, earlier, current, esdf::toVec(z), information, true, detection);
   if (r.accepted) map_.addEdge({earlier, current, r.measurement, r.information, true});
   reportClosure(r);
   if (r.accepted) closureAdded(current, std::chrono::steady_clock::now());
@@ -289,6 +317,7 @@ void GlobalSlam::recoverAll(bool converge) {
   PosesUpdatedEvent e{&poses};
   e.recovery_ms = sw.milliseconds();
   e.map_factorisations = map_.filter()->factorisations();
+  e.filter_poses = map_.filter()->size();
   if (unrecovered_closure_) {
     e.keyframe = unrecovered_closure_->first;
     e.latency_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - unrecovered_closure_->second).count();
@@ -299,7 +328,7 @@ void GlobalSlam::recoverAll(bool converge) {
 }
 
 bool GlobalSlam::allowsFullCameraPose(size_t earlier, size_t current) {
-  esdf::Esdf* f = map_.filter();
+  KeyframeNodes* f = map_.nodes();
   return f && esdf::largestPositionSigma(closer_.relativeCovariance(*f, earlier, current)) <= options_.loop_closure.appearance_min_sigma_m;
 }
 
@@ -317,7 +346,7 @@ void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double scor
     expirePending(current);
     const bool confirm = options_.loop_closure.confirm_window > 0;
     const Detection detection{Proposer::Image, score};
-    esdf::Esdf& f = *map_.filter();
+    KeyframeNodes& f = *map_.nodes();
     LoopClosureRecord r;
     std::optional<CameraPairView> view;
     if (scans) {
@@ -326,7 +355,7 @@ void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double scor
     } else {
       CameraMeasurement m = *camera;
       if (m.metric.valid && !allowsFullCameraPose(earlier, current)) m.metric.valid = false;
-      const esdf::RelativeFactor factor = cameraFactor(m, f.mean(static_cast<int>(earlier)), f.mean(static_cast<int>(current)));
+      const esdf::RelativeFactor factor = cameraFactor(m, f.mean(earlier), f.mean(current));
       r = closer_.tryCloseMeasured(f, map_, earlier, current, factor.z, factor.omega, !confirm, detection, &m);
     }
     ++stats_.closures_tried;

@@ -78,18 +78,18 @@ void LoopCloser::setScorer(CandidateScorer scorer) { scorer_ = std::move(scorer)
 
 // Covariance of the relative pose ⊖x_i ⊕ x_k from the (conservative) joint covariance. Kept for
 // the current keyframe: the candidate search computes it, the alignment choice reuses it.
-Eigen::Matrix3d LoopCloser::relativeCovariance(esdf::Esdf& filter, size_t i, size_t k) {
+Eigen::Matrix3d LoopCloser::relativeCovariance(KeyframeNodes& filter, size_t i, size_t k) {
   if (cached_for_ != k) {
     cached_.clear();
     cached_for_ = k;
   }
   if (const auto it = cached_.find(i); it != cached_.end()) return it->second;
-  const Eigen::Matrix3d s = filter.relativeCovariance(static_cast<int>(i), static_cast<int>(k), esdf::CovarianceMode::Conservative);
+  const Eigen::Matrix3d s = filter.relativeCovariance(i, k, esdf::CovarianceMode::Conservative);
   cached_[i] = s;
   return s;
 }
 
-std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const Map& map, size_t current, bool confirming) {
+std::vector<Candidate> LoopCloser::candidates(KeyframeNodes& filter, const Map& map, size_t current, bool confirming) {
   const auto& keyframes = map.keyframes();
   const KeyframeGrid& grid = map.index();
   const auto& cur = keyframes[current];
@@ -97,7 +97,7 @@ std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const Map& map
   const size_t newest_allowed = current - static_cast<size_t>(options_.min_keyframe_gap);
   // Initial set: earlier keyframes within the search radius, widened by the current pose's own
   // 3-sigma position uncertainty (conservative covariance: no refactorisation).
-  const esdf::Mat3 c = filter.marginalCovariance(static_cast<int>(current), esdf::CovarianceMode::Conservative);
+  const esdf::Mat3 c = filter.marginalCovariance(current, esdf::CovarianceMode::Conservative);
   const double sigma = esdf::largestPositionSigma(c);
   const double radius = options_.search_radius_m + 3 * sigma;
   std::vector<size_t> near;
@@ -113,7 +113,7 @@ std::vector<Candidate> LoopCloser::candidates(esdf::Esdf& filter, const Map& map
   // uncertainty? d^2 = t' (J Σ J' + (R/2)^2 I)^-1 t for the relative position t.
   const double r2 = 0.25 * options_.search_radius_m * options_.search_radius_m;
   const auto mahalanobis2 = [&](size_t i) {
-    const esdf::Vec3 xi = filter.mean(static_cast<int>(i)), xk = filter.mean(static_cast<int>(current));
+    const esdf::Vec3 xi = filter.mean(i), xk = filter.mean(current);
     const Eigen::Matrix3d s = relativeCovariance(filter, i, current);
     const Eigen::Matrix2d st = s.topLeftCorner<2, 2>() + r2 * Eigen::Matrix2d::Identity();
     const Eigen::Vector2d t = esdf::between(xi, xk).head<2>();
@@ -179,9 +179,9 @@ bool LoopCloser::headingOtherWay(const Map& map, const esdf::Vec3& xi, const esd
   return *narrow_view_;
 }
 
-std::optional<size_t> LoopCloser::oppositeViewPartner(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current,
+std::optional<size_t> LoopCloser::oppositeViewPartner(KeyframeNodes& filter, const Map& map, size_t earlier, size_t current,
                                                       size_t newest_allowed) {
-  const esdf::Vec3 xi = filter.mean(static_cast<int>(earlier)), xk = filter.mean(static_cast<int>(current));
+  const esdf::Vec3 xi = filter.mean(earlier), xk = filter.mean(current);
   if (!headingOtherWay(map, xi, xk, current)) return std::nullopt;
   // Where the current laser looks: ahead of the pose. The earlier visit saw that stretch from
   // behind it, i.e. before it reached `earlier`: walk along its keyframes (both ways, the path
@@ -189,7 +189,7 @@ std::optional<size_t> LoopCloser::oppositeViewPartner(esdf::Esdf& filter, const 
   const double tx = xk(0) + options_.opposite_view_offset_m * std::cos(xk(2));
   const double ty = xk(1) + options_.opposite_view_offset_m * std::sin(xk(2));
   const auto dist = [&](size_t j) {
-    const esdf::Vec3 xj = filter.mean(static_cast<int>(j));
+    const esdf::Vec3 xj = filter.mean(j);
     return std::hypot(xj(0) - tx, xj(1) - ty);
   };
   const auto& keyframes = map.keyframes();
@@ -277,7 +277,7 @@ alignment::AlignmentResult LoopCloser::verifyAlignment(const io::LaserScan& earl
   return a;
 }
 
-LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current, bool commit,
+LoopClosureRecord LoopCloser::tryClose(KeyframeNodes& filter, const Map& map, size_t earlier, size_t current, bool commit,
                                        const Detection* detection) {
   const auto& keyframes = map.keyframes();
   LoopClosureRecord r;
@@ -288,7 +288,7 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_
   r.detector = detection ? detection->detector : Proposer::Pose;
   if (detection) r.score = detection->score;
   // Alignment from the current estimate of the relative pose.
-  const esdf::Vec3 xi = filter.mean(static_cast<int>(earlier)), xk = filter.mean(static_cast<int>(current));
+  const esdf::Vec3 xi = filter.mean(earlier), xk = filter.mean(current);
   const Eigen::Matrix3d s = relativeCovariance(filter, earlier, current);
   r.prior_sigma_m = esdf::largestPositionSigma(s);
   alignment::Method method = alignment::Method::CrfIcp;
@@ -350,9 +350,9 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_
   esdf::GateResult gate;
   if (commit) {
     gate =
-        filter.observeRelative(static_cast<int>(earlier), static_cast<int>(current), esdf::toVec(r.measurement), r.information, true).gate;
+        filter.observeRelative(earlier, current, esdf::toVec(r.measurement), r.information, true).gate;
   } else {
-    gate = filter.gateRelative(static_cast<int>(earlier), static_cast<int>(current), esdf::toVec(r.measurement), r.information);
+    gate = filter.gateRelative(earlier, current, esdf::toVec(r.measurement), r.information);
   }
   r.mahalanobis2 = gate.mahalanobis2;
   r.gate_threshold = gate.threshold;
@@ -361,7 +361,7 @@ LoopClosureRecord LoopCloser::tryClose(esdf::Esdf& filter, const Map& map, size_
   return r;
 }
 
-LoopClosureRecord LoopCloser::tryCloseMeasured(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current, const esdf::Vec3& z,
+LoopClosureRecord LoopCloser::tryCloseMeasured(KeyframeNodes& filter, const Map& map, size_t earlier, size_t current, const esdf::Vec3& z,
                                                const Eigen::Matrix3d& information, bool commit, const Detection& detection,
                                                const CameraMeasurement* camera) {
   const auto& keyframes = map.keyframes();
@@ -377,14 +377,14 @@ LoopClosureRecord LoopCloser::tryCloseMeasured(esdf::Esdf& filter, const Map& ma
   r.measurement = esdf::toPose(z);
   r.bearing_only = camera && !camera->metric.valid;
   r.information = information;
-  if (camera && nearestSceneDepth(*camera, filter.mean(static_cast<int>(earlier)), filter.mean(static_cast<int>(current)), s) >
+  if (camera && nearestSceneDepth(*camera, filter.mean(earlier), filter.mean(current), s) >
                     options_.max_scene_depth_m) {
     r.reason = ClosureReason::SceneDepth;
     return r;
   }
   const esdf::GateResult gate =
-      commit ? filter.observeRelative(static_cast<int>(earlier), static_cast<int>(current), z, information, true).gate
-             : filter.gateRelative(static_cast<int>(earlier), static_cast<int>(current), z, information);
+      commit ? filter.observeRelative(earlier, current, z, information, true).gate
+             : filter.gateRelative(earlier, current, z, information);
   r.mahalanobis2 = gate.mahalanobis2;
   r.gate_threshold = gate.threshold;
   r.accepted = gate.accepted;

@@ -7,6 +7,7 @@
 
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/esdf/PoseOps.h"
+#include "urbanslam/slam/KeyframeNodes.h"
 
 namespace urbanslam::slam {
 
@@ -14,11 +15,12 @@ namespace {
 constexpr size_t kNone = std::numeric_limits<size_t>::max();
 }  // namespace
 
-Map::Map(std::unique_ptr<esdf::Esdf> filter, double index_cell_m, size_t scan_cache_bytes, std::string spill_dir)
+Map::Map(std::unique_ptr<esdf::Esdf> filter, double index_cell_m, size_t scan_cache_bytes, std::string spill_dir, bool reduced_pose_graph)
     : scans_(scan_cache_bytes, spill_dir),
       edges_("pose graph edges", spill_dir),
       index_(index_cell_m),
       filter_(std::move(filter)),
+      nodes_(filter_ ? std::make_unique<KeyframeNodes>(*filter_, reduced_pose_graph) : nullptr),
       odometry_("odometry readings", spill_dir) {}
 
 Map::~Map() = default;
@@ -39,7 +41,7 @@ void Map::reindex() {
 }
 
 void Map::pullPoses(size_t from) {
-  for (size_t i = from; i < keyframes_.size(); ++i) keyframes_[i].pose = esdf::toPose(filter_->mean(static_cast<int>(i)));
+  for (size_t i = from; i < keyframes_.size(); ++i) keyframes_[i].pose = esdf::toPose(nodes_->mean(i));
 }
 
 void Map::addAnchor(const ScanAnchor& anchor) {

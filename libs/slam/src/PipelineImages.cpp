@@ -7,6 +7,7 @@
 
 #include "urbanslam/common/Timing.h"
 #include "urbanslam/esdf/Esdf.h"
+#include "urbanslam/slam/KeyframeNodes.h"
 #include "urbanslam/slam/Pipeline.h"
 #include "urbanslam/vision_loop/LoopDetector.h"
 #include "urbanslam/vision_loop/PlanarRelativePose.h"
@@ -144,7 +145,7 @@ void Pipeline::attachImage(const AssignedImage& assigned, std::optional<Prepared
 }
 
 void Pipeline::measureLength(size_t earlier_image, size_t current_image, CameraMeasurement& m) {
-  esdf::Esdf* filter = map_.filter();
+  KeyframeNodes* filter = map_.nodes();
   if (!options_.image_loop.metric_pose || !filter) return;
   // The earlier keyframe's neighbour in the same visit: the next image, else the previous, of a
   // keyframe at most twice kImageReachKeyframes away (with a laser, the images fall between its
@@ -168,7 +169,7 @@ void Pipeline::measureLength(size_t earlier_image, size_t current_image, CameraM
   if (!(baseline > 0)) return;
   const common::Pose2 rel = common::between(kf[a].pose, kf[image_keyframes_[n]].pose);
   const Eigen::Matrix3d cov =
-      filter->relativeCovariance(static_cast<int>(a), static_cast<int>(image_keyframes_[n]), esdf::CovarianceMode::Conservative);
+      filter->relativeCovariance(a, image_keyframes_[n], esdf::CovarianceMode::Conservative);
   const double len = std::max(1e-9, std::hypot(rel.x, rel.y));
   const Eigen::Vector2d dir(rel.x / len, rel.y / len);
   const double sigma = std::sqrt(std::max(0.0, dir.dot(cov.topLeftCorner<2, 2>() * dir)));

@@ -13,6 +13,7 @@
 #include "urbanslam/common/Error.h"
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/laser_loop/LoopDetector.h"
+#include "urbanslam/slam/KeyframeNodes.h"
 #include "urbanslam/slam/MapFile.h"
 #include "urbanslam/slam/Pipeline.h"
 #include "urbanslam/vision_loop/LoopDetector.h"
@@ -652,7 +653,10 @@ void Pipeline::writeStateNow(BinaryWriter& w) const {
 
   w.beginSection(kFilterTag);
   w.boolean(map_.filter() != nullptr);
-  if (map_.filter()) map_.filter()->writeState(w);
+  if (map_.filter()) {
+    map_.filter()->writeState(w);
+    map_.nodes()->writeState(w);
+  }
   w.endSection();
 
   w.beginSection(kLocalTag);
@@ -694,9 +698,11 @@ void Pipeline::readState(BinaryReader& r, std::uint32_t format_version, bool con
     if (has_filter != (map_.filter() != nullptr))
       s.fail(has_filter ? "it holds a filter, but [estimator] type is dead_reckoning" : "it holds no filter, but [estimator] type is esdf");
     if (map_.filter()) {
-      map_.filter()->readState(s, format_version >= 9);
-      if (static_cast<size_t>(map_.filter()->size()) != map_.size())
-        s.fail("a filter of " + std::to_string(map_.filter()->size()) + " poses for " + std::to_string(map_.size()) + " keyframes");
+      map_.filter()->readState(s, format_version >= 9, format_version >= 10);
+      if (format_version >= 10)
+        map_.nodes()->readState(s, map_.size());
+      else
+        map_.nodes()->readOwnPoses(s, map_.size());
     }
     s.expectEnd();
   }

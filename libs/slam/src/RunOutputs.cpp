@@ -203,6 +203,9 @@ common::Json writeRunOutputs(const Pipeline& p, const std::string& dir, const Ru
   // Factorisations of the whole map (full recoveries, exact covariances): the work that grows with
   // it. This run's only: a resumed map's earlier sessions are not counted.
   c["map_factorisations"] = p.map().filter() ? p.map().filter()->factorisations() : 0;
+  // Poses in the filter: one per keyframe, fewer where keyframes hang from others' (a reduced
+  // pose graph).
+  c["filter_poses"] = p.map().filter() ? p.map().filter()->size() : 0;
   c["image_keyframes"] = s.image_keyframes;
   c["image_proposals"] = s.image_proposals;
   Json& t = j["timing"];

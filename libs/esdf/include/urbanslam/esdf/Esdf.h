@@ -151,6 +151,14 @@ class Esdf {
   // to the older pose (a bound on the relative pose only, with no solve over the map).
   Mat3 relativeCovariance(int i, int j, CovarianceMode mode = CovarianceMode::Exact);
 
+  // A bound on the covariance of ⊖x_i ⊕ x_j (i != j) from the relative factors alone on the
+  // tightest path between them (a subset of the factors holds less information), found within
+  // `max_poses` settled poses and kAnchorPathLinks links: no solve over the map, for poses a few
+  // factors apart. False when no path reached the other pose. The search starts from j (or from i
+  // when the last one did) and is resumed by the next query from the same pose while the filter
+  // does not change: the candidates of one keyframe are one search.
+  bool pathRelativeCovariance(int i, int j, Mat3* cov, size_t max_poses = kAnchorPathPoses);
+
   int size() const { return state_.size(); }
   int currentPose() const { return state_.size() - 1; }
   const Vec3& mean(int i) const { return state_.mean(i); }
@@ -180,7 +188,9 @@ class Esdf {
   // Into a filter with no poses yet. Throws common::InputError (naming the reader's file) for
   // inconsistent contents. `with_updates`: the state records which factors came after the last
   // factorisation (written since map format 9; older states refactorise at the next exact query).
-  void readState(common::BinaryReader& r, bool with_updates = true);
+  // `with_lineages`: the chain's poses record the factored pose each descends from (written since
+  // map format 10; older chains all descend from the last factored pose).
+  void readState(common::BinaryReader& r, bool with_updates = true, bool with_lineages = true);
 
  private:
   struct Factor {
@@ -298,25 +308,46 @@ class Esdf {
   std::unordered_map<int, int> involved_at_;  // ... their place in involved_
   Eigen::MatrixXd involved_cov_;            // ... the blocks among them (3|involved| square)
 
-  // Conservative covariance support: for poses k >= chain_base_, x_k = Phi_k x_{base-1} + noise
-  // with accumulated noise C_k, valid while every such pose came from its predecessor.
+  // Conservative covariance support: for poses k >= chain_base_, x_k = Phi_k x_r + noise with
+  // accumulated noise C_k, where r (chain_root_) is a factored pose: the chain descends from
+  // the last factored pose base-1, and a pose added from another factored pose starts a lineage
+  // of its own from that one (a keyframe leaving mapped ground in a reduced pose graph). Each
+  // pose comes from its predecessor or from a factored pose; the noises of two lineages are
+  // independent. chain_lineage_: the lineage's first pose.
   int chain_base_ = 0;
   std::vector<Mat3> chain_phi_, chain_cov_;
+  std::vector<int> chain_root_, chain_lineage_;
   bool chain_valid_ = true;
   Eigen::MatrixXd base_columns_;          // stale Sigma(:, base-1), from the last full factorisation
+  std::unordered_map<int, Eigen::MatrixXd> root_columns_;  // ... and Sigma(:, r) of the other lineages' roots
+  static constexpr size_t kMaxLineages = 8;  // beyond, refactorising is cheaper than their column solves
+  // Sigma(:, r) of the last full factorisation for a lineage's root r.
+  const Eigen::MatrixXd& rootColumns(int r);
   std::vector<Mat3> factored_marginals_;  // Sigma(p, p) of the factored poses (empty: not yet computed)
   ChainAnchor anchor_;
   size_t anchor_factors_ = 0;                        // factors_.size() when anchor_ was looked for ...
   int anchor_base_ = -1;                             // ... and chain_base_ then
-  std::unordered_map<int, PathBound> anchor_paths_;  // from anchor_paths_from_, within the factored poses
   struct PathEntry {
     double spread;
     int pose, links;
     bool operator>(const PathEntry& o) const { return spread > o.spread; }
   };
-  std::priority_queue<PathEntry, std::vector<PathEntry>, std::greater<PathEntry>> anchor_open_;  // the path search, resumed
-  std::unordered_set<int> anchor_settled_;                                                       // when a pose is asked
+  // A search for the tightest paths from one pose (Dijkstra on the accumulated position spread),
+  // resumed as more poses are asked for.
+  struct PathSearch {
+    int from = -1;
+    std::uint64_t stamp = 0;  // pathRelativeCovariance's: values_stamp_ when started
+    std::unordered_map<int, PathBound> paths;
+    std::unordered_set<int> settled;
+    std::priority_queue<PathEntry, std::vector<PathEntry>, std::greater<PathEntry>> open;
+    void start(int pose);
+  };
+  // Settles poses of `s` until `to` is settled, the search runs out or `max_poses` are settled,
+  // over paths of at most kAnchorPathLinks factors through poses below `below`.
+  void searchPaths(PathSearch& s, int to, size_t max_poses, int below);
+  PathSearch anchor_search_;  // from anchor_paths_from_, within the factored poses
   int anchor_paths_from_ = -1, anchor_paths_base_ = -1;
+  PathSearch path_search_;  // pathRelativeCovariance's, kept while values_stamp_ stays
   std::vector<std::vector<int>> factors_of_pose_;  // the factors touching each pose (anchorPath's graph) ...
   size_t factors_indexed_ = 0;                     // ... for factors_[0, this)
 };

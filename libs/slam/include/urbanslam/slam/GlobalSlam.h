@@ -109,6 +109,13 @@ class GlobalSlam {
   // After an accepted closure of keyframe `current`: a full recovery when the map has grown
   // enough since the last one ([estimator] full_recovery_min_growth), else the recent poses.
   void closureAdded(size_t current, SteadyTime handed_over);
+  // Candidates, alignment, gating and confirmation for keyframe `current`.
+  void searchLoops(size_t current, SteadyTime handed_over);
+  // The newest filter poses recovered ([estimator] recent_window), the newest keyframes' poses
+  // pulled.
+  void recoverRecent();
+  // The tail's keyframes get poses of their own unless one of them awaits a confirmation.
+  void settleTail();
   // Full recovery: the factors the last one moved relinearised, then [estimator]
   // full_recovery_steps Gauss-Newton steps or (`converge`, the run's last) steps until nothing
   // moves; the latency of the oldest closure it brings into the whole map is recorded.

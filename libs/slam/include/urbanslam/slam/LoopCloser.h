@@ -20,6 +20,7 @@
 #include "urbanslam/io/SpillLog.h"
 #include "urbanslam/slam/CameraClosure.h"
 #include "urbanslam/slam/KeyframeGrid.h"
+#include "urbanslam/slam/KeyframeNodes.h"
 #include "urbanslam/slam/PipelineOptions.h"
 #include "urbanslam/slam/Proposer.h"
 
@@ -121,19 +122,29 @@ class LoopCloser {
   // classifier's detections follow, best first and one per place (search_radius_m apart).
   // `confirming`: a closure hypothesis waits for its confirmation, which only the next
   // keyframes' searches can bring, so they search at every keyframe.
-  std::vector<Candidate> candidates(esdf::Esdf& filter, const Map& map, size_t current, bool confirming = false);
+  std::vector<Candidate> candidates(KeyframeNodes& filter, const Map& map, size_t current, bool confirming = false);
   // Alignment and gating of one candidate. With `commit`, a closure that passes is
   // added to the filter; without, it is only tested (accepted = passed) for later confirmation.
-  LoopClosureRecord tryClose(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current, bool commit = true,
+  LoopClosureRecord tryClose(KeyframeNodes& filter, const Map& map, size_t earlier, size_t current, bool commit = true,
                              const Detection* detection = nullptr);
   // Gating (and with `commit` the update) of a relative-pose factor measured by another sensor
   // in place of a scan alignment. With `camera` (the images that measured it: CameraClosure.h),
   // first the scene's depth: a monocular pair fixes its scene up to the baseline, and at the
   // distance the estimate puts between the cameras it must lie within max_scene_depth_m
   // (nearestSceneDepth; reason SceneDepth, not gated).
-  LoopClosureRecord tryCloseMeasured(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current, const esdf::Vec3& z,
+  LoopClosureRecord tryCloseMeasured(KeyframeNodes& filter, const Map& map, size_t earlier, size_t current, const esdf::Vec3& z,
                                      const Eigen::Matrix3d& information, bool commit, const Detection& detection,
                                      const CameraMeasurement* camera = nullptr);
+  // The same over a filter whose poses are the keyframes, one each.
+  std::vector<Candidate> candidates(esdf::Esdf& filter, const Map& map, size_t current, bool confirming = false) {
+    KeyframeNodes nodes(filter, false);
+    return candidates(nodes, map, current, confirming);
+  }
+  LoopClosureRecord tryClose(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current, bool commit = true,
+                             const Detection* detection = nullptr) {
+    KeyframeNodes nodes(filter, false);
+    return tryClose(nodes, map, earlier, current, commit, detection);
+  }
 
   // The checks of a closure that need no estimate, for two scans aligned from `guess` by
   // `method`: the alignment's residual and matched share, the ambiguity restarts as far as
@@ -151,7 +162,7 @@ class LoopCloser {
   void writeState(common::BinaryWriter& w) const;
   void readState(common::BinaryReader& r);
   // Covariance of the relative pose ⊖x_i ⊕ x_k (conservative), kept for the current keyframe k.
-  Eigen::Matrix3d relativeCovariance(esdf::Esdf& filter, size_t i, size_t k);
+  Eigen::Matrix3d relativeCovariance(KeyframeNodes& filter, size_t i, size_t k);
 
  private:
   LoopClosureOptions options_;
@@ -164,7 +175,7 @@ class LoopCloser {
 
   // For a candidate heading the other way, the keyframe of its visit whose view meets the current
   // scan's ([loop_closure] opposite_view_offset_m); none when the candidate stays.
-  std::optional<size_t> oppositeViewPartner(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current, size_t newest_allowed);
+  std::optional<size_t> oppositeViewPartner(KeyframeNodes& filter, const Map& map, size_t earlier, size_t current, size_t newest_allowed);
   // Whether the pair (estimates xi, xk) heads more than 90° apart with a laser well short of the
   // full circle (opposite_view_offset_m on): the candidates it changes and the check it adds.
   bool headingOtherWay(const Map& map, const esdf::Vec3& xi, const esdf::Vec3& xk, size_t current);

@@ -28,6 +28,8 @@ class Esdf;
 
 namespace urbanslam::slam {
 
+class KeyframeNodes;
+
 // What the map appends to per keyframe, up to millions of entries: a deque grows by fixed blocks,
 // where a vector's doubling leaves up to half its capacity unused and, while it moves to a new
 // buffer, holds three times its size at once.
@@ -76,9 +78,10 @@ class Map {
  public:
   // `filter`: the estimator behind the poses (nullptr: dead reckoning, poses composed from the
   // constraints). `index_cell_m`: the spatial index's cell. `scan_cache_bytes`, `spill_dir`: the
-  // scan store's memory bound and spill folder (io::ScanStore).
+  // scan store's memory bound and spill folder (io::ScanStore). `reduced_pose_graph`: keyframes
+  // may hang from the filter poses of others (KeyframeNodes.h).
   Map(std::unique_ptr<esdf::Esdf> filter, double index_cell_m, size_t scan_cache_bytes = io::ScanStore::kDefaultCacheBytes,
-      std::string spill_dir = {});
+      std::string spill_dir = {}, bool reduced_pose_graph = false);
   ~Map();
 
   const PerKeyframe<Keyframe>& keyframes() const { return keyframes_; }
@@ -104,7 +107,11 @@ class Map {
 
   esdf::Esdf* filter() { return filter_.get(); }
   const esdf::Esdf* filter() const { return filter_.get(); }
-  // Copies the filter's current means of keyframes [from, size()) into their poses.
+  // Which filter pose each keyframe is, and the filter read and updated by keyframe (nullptr
+  // without a filter).
+  KeyframeNodes* nodes() { return nodes_.get(); }
+  const KeyframeNodes* nodes() const { return nodes_.get(); }
+  // Copies the filter's current estimates of keyframes [from, size()) into their poses.
   void pullPoses(size_t from = 0);
 
   // The trajectory at sensor times.
@@ -145,6 +152,7 @@ class Map {
   GraphEdgeLog edges_;
   KeyframeGrid index_;
   std::unique_ptr<esdf::Esdf> filter_;
+  std::unique_ptr<KeyframeNodes> nodes_;
   PerKeyframe<ScanAnchor> anchors_;
   // Several per keyframe, read only when the trajectory is written: all but the newest wait in a
   // spill file.

@@ -20,11 +20,12 @@
 namespace urbanslam::slam {
 
 constexpr const char* kMapFileName = "map.usmap";
-constexpr std::uint32_t kMapFormatVersion = 9;
+constexpr std::uint32_t kMapFormatVersion = 10;
 // Version 3 files (no separate maps), 4 (no heading corrections of local SLAM), 5 (no record of
 // which camera closures measured bearing and heading only), 6 (no record of what confirmed a
-// closure), 7 (every step's duration instead of their histograms) and 8 (no record of the
-// filter's factors since its last factorisation) are read as well.
+// closure), 7 (every step's duration instead of their histograms), 8 (no record of the
+// filter's factors since its last factorisation) and 9 (every keyframe a filter pose of its own)
+// are read as well.
 constexpr std::uint32_t kOldestMapFormatVersion = 3;
 
 // The map of the pipeline's current state written to `out` from its start, streamed (the

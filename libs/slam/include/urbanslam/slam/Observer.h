@@ -38,6 +38,8 @@ struct PosesUpdatedEvent {
   double recovery_ms = 0;
   // Factorisations of the whole map so far (recoveries and exact covariances).
   long long map_factorisations = 0;
+  // Poses in the filter: one per keyframe, fewer where keyframes hang from others'.
+  int filter_poses = 0;
 };
 
 // A loop-closure hypothesis between the current keyframe and an earlier one, and its fate.

@@ -167,6 +167,10 @@ struct EstimatorOptions {
   // gate's exact covariances start from until the next recovery. The run's last recovery goes
   // on until nothing moves past 1 mm and 1e-4 rad.
   int full_recovery_steps = 1;
+  // A keyframe that closes with an earlier one hangs from that one's filter pose, and so do the
+  // keyframes after it until the vehicle leaves mapped ground: a pass over mapped streets adds
+  // information to the poses there instead of poses of its own (KeyframeNodes.h).
+  bool reduced_pose_graph = false;
 };
 
 struct MapOptions {
