@@ -9,7 +9,8 @@
 // what the run's data takes, against which rss_mb shows the allocator's free but kept pages); closures (accepted), attempts (candidates
 // aligned or refused, all proposers) and laser_attempts (those the laser classifier proposed: far from the map each costs CRF-match and
 // ICP); full_recoveries and full_recovery_s (global SLAM's passes over the whole map, the part of its work that grows with the map) and
-// factorisations (of the whole map, by the recoveries and the innovation gate's exact covariances, as of the last recovery).
+// factorisations (of the whole map, by the recoveries and the innovation gate's exact covariances, as of the last recovery) and filter_poses
+// (the filter's poses at the last recovery: fewer than the keyframes where they hang from others').
 #include <malloc.h>
 #include <time.h>
 #include <unistd.h>
@@ -54,7 +55,7 @@ class ProgressLog : public slam::PipelineObserver {
  public:
   ProgressLog(const std::string& path, size_t every) : csv_(path), every_(every) {
     csv_ << "keyframes,log_s,wall_s,cpu_s,front_cpu_s,rss_mb,peak_rss_mb,heap_mb,closures,attempts,laser_attempts,full_recoveries,full_"
-            "recovery_s,factorisations\n"
+            "recovery_s,factorisations,filter_poses\n"
          << std::flush;
   }
   // From the thread that reads the sensors.
@@ -63,11 +64,11 @@ class ProgressLog : public slam::PipelineObserver {
     if (e.keyframes == last_row_ || !due(e.keyframes)) return;
     last_row_ = e.keyframes;
     char row[256];
-    std::snprintf(row, sizeof row, "%zu,%.1f,%.1f,%.1f,%.1f,%.0f,%.0f,%.0f,%zu,%zu,%zu,%zu,%.1f,%lld\n", e.keyframes,
+    std::snprintf(row, sizeof row, "%zu,%.1f,%.1f,%.1f,%.1f,%.0f,%.0f,%.0f,%zu,%zu,%zu,%zu,%.1f,%lld,%d\n", e.keyframes,
                   e.timestamp - first_timestamp_, wall_.seconds(), processCpuSeconds(), threadCpuSeconds(), residentMegabytes(),
                   static_cast<double>(common::peakResidentBytes()) / (1024.0 * 1024.0), heapInUseMegabytes(), closures_.load(),
                   attempts_.load(), laser_attempts_.load(), recoveries_.load(), static_cast<double>(recovery_us_.load()) / 1e6,
-                  factorisations_.load());
+                  factorisations_.load(), filter_poses_.load());
     csv_ << row << std::flush;
   }
   // From global SLAM, which may run on its own thread.
@@ -80,6 +81,7 @@ class ProgressLog : public slam::PipelineObserver {
     ++recoveries_;
     recovery_us_ += static_cast<long long>(e.recovery_ms * 1e3);
     factorisations_ = e.map_factorisations;
+    filter_poses_ = e.filter_poses;
   }
 
  private:
@@ -92,6 +94,7 @@ class ProgressLog : public slam::PipelineObserver {
   std::atomic<size_t> closures_{0}, attempts_{0}, laser_attempts_{0}, recoveries_{0};
   std::atomic<long long> recovery_us_{0};
   std::atomic<long long> factorisations_{0};
+  std::atomic<int> filter_poses_{0};
 };
 
 }  // namespace urbanslam::bench

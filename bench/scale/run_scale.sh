@@ -8,7 +8,7 @@
 # LOGS="intel aces fr079 csail" (raw Freiburg logs, needs ../shared/data; "" for none),
 # PIPELINE_INI (the cities' pipeline configuration; default ini/default.ini).
 # Per run: OUT_DIR/NAME/ holds the run's outputs, steps.csv and step_time.png (step time against
-# the map's size) and progress.csv (CPU time, RSS, the heap in use, closures, full recoveries and factorisations every 10,000
+# the map's size) and progress.csv (CPU time, RSS, the heap in use, closures, full recoveries, factorisations and the filter's poses every 10,000
 # keyframes; while the run goes it is OUT_DIR/NAME.progress.csv, so a run stopped early still
 # tells); the cities are scored against their truth (simulate --no-rawlog writes it).
 # Prints one table: keyframes, the front end's step p50/p99/max and p99 per decade of map size,
