@@ -176,32 +176,36 @@ TEST(Recovery, MarginalsAndPairsEqualDenseInverse) {
 template <int N>
 double minEigen(const Eigen::Matrix<double, N, N>& m) { return Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, N, N>>(m).eigenvalues().minCoeff(); }
 
+// The conservative and the exact joint covariance of each pair: all conservative queries first,
+// since an exact query refactorises and so refreshes the conservative one's reference.
+std::vector<std::pair<Mat6, Mat6>> conservativeThenExact(Esdf& f, const std::vector<std::pair<int, int>>& pairs) {
+  std::vector<std::pair<Mat6, Mat6>> out;
+  for (auto [i, j] : pairs) out.push_back({f.jointCovariance(i, j, CovarianceMode::Conservative), Mat6::Zero()});
+  for (size_t k = 0; k < pairs.size(); ++k) out[k].second = f.jointCovariance(pairs[k].first, pairs[k].second, CovarianceMode::Exact);
+  return out;
+}
+
 TEST(Recovery, ConservativeCovarianceIsExactWithoutNewInformationAndAnUpperBoundWithIt) {
   LinearGraph g(33, 50, 6);
   Esdf& f = g.f;
   f.recover();  // factor of 50 poses
   // Dead reckoning beyond the factor: conservative is exact.
   for (int k = 50; k < 65; ++k) f.augmentRelative(k - 1, Vec3(1, 0, 0.05), kOdoInfo);
-  // All conservative queries first: an exact query refactorises and so refreshes the reference.
-  const std::vector<std::pair<int, int>> pairs1{{3, 20}, {10, 60}, {55, 64}, {64, 2}};
-  std::vector<Mat6> cons;
-  for (auto [i, j] : pairs1) cons.push_back(f.jointCovariance(i, j, CovarianceMode::Conservative));
-  for (size_t k = 0; k < pairs1.size(); ++k) {
-    const Mat6 e = f.jointCovariance(pairs1[k].first, pairs1[k].second, CovarianceMode::Exact);
-    EXPECT_LT((cons[k] - e).cwiseAbs().maxCoeff() / e.cwiseAbs().maxCoeff(), 1e-9) << k;
+  const auto exact = conservativeThenExact(f, {{3, 20}, {10, 60}, {55, 64}, {64, 2}});
+  for (size_t k = 0; k < exact.size(); ++k) {
+    const auto& [c, e] = exact[k];
+    EXPECT_LT((c - e).cwiseAbs().maxCoeff() / e.cwiseAbs().maxCoeff(), 1e-9) << k;
   }
   f.recover();  // new factor at 65
   for (int k = 65; k < 80; ++k) f.augmentRelative(k - 1, Vec3(1, 0, 0.05), kOdoInfo);
   // Loop closures after the factor add information: conservative >= exact (PSD difference).
   f.observeRelative(5, 79, between(f.mean(5), f.mean(79)), kLoopInfo);
   f.observeRelative(30, 70, between(f.mean(30), f.mean(70)), kLoopInfo);
-  const std::vector<std::pair<int, int>> pairs2{{5, 79}, {30, 40}, {70, 78}, {12, 66}};
-  cons.clear();
-  for (auto [i, j] : pairs2) cons.push_back(f.jointCovariance(i, j, CovarianceMode::Conservative));
-  for (size_t k = 0; k < pairs2.size(); ++k) {
-    const Mat6 e = f.jointCovariance(pairs2[k].first, pairs2[k].second, CovarianceMode::Exact);
-    EXPECT_GT(minEigen<6>(cons[k] - e), -1e-9 * e.norm()) << k;
-    EXPECT_GT((cons[k] - e).norm(), 1e-6 * e.norm()) << "closures should make a difference for pair " << k;
+  const auto bounded = conservativeThenExact(f, {{5, 79}, {30, 40}, {70, 78}, {12, 66}});
+  for (size_t k = 0; k < bounded.size(); ++k) {
+    const auto& [c, e] = bounded[k];
+    EXPECT_GT(minEigen<6>(c - e), -1e-9 * e.norm()) << k;
+    EXPECT_GT((c - e).norm(), 1e-6 * e.norm()) << "closures should make a difference for pair " << k;
   }
 }
 
@@ -423,12 +427,12 @@ TEST(Recovery, AChainLineageFromAnOlderPoseKeepsTheConservativeCovarianceExact) 
   for (int k = 57; k < 62; ++k) f.augmentRelative(k - 1, Vec3(1, 0, -0.05), kOdoInfo);
   const long long factorisations = f.factorisations();
   const std::vector<std::pair<int, int>> pairs{{56, 60}, {53, 61}, {10, 61}, {61, 61}, {58, 3}, {20, 57}, {55, 55}};
-  std::vector<Mat6> cons;
-  for (auto [i, j] : pairs) cons.push_back(f.jointCovariance(i, j, CovarianceMode::Conservative));
+  for (auto [i, j] : pairs) f.jointCovariance(i, j, CovarianceMode::Conservative);
   EXPECT_EQ(f.factorisations(), factorisations);
-  for (size_t k = 0; k < pairs.size(); ++k) {
-    const Mat6 e = f.jointCovariance(pairs[k].first, pairs[k].second, CovarianceMode::Exact);
-    EXPECT_LT((cons[k] - e).cwiseAbs().maxCoeff() / e.cwiseAbs().maxCoeff(), 1e-9) << k;
+  const auto exact = conservativeThenExact(f, pairs);
+  for (size_t k = 0; k < exact.size(); ++k) {
+    const auto& [c, e] = exact[k];
+    EXPECT_LT((c - e).cwiseAbs().maxCoeff() / e.cwiseAbs().maxCoeff(), 1e-9) << k;
   }
   f.recover();
   for (int k = 62; k < 66; ++k) f.augmentRelative(k - 1, Vec3(1, 0, 0.05), kOdoInfo);
@@ -436,12 +440,10 @@ TEST(Recovery, AChainLineageFromAnOlderPoseKeepsTheConservativeCovarianceExact) 
   f.augmentRelative(66, Vec3(1, 0, 0), kOdoInfo);
   f.observeRelative(40, 67, between(f.mean(40), f.mean(67)), kLoopInfo);
   f.observeRelative(5, 64, between(f.mean(5), f.mean(64)), kLoopInfo);
-  const std::vector<std::pair<int, int>> after{{66, 64}, {40, 67}, {12, 65}, {67, 67}};
-  cons.clear();
-  for (auto [i, j] : after) cons.push_back(f.jointCovariance(i, j, CovarianceMode::Conservative));
-  for (size_t k = 0; k < after.size(); ++k) {
-    const Mat6 e = f.jointCovariance(after[k].first, after[k].second, CovarianceMode::Exact);
-    EXPECT_GT(minEigen<6>(cons[k] - e), -1e-9 * e.norm()) << k;
+  const auto bounded = conservativeThenExact(f, {{66, 64}, {40, 67}, {12, 65}, {67, 67}});
+  for (size_t k = 0; k < bounded.size(); ++k) {
+    const auto& [c, e] = bounded[k];
+    EXPECT_GT(minEigen<6>(c - e), -1e-9 * e.norm()) << k;
   }
 }
 
