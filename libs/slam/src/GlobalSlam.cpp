@@ -72,8 +72,9 @@ std::array<double, 9> GlobalSlam::addKeyframeFrom(size_t from, Keyframe kf, io::
     map_.addEdge({from, k, constraint.z, info, false});
     if (filter) {
       // ESDF prediction with augmentation: the keyframe becomes a delayed pose, O(1); then the
-      // recent poses are recovered (a bounded window: constant time between closures). On mapped
-      // ground (a reduced pose graph) it hangs from a pose there instead, the filter unchanged.
+      // recent poses are recovered (a bounded window: constant time between closures). In a
+      // reduced pose graph three keyframes in four hang from the newest pose instead, the filter
+      // unchanged.
       if (nodes->add(from, esdf::toVec(constraint.z), info)) {
         filter->recoverRecent(std::max(0, filter->size() - 1 - options_.estimator.recent_window));
         dirty_since_recovery_ = true;
@@ -126,22 +127,7 @@ void GlobalSlam::recoverRecent() {
   map_.pullPoses(first);
 }
 
-void GlobalSlam::settleTail() {
-  KeyframeNodes* nodes = map_.nodes();
-  if (!nodes || nodes->tailSize() == 0) return;
-  // The tail waits while one of its keyframes has a closure awaiting confirmation (the window
-  // bounds how long); otherwise the vehicle has left mapped ground, or its closures failed: the
-  // tail's keyframes get poses of their own, linked as they came.
-  const size_t first = map_.size() - nodes->tailSize();
-  const bool awaited = std::any_of(pending_.begin(), pending_.end(), [&](const LoopClosureRecord& p) { return p.to >= first; });
-  if (awaited && nodes->tailSize() <= static_cast<size_t>(options_.loop_closure.confirm_window) + 1) return;
-  nodes->promoteTail();
-  dirty_since_recovery_ = true;
-  recoverRecent();
-}
-
 void GlobalSlam::reportClosure(const LoopClosureRecord& r) {
-  if (r.accepted && !r.bearing_only && map_.nodes()) map_.nodes()->closed(r.from, r.to, esdf::toVec(r.measurement), r.information.inverse());
   ++(r.accepted ? stats_.closures_accepted : stats_.closures_rejected);
   closures_.push_back(r);
   const LoopClosureEvent e{r.from, r.to, r.to_time, r.detector, r.score, r.accepted, reasonName(r.reason)};
@@ -253,7 +239,6 @@ bool GlobalSlam::cameraConfirms(const LoopClosureRecord& r, const std::optional<
 void GlobalSlam::closeLoops(size_t current, SteadyTime handed_over) {
   if (map_.filter() && options_.loop_closure.enabled && current % static_cast<size_t>(options_.loop_closure.every_n_keyframes) == 0)
     searchLoops(current, handed_over);
-  settleTail();
 }
 
 void GlobalSlam::searchLoops(size_t current, SteadyTime handed_over) {

@@ -2,6 +2,7 @@
 
 #include <Eigen/LU>
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -40,95 +41,35 @@ KeyframeNodes::Hang KeyframeNodes::beyond(const Hang& h, const Vec3& z, const Ma
 }
 
 void KeyframeNodes::addFirst() {
-  if (reduced_) hangs_.push_back(Hang{filter_.size() - 1, false, Vec3::Zero(), Mat3::Zero()});
+  if (!reduced_) return;
+  hangs_.push_back(Hang{filter_.size() - 1, false, Vec3::Zero(), Mat3::Zero()});
+  uses_.push_back(0);
 }
 
-void KeyframeNodes::addOwn(size_t from, const Vec3& z, const Mat3& omega) {
+bool KeyframeNodes::add(size_t from, const Vec3& z, const Mat3& omega) {
   if (!reduced_) {
     filter_.augmentRelative(static_cast<int>(from), z, omega);
-    return;
+    return true;
+  }
+  if (from + 1 == size() && tail_ + 1 < kKeyframesPerPose) {
+    hangs_.push_back(beyond(hangs_.at(from), z, omega.inverse()));
+    ++tail_;
+    return false;
   }
   const Hang& f = hangs_.at(from);
   if (!f.hung) {
     filter_.augmentRelative(f.node, z, omega);
   } else {
-    const Hang h = beyond(f, z, omega.inverse());
+    // The link to the new pose: the group's constraints composed, with the share of their
+    // information that closures of the group's hung keyframes do not take (kReserved).
+    Hang h = beyond(f, z, omega.inverse());
+    h.cov /= 1 - kReserved;
     filter_.augmentRelative(h.node, h.offset, addedToRight(h.offset, h.cov).inverse());
   }
   hangs_.push_back(Hang{filter_.size() - 1, false, Vec3::Zero(), Mat3::Zero()});
-}
-
-bool KeyframeNodes::add(size_t from, const Vec3& z, const Mat3& omega) {
-  const bool after_closure = newest_closed_ && newest_closed_to_ == from && from + 1 == size();
-  newest_closed_ = false;
-  if (!reduced_ || !(hung(from) || after_closure)) {
-    addOwn(from, z, omega);
-    return true;
-  }
-  hangs_.push_back(beyond(hangs_[from], z, omega.inverse()));
-  tail_.push_back(Link{from, z, omega});
-  return false;
-}
-
-void KeyframeNodes::closed(size_t earlier, size_t k, const Vec3& z, const Mat3& cov) {
-  if (!reduced_ || earlier >= k || inTail(earlier)) return;
-  if (!inTail(k)) {
-    // The newest keyframe, with a pose of its own, on mapped ground: the next hangs from it.
-    if (!hung(k) && k + 1 == size()) {
-      newest_closed_ = true;
-      newest_closed_to_ = k;
-    }
-    return;
-  }
-  hangs_[k] = fused(hangs_[k], beyond(hangs_[earlier], z, cov));
-  // The tail after k follows it by local SLAM's constraints.
-  const size_t first = size() - tail_.size();
-  for (size_t t = k + 1; t < size(); ++t) {
-    const Link& l = tail_[t - first];
-    hangs_[t] = beyond(hangs_[l.from], l.z, l.omega.inverse());
-  }
-  tail_.erase(tail_.begin(), tail_.begin() + static_cast<std::ptrdiff_t>(k + 1 - first));
-}
-
-KeyframeNodes::Hang KeyframeNodes::fused(const Hang& motion, const Hang& closure) {
-  // Local SLAM's chain places a keyframe relative to its predecessor far better than a closure
-  // does (on the cities a closure's position variance is 36 times a step's, median), so the
-  // keyframe hangs from the closure's pose where both put it, each weighed by its covariance
-  // (a Kalman update of the offset). The chain's offset is carried into that pose's frame by the
-  // two filter poses' estimates, their relative uncertainty from the factors between them.
-  Hang out = closure;
-  Vec3 predicted = motion.offset;
-  Mat3 predicted_cov = motion.cov;
-  if (motion.node != closure.node) {
-    Mat3 r_cov;
-    if (!filter_.pathRelativeCovariance(closure.node, motion.node, &r_cov)) return closure;
-    const Vec3 r = esdf::between(filter_.mean(closure.node), filter_.mean(motion.node));
-    Mat3 j1, j2;
-    esdf::composeJacobians(r, motion.offset, &j1, &j2);
-    predicted = esdf::compose(r, motion.offset);
-    predicted_cov = j1 * r_cov * j1.transpose() + j2 * motion.cov * j2.transpose();
-  }
-  const Mat3 gain = predicted_cov * (predicted_cov + closure.cov).inverse();
-  out.offset = predicted + gain * esdf::poseDifference(closure.offset, predicted);
-  const Mat3 c = (Mat3::Identity() - gain) * predicted_cov;
-  out.cov = 0.5 * (c + c.transpose());
-  return out;
-}
-
-void KeyframeNodes::promoteTail() {
-  const size_t first = size() - tail_.size();
-  for (size_t t = first; t < size(); ++t) {
-    const Link& l = tail_[t - first];
-    const Hang& f = hangs_[l.from];
-    if (!f.hung) {
-      filter_.augmentRelative(f.node, l.z, l.omega);
-    } else {
-      const Hang h = beyond(f, l.z, l.omega.inverse());
-      filter_.augmentRelative(h.node, h.offset, addedToRight(h.offset, h.cov).inverse());
-    }
-    hangs_[t] = Hang{filter_.size() - 1, false, Vec3::Zero(), Mat3::Zero()};
-  }
-  tail_.clear();
+  uses_.push_back(0);
+  tail_ = 0;
+  return true;
 }
 
 Vec3 KeyframeNodes::mean(size_t k) const {
@@ -165,7 +106,8 @@ Mat3 KeyframeNodes::relativeCovariance(size_t i, size_t k, esdf::CovarianceMode 
   return d_r * r_cov * d_r.transpose() + d_i * hi.cov * d_i.transpose() + b2 * hk.cov * b2.transpose();
 }
 
-void KeyframeNodes::toNodes(size_t i, size_t k, const Vec3& z, const Mat3& cov, Vec3* z_nodes, Mat3* cov_nodes) const {
+void KeyframeNodes::toNodes(size_t i, size_t k, const Vec3& z, const Mat3& cov, double scale_i, double scale_k, Vec3* z_nodes,
+                            Mat3* cov_nodes) const {
   const Hang& hi = hangs_[i];
   const Hang& hk = hangs_[k];
   // x_k = x_i ⊕ z, so x_b = x_a ⊕ (o_i ⊕ z ⊕ ⊖o_k).
@@ -176,7 +118,8 @@ void KeyframeNodes::toNodes(size_t i, size_t k, const Vec3& z, const Mat3& cov, 
   esdf::composeJacobians(v, inv_k, &d1, &d2);
   *z_nodes = esdf::compose(v, inv_k);
   const Mat3 d_z = d1 * c2, d_i = d1 * c1, d_k = d2 * esdf::inverseJacobian(hk.offset);
-  const Mat3 added = d_z * rightToAdded(z, cov) * d_z.transpose() + d_i * hi.cov * d_i.transpose() + d_k * hk.cov * d_k.transpose();
+  const Mat3 added = d_z * rightToAdded(z, cov) * d_z.transpose() + scale_i * d_i * hi.cov * d_i.transpose() +
+                     scale_k * d_k * hk.cov * d_k.transpose();
   *cov_nodes = addedToRight(*z_nodes, added);
 }
 
@@ -193,20 +136,28 @@ esdf::GateResult KeyframeNodes::gateWithinNode(size_t i, size_t k, const Vec3& z
   return esdf::mahalanobisGate(nu, s, filter_.options().chi2_gate_probability);
 }
 
+double KeyframeNodes::offsetScale(size_t k) const {
+  // The u-th closure through a group's offsets takes them with 2^(u+1) / kReserved times their
+  // covariance: the shares 1/2, 1/4, ... of the reserve, never more than it in all.
+  return hung(k) ? std::ldexp(1.0, uses_[static_cast<size_t>(hangs_[k].node)] + 1) / kReserved : 1.0;
+}
+
 esdf::ObservationResult KeyframeNodes::observeRelative(size_t i, size_t k, const Vec3& z, const Mat3& omega, bool gate) {
   if (!hung(i) && !hung(k)) return filter_.observeRelative(node(i), node(k), z, omega, gate);
-  if (hangs_[i].node == hangs_[k].node) {
-    esdf::ObservationResult r;
-    if (gate) {
-      r.gate = gateWithinNode(i, k, z, omega);
-      r.accepted = r.gate.accepted;
-    }
-    return r;
+  esdf::ObservationResult r;
+  if (gate) {
+    r.gate = gateRelative(i, k, z, omega);
+    r.accepted = r.gate.accepted;
   }
+  const double scale_i = offsetScale(i), scale_k = offsetScale(k);
+  if (!r.accepted || hangs_[i].node == hangs_[k].node || std::max(scale_i, scale_k) > kMaxOffsetScale) return r;
   Vec3 zn;
   Mat3 cn;
-  toNodes(i, k, z, omega.inverse(), &zn, &cn);
-  return filter_.observeRelative(hangs_[i].node, hangs_[k].node, zn, cn.inverse(), gate);
+  toNodes(i, k, z, omega.inverse(), scale_i, scale_k, &zn, &cn);
+  r.chi2 = filter_.observeRelative(hangs_[i].node, hangs_[k].node, zn, cn.inverse(), false).chi2;
+  for (const size_t x : {i, k})
+    if (hung(x)) ++uses_[static_cast<size_t>(hangs_[x].node)];
+  return r;
 }
 
 esdf::GateResult KeyframeNodes::gateRelative(size_t i, size_t k, const Vec3& z, const Mat3& omega) {
@@ -214,7 +165,7 @@ esdf::GateResult KeyframeNodes::gateRelative(size_t i, size_t k, const Vec3& z, 
   if (hangs_[i].node == hangs_[k].node) return gateWithinNode(i, k, z, omega);
   Vec3 zn;
   Mat3 cn;
-  toNodes(i, k, z, omega.inverse(), &zn, &cn);
+  toNodes(i, k, z, omega.inverse(), 1.0, 1.0, &zn, &cn);
   return filter_.gateRelative(hangs_[i].node, hangs_[k].node, zn, cn.inverse());
 }
 
@@ -229,34 +180,32 @@ void KeyframeNodes::writeState(common::BinaryWriter& w) const {
     w.matrix(h.offset);
     w.matrix(h.cov);
   }
-  w.size(tail_.size());
-  for (const Link& l : tail_) {
-    w.size(l.from);
-    w.matrix(l.z);
-    w.matrix(l.omega);
-  }
-  w.boolean(newest_closed_);
-  if (newest_closed_) w.size(newest_closed_to_);
+  w.size(tail_);
+  w.size(uses_.size());
+  for (const std::uint8_t u : uses_) w.u8(u);
 }
 
 void KeyframeNodes::readOwnPoses(common::BinaryReader& r, size_t keyframes) {
   if (static_cast<size_t>(filter_.size()) != keyframes)
     r.fail("a filter of " + std::to_string(filter_.size()) + " poses for " + std::to_string(keyframes) + " keyframes");
   hangs_.clear();
-  tail_.clear();
-  newest_closed_ = false;
-  if (reduced_)
-    for (size_t k = 0; k < keyframes; ++k) hangs_.push_back(Hang{static_cast<int>(k), false, Vec3::Zero(), Mat3::Zero()});
+  tail_ = 0;
+  uses_.clear();
+  if (!reduced_) return;
+  for (size_t k = 0; k < keyframes; ++k) hangs_.push_back(Hang{static_cast<int>(k), false, Vec3::Zero(), Mat3::Zero()});
+  uses_.assign(keyframes, 0);
 }
 
-void KeyframeNodes::readState(common::BinaryReader& r, size_t keyframes) {
+void KeyframeNodes::readState(common::BinaryReader& r, size_t keyframes, std::uint32_t format_version) {
   const bool reduced = r.boolean();
+  if (reduced && format_version < 11)
+    r.fail("keyframes hung from the filter's poses at their closures (map format " + std::to_string(format_version) +
+           "), which this version no longer reads: map the log again");
   if (reduced != reduced_)
-    r.fail(reduced ? "keyframes hang from mapped places, but [estimator] reduced_pose_graph is false"
+    r.fail(reduced ? "keyframes hang from others' filter poses, but [estimator] reduced_pose_graph is false"
                    : "every keyframe has a pose of its own, but [estimator] reduced_pose_graph is true");
   if (!reduced_) return readOwnPoses(r, keyframes);
   hangs_.clear();
-  tail_.clear();
   const size_t n = r.count(5);
   if (n != keyframes) r.fail(std::to_string(n) + " keyframe nodes for " + std::to_string(keyframes) + " keyframes");
   for (size_t k = 0; k < n; ++k) {
@@ -270,20 +219,13 @@ void KeyframeNodes::readState(common::BinaryReader& r, size_t keyframes) {
     }
     hangs_.push_back(h);
   }
-  const size_t t = r.count(8 + 12 * 8);
-  if (t > n) r.fail("a tail of " + std::to_string(t) + " keyframes");
-  for (size_t i = 0; i < t; ++i) {
-    Link l;
-    l.from = r.size();
-    if (l.from >= n) r.fail("a tail constraint from keyframe " + std::to_string(l.from));
-    l.z = r.matrix<3, 1>();
-    l.omega = r.matrix<3, 3>();
-    tail_.push_back(l);
-  }
-  newest_closed_ = r.boolean();
-  if (!newest_closed_) return;
-  newest_closed_to_ = r.size();
-  if (newest_closed_to_ >= n) r.fail("a closure of keyframe " + std::to_string(newest_closed_to_));
+  tail_ = r.size();
+  if (tail_ >= kKeyframesPerPose || tail_ >= n) r.fail("a tail of " + std::to_string(tail_) + " keyframes");
+  const size_t poses = r.count(1);
+  if (poses != static_cast<size_t>(filter_.size()))
+    r.fail(std::to_string(poses) + " closure counts for " + std::to_string(filter_.size()) + " filter poses");
+  uses_.clear();
+  for (size_t p = 0; p < poses; ++p) uses_.push_back(r.u8());
 }
 
 }  // namespace urbanslam::slam

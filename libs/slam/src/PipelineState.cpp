@@ -700,7 +700,7 @@ void Pipeline::readState(BinaryReader& r, std::uint32_t format_version, bool con
     if (map_.filter()) {
       map_.filter()->readState(s, format_version >= 9, format_version >= 10);
       if (format_version >= 10)
-        map_.nodes()->readState(s, map_.size());
+        map_.nodes()->readState(s, map_.size(), format_version);
       else
         map_.nodes()->readOwnPoses(s, map_.size());
     }

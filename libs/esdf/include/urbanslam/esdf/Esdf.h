@@ -311,7 +311,7 @@ class Esdf {
   // Conservative covariance support: for poses k >= chain_base_, x_k = Phi_k x_r + noise with
   // accumulated noise C_k, where r (chain_root_) is a factored pose: the chain descends from
   // the last factored pose base-1, and a pose added from another factored pose starts a lineage
-  // of its own from that one (a keyframe leaving mapped ground in a reduced pose graph). Each
+  // of its own from that one (a keyframe added from an earlier one than the newest). Each
   // pose comes from its predecessor or from a factored pose; the noises of two lineages are
   // independent. chain_lineage_: the lineage's first pose.
   int chain_base_ = 0;

@@ -114,8 +114,6 @@ class GlobalSlam {
   // The newest filter poses recovered ([estimator] recent_window), the newest keyframes' poses
   // pulled.
   void recoverRecent();
-  // The tail's keyframes get poses of their own unless one of them awaits a confirmation.
-  void settleTail();
   // Full recovery: the factors the last one moved relinearised, then [estimator]
   // full_recovery_steps Gauss-Newton steps or (`converge`, the run's last) steps until nothing
   // moves; the latency of the oldest closure it brings into the whole map is recorded.

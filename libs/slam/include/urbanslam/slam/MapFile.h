@@ -20,11 +20,12 @@
 namespace urbanslam::slam {
 
 constexpr const char* kMapFileName = "map.usmap";
-constexpr std::uint32_t kMapFormatVersion = 10;
+constexpr std::uint32_t kMapFormatVersion = 11;
 // Version 3 files (no separate maps), 4 (no heading corrections of local SLAM), 5 (no record of
 // which camera closures measured bearing and heading only), 6 (no record of what confirmed a
 // closure), 7 (every step's duration instead of their histograms), 8 (no record of the
-// filter's factors since its last factorisation) and 9 (every keyframe a filter pose of its own)
+// filter's factors since its last factorisation), 9 (every keyframe a filter pose of its own)
+// and 10 (a reduced pose graph that hung keyframes at their closures: refused when it has one)
 // are read as well.
 constexpr std::uint32_t kOldestMapFormatVersion = 3;
 

@@ -167,9 +167,9 @@ struct EstimatorOptions {
   // gate's exact covariances start from until the next recovery. The run's last recovery goes
   // on until nothing moves past 1 mm and 1e-4 rad.
   int full_recovery_steps = 1;
-  // A keyframe that closes with an earlier one hangs from that one's filter pose, and so do the
-  // keyframes after it until the vehicle leaves mapped ground: a pass over mapped streets adds
-  // information to the poses there instead of poses of its own (KeyframeNodes.h).
+  // One keyframe in four is a pose of the filter, the others hang from it by local SLAM's
+  // constraints, their closures composed with the offsets (KeyframeNodes.h): a quarter of the
+  // filter, and of the whole-map factor's fill from passes over mapped streets.
   bool reduced_pose_graph = false;
 };
 
