@@ -9,6 +9,7 @@
 #include "urbanslam/common/Progress.h"
 #include "urbanslam/sim/SimOptions.h"
 #include "urbanslam/sim/SimulatedSource.h"
+#include "urbanslam/slam/Checkpoint.h"
 #include "urbanslam/slam/MapFile.h"
 #include "urbanslam/slam/MapMerge.h"
 #include "urbanslam/slam/MapSession.h"
@@ -31,10 +32,17 @@ class ProgressObserver : public slam::PipelineObserver {
   common::ProgressBar& bar_;
 };
 
+// The same input named twice (a relative and an absolute path, a symbolic link).
+bool sameInput(const std::string& a, const std::string& b) {
+  std::error_code ea, eb;
+  const auto ca = std::filesystem::weakly_canonical(a, ea), cb = std::filesystem::weakly_canonical(b, eb);
+  return ea || eb ? a == b : ca == cb;
+}
+
 }  // namespace
 
 int runCommand(const Argv& args) {
-  ArgParser ap("urbanslam run [--ini FILE] [--out DIR] [--quiet] [--json] [--resume MAP | --map MAP] [LOG | --simulate CITY_INI]",
+  ArgParser ap("urbanslam run [--ini FILE] [--out DIR] [--quiet] [--json] [--resume MAP | --map MAP] [--checkpoint-every N [--continue]] [LOG | --simulate CITY_INI]",
                "Builds a map and trajectory from a log: MRPT rawlog (either layout, gzipped or not),\n"
                "CARMEN log (raw or Freiburg-corrected), GMapping gfs log, Victoria Park (folder or zip) or a\n"
                "folder of camera images (one keyframe per image; image loop proposals need [loop_closure] image_detector).");
@@ -58,6 +66,13 @@ int runCommand(const Argv& args) {
                "searched for again: the new session may link them. An --ini may change only [map] and\n"
                "[output] keys");
   ap.addOption("out", "DIR", "output folder (created if needed)", "out");
+  ap.addOption("checkpoint-every", "N",
+               "save the run every N keyframes to DIR.checkpoint/ (its map and how far it read LOG), so that\n"
+               "an interrupted run goes on with --continue; removed when the run completes", "0");
+  ap.addFlag("continue",
+             "go on with the interrupted run whose checkpoint is DIR.checkpoint/: the same LOG (or city) is\n"
+             "read from where the checkpoint left it, and the run ends as one never interrupted. An --ini\n"
+             "may change only [map] and [output] keys");
   ap.addFlag("quiet", "no progress bar and no summary on stderr");
   ap.addFlag("json", "print stats.json as one JSON object on stdout");
   ap.addEpilog(
@@ -76,15 +91,23 @@ int runCommand(const Argv& args) {
   if (ap.has("resume") && ap.has("map")) throw common::InputError("run: give either --resume MAP or --map MAP, not both");
   if (ap.has("map") && !ap.has("simulate") && ap.positional("LOG").empty())
     throw common::InputError("run --map: give the LOG to map into the map");
+  if (ap.flag("continue") && (ap.has("resume") || ap.has("map")))
+    throw common::InputError("run --continue: the checkpoint holds the map; give neither --resume nor --map");
+  const long every = ap.optionInt("checkpoint-every");
+  if (every < 0) throw common::InputError("run --checkpoint-every: a number of keyframes, 0 for none (got " + std::to_string(every) + ")");
+  if (every > 0 && ap.has("map")) throw common::InputError("run --map: a session joined to a map cannot be checkpointed (map its LOG alone)");
   const std::string log = ap.has("simulate")             ? ap.option("simulate")
                           : ap.positional("LOG").empty() ? defaultRawlog()
                                                          : ap.positional("LOG");
   const bool quiet = ap.flag("quiet");
+  std::string out = ap.option("out");
+  while (out.size() > 1 && out.back() == '/') out.pop_back();
+  const std::string checkpoint = slam::checkpointPath(out);
   const std::string map = ap.has("resume") ? slam::mapFilePath(ap.option("resume"))
                           : ap.has("map")  ? slam::mapFilePath(ap.option("map"))
                                            : "";
   // Resuming without --ini keeps the map's own options.
-  std::string ini = ap.has("ini") ? ap.option("ini") : map.empty() ? defaultIni() : "";
+  std::string ini = ap.has("ini") ? ap.option("ini") : map.empty() && !ap.flag("continue") ? defaultIni() : "";
   std::string resolved;
   slam::PipelineOptions options;
   if (!ini.empty()) {
@@ -98,7 +121,14 @@ int runCommand(const Argv& args) {
   // The maps of the output's map.usmap: [0] the one this run builds, then a map file's separate
   // maps (MapFile.h), carried along.
   std::vector<slam::NamedMap> maps;
-  {
+  slam::CheckpointInfo earlier;
+  if (ap.flag("continue")) {
+    slam::Checkpoint c = slam::loadCheckpoint(checkpoint, ini.empty() ? nullptr : &options);
+    if (!sameInput(c.info.input, log))
+      throw common::InputError(checkpoint + ": made from " + c.info.input + ", not from " + log + " (continue it with that input)");
+    earlier = c.info;
+    maps.push_back({std::move(c.pipeline), {c.info.resumed_map.empty() ? log : c.info.resumed_map}, 0});
+  } else {
     std::vector<std::unique_ptr<slam::Pipeline>> separate;
     maps.push_back(
         {map.empty() ? std::make_unique<slam::Pipeline>(options) : slam::loadMap(map, ini.empty() ? nullptr : &options, &separate),
@@ -108,7 +138,7 @@ int runCommand(const Argv& args) {
   }
   if (ini.empty()) {
     resolved = slam::optionsToIni(maps.front().map->options());
-    ini = map + " (its saved options)";
+    ini = (map.empty() ? checkpoint : map) + " (its saved options)";
   }
 
   // The simulator is a data source like a file reader: a drive of any length streams through.
@@ -136,13 +166,23 @@ int runCommand(const Argv& args) {
         std::cerr << "urbanslam run: " << maps.size() - 1 << " separate map" << (maps.size() > 2 ? "s" : "") << " kept in map.usmap\n";
     }
   } else {
-    maps.front().map->addObserver(&progress);
-    maps.front().map->runInput(*source);
+    slam::Pipeline& p = *maps.front().map;
+    const std::uint64_t before = p.stats().measurements - earlier.input_measurements;  // a resumed map's own
+    if (ap.flag("continue")) {
+      if (!quiet)
+        std::cerr << "urbanslam run: continuing from " << checkpoint << " (" << earlier.keyframes << " keyframes, "
+                  << earlier.input_measurements << " measurements of " << log << " read)\n";
+      slam::skipMeasurements(*source, earlier.input_measurements, log);
+    } else {
+      earlier.input = std::filesystem::absolute(log).string();
+      earlier.resumed_map = map;
+    }
+    p.addObserver(&progress);
+    slam::Checkpointer saver(checkpoint, static_cast<size_t>(every), earlier, before);
+    slam::runCheckpointed(p, *source, saver);
   }
   slam::Pipeline* const pipeline = maps.front().map.get();
   // The map is saved before finish() (StagedMapFile).
-  std::string out = ap.option("out");
-  while (out.size() > 1 && out.back() == '/') out.pop_back();
   const slam::StagedMapFile map_file(out, *pipeline, slam::separateMaps(maps));
   pipeline->finish(*source);
   bar.finish();
@@ -156,6 +196,9 @@ int runCommand(const Argv& args) {
   const slam::RunInfo info{
       log, source->format(), ini, resolved, map_file.path(), ap.has("map") && !joined ? "" : map, sessions, slam::separateMapsJson(maps)};
   const common::Json stats = slam::writeRunOutputs(*pipeline, out, info);
+  // The outputs hold the whole run now (map.usmap continues it): the checkpoint has done its job.
+  std::error_code ec;
+  if (every > 0 || ap.flag("continue")) std::filesystem::remove_all(checkpoint, ec);
   if (ap.flag("json")) std::cout << stats.dump() << "\n";
   if (!quiet) {
     const auto& t = stats.at("timing");

@@ -11,6 +11,11 @@
 // ICP); full_recoveries and full_recovery_s (global SLAM's passes over the whole map, the part of its work that grows with the map) and
 // factorisations (of the whole map, by the recoveries and the innovation gate's exact covariances, as of the last recovery) and filter_poses
 // (the filter's poses at the last recovery: fewer than the keyframes where they hang from others').
+//
+// A run continued from a checkpoint (slam/Checkpoint.h) appends to the same file: the rows written
+// after the checkpoint are dropped, and the times and counts go on from the checkpoint's totals
+// (totals()). The time spent loading the checkpoint is not counted; peak_rss_mb is then the peak
+// since the continuation.
 #include <malloc.h>
 #include <time.h>
 #include <unistd.h>
@@ -18,6 +23,8 @@
 #include <atomic>
 #include <cstdio>
 #include <fstream>
+#include <map>
+#include <sstream>
 #include <string>
 
 #include "urbanslam/common/Timing.h"
@@ -51,21 +58,65 @@ inline double heapInUseMegabytes() {
   return static_cast<double>(m.uordblks + m.hblkhd) / (1024.0 * 1024.0);
 }
 
+// Keeps the header line and the first `rows` rows of a CSV file (a continued run's, whose later
+// rows came after its checkpoint); `header` is written when the file is missing.
+inline void keepCsvRows(const std::string& path, size_t rows, const std::string& header) {
+  std::ifstream in(path);
+  std::ostringstream kept;
+  std::string line;
+  if (!std::getline(in, line)) line = header;
+  kept << line << "\n";
+  for (size_t i = 0; i < rows && std::getline(in, line); ++i) kept << line << "\n";
+  in.close();
+  std::ofstream(path, std::ios::trunc) << kept.str();
+}
+
 class ProgressLog : public slam::PipelineObserver {
  public:
-  ProgressLog(const std::string& path, size_t every) : csv_(path), every_(every) {
-    csv_ << "keyframes,log_s,wall_s,cpu_s,front_cpu_s,rss_mb,peak_rss_mb,heap_mb,closures,attempts,laser_attempts,full_recoveries,full_"
-            "recovery_s,factorisations,filter_poses\n"
-         << std::flush;
+  static constexpr const char* kHeader =
+      "keyframes,log_s,wall_s,cpu_s,front_cpu_s,rss_mb,peak_rss_mb,heap_mb,closures,attempts,laser_attempts,full_recoveries,full_"
+      "recovery_s,factorisations,filter_poses";
+  // `earlier`: a checkpoint's totals() (empty for a run from its start).
+  ProgressLog(const std::string& path, size_t every, const std::map<std::string, double>& earlier = {}) : every_(every) {
+    const auto get = [&](const char* key) {
+      const auto it = earlier.find(key);
+      return it == earlier.end() ? 0.0 : it->second;
+    };
+    keepCsvRows(path, static_cast<size_t>(get("progress_rows")), kHeader);
+    csv_.open(path, std::ios::app);
+    rows_ = static_cast<size_t>(get("progress_rows"));
+    wall0_ = get("wall_s"), cpu0_ = get("cpu_s") - processCpuSeconds(), front0_ = get("front_cpu_s") - threadCpuSeconds();
+    if (earlier.count("first_timestamp")) first_timestamp_ = get("first_timestamp");
+    closures_ = static_cast<size_t>(get("closures")), attempts_ = static_cast<size_t>(get("attempts"));
+    laser_attempts_ = static_cast<size_t>(get("laser_attempts")), recoveries_ = static_cast<size_t>(get("full_recoveries"));
+    recovery_us_ = static_cast<long long>(get("full_recovery_s") * 1e6);
+    factorisations_ = static_cast<long long>(get("factorisations")), filter_poses_ = static_cast<int>(get("filter_poses"));
+  }
+  // Everything a continued run goes on from; read while global SLAM is idle.
+  std::map<std::string, double> totals() const {
+    return {{"progress_rows", static_cast<double>(rows_)},
+            {"first_timestamp", first_timestamp_},
+            {"wall_s", wall0_ + wall_.seconds()},
+            {"cpu_s", cpu0_ + processCpuSeconds()},
+            {"front_cpu_s", front0_ + threadCpuSeconds()},
+            {"closures", static_cast<double>(closures_.load())},
+            {"attempts", static_cast<double>(attempts_.load())},
+            {"laser_attempts", static_cast<double>(laser_attempts_.load())},
+            {"full_recoveries", static_cast<double>(recoveries_.load())},
+            {"full_recovery_s", static_cast<double>(recovery_us_.load()) / 1e6},
+            {"factorisations", static_cast<double>(factorisations_.load())},
+            {"filter_poses", static_cast<double>(filter_poses_.load())}};
   }
   // From the thread that reads the sensors.
   void onStep(const slam::StepEvent& e) override {
     if (first_timestamp_ < 0) first_timestamp_ = e.timestamp;
+    last_log_s_ = e.timestamp - first_timestamp_;
     if (e.keyframes == last_row_ || !due(e.keyframes)) return;
     last_row_ = e.keyframes;
+    ++rows_;
     char row[256];
     std::snprintf(row, sizeof row, "%zu,%.1f,%.1f,%.1f,%.1f,%.0f,%.0f,%.0f,%zu,%zu,%zu,%zu,%.1f,%lld,%d\n", e.keyframes,
-                  e.timestamp - first_timestamp_, wall_.seconds(), processCpuSeconds(), threadCpuSeconds(), residentMegabytes(),
+                  last_log_s_, wall0_ + wall_.seconds(), cpu0_ + processCpuSeconds(), front0_ + threadCpuSeconds(), residentMegabytes(),
                   static_cast<double>(common::peakResidentBytes()) / (1024.0 * 1024.0), heapInUseMegabytes(), closures_.load(),
                   attempts_.load(), laser_attempts_.load(), recoveries_.load(), static_cast<double>(recovery_us_.load()) / 1e6,
                   factorisations_.load(), filter_poses_.load());
@@ -88,8 +139,8 @@ class ProgressLog : public slam::PipelineObserver {
   bool due(size_t keyframes) const { return keyframes == 100 || keyframes == 1000 || (keyframes > 0 && keyframes % every_ == 0); }
   std::ofstream csv_;
   size_t every_;
-  size_t last_row_ = 0;
-  double first_timestamp_ = -1;
+  size_t last_row_ = 0, rows_ = 0;
+  double first_timestamp_ = -1, last_log_s_ = 0, wall0_ = 0, cpu0_ = 0, front0_ = 0;
   common::Stopwatch wall_;
   std::atomic<size_t> closures_{0}, attempts_{0}, laser_attempts_{0}, recoveries_{0};
   std::atomic<long long> recovery_us_{0};

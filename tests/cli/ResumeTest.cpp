@@ -150,4 +150,64 @@ TEST(RunResume, HelpListsResume) {
   EXPECT_EQ(r.code, 0);
   EXPECT_NE(r.out.find("--resume"), std::string::npos);
   EXPECT_NE(r.out.find("map.usmap"), std::string::npos);
+  EXPECT_NE(r.out.find("--checkpoint-every"), std::string::npos);
+  EXPECT_NE(r.out.find("--continue"), std::string::npos);
+}
+
+// A run that stops on an error (here the log's copy ends in a damaged line) keeps its last
+// checkpoint; once the log is whole again, `run --continue` goes on from there and ends as one
+// run over the whole log. A run that completes leaves no checkpoint, and its outputs are those of
+// a run without checkpoints.
+TEST(RunCheckpoint, AStoppedRunContinuesFromItsCheckpoint) {
+  const fs::path dir = scratchDir("cli_checkpoint");
+  const SplitLog log = splitExcerpt(dir, 2000);
+  const std::string whole = (dir / "whole").string(), run = (dir / "run").string(), every = (dir / "every").string();
+  ASSERT_EQ(runCli("run --quiet --ini " + kIni + " --out " + whole + " " + log.whole).code, 0);
+
+  const std::string input = (dir / "log.clf").string();
+  writeFile(input, slurp(log.first) + "FLASER 181 1.0 2.0 damaged\n");
+  const CliResult stopped = runCli("run --quiet --ini " + kIni + " --checkpoint-every 30 --out " + run + " " + input);
+  EXPECT_EQ(stopped.code, 2);
+  ASSERT_TRUE(fs::exists(run + ".checkpoint/map.usmap")) << stopped.err;
+  EXPECT_FALSE(fs::exists(run));
+
+  writeFile(input, slurp(log.whole));
+  const CliResult continued = runCli("run --ini " + kIni + " --checkpoint-every 30 --continue --out " + run + " " + input);
+  ASSERT_EQ(continued.code, 0) << continued.err;
+  EXPECT_NE(continued.err.find("continuing from " + run + ".checkpoint"), std::string::npos) << continued.err;
+  EXPECT_FALSE(fs::exists(run + ".checkpoint"));
+  const auto kw = readKeyframes(whole), kr = readKeyframes(run);
+  ASSERT_EQ(kw.size(), kr.size());
+  ASSERT_GT(kw.size(), 250u);
+  for (size_t i = 0; i < kw.size(); ++i) {
+    EXPECT_EQ(kw[i].t, kr[i].t) << i;
+    EXPECT_NEAR(kw[i].x, kr[i].x, 2e-6) << i;
+    EXPECT_NEAR(kw[i].y, kr[i].y, 2e-6) << i;
+  }
+  EXPECT_EQ(closurePairs(whole), closurePairs(run));
+
+  ASSERT_EQ(runCli("run --quiet --ini " + kIni + " --checkpoint-every 50 --out " + every + " " + log.whole).code, 0);
+  EXPECT_FALSE(fs::exists(every + ".checkpoint"));
+  EXPECT_EQ(slurp(whole + "/trajectory_keyframes.tum"), slurp(every + "/trajectory_keyframes.tum"));
+}
+
+TEST(RunCheckpoint, ContinuingWhatCannotBeContinuedExitsTwo) {
+  const fs::path dir = scratchDir("cli_checkpoint_bad");
+  const SplitLog log = splitExcerpt(dir, 300);
+  const std::string out = (dir / "out").string();
+  const CliResult none = runCli("run --quiet --continue --out " + out + " " + log.first);
+  EXPECT_EQ(none.code, 2);
+  EXPECT_NE(none.err.find(out + ".checkpoint"), std::string::npos) << none.err;
+  EXPECT_EQ(runCli("run --quiet --continue --resume " + out + " --out " + out + " " + log.first).code, 2);
+  const CliResult negative = runCli("run --quiet --checkpoint-every -5 --out " + out + " " + log.first);
+  EXPECT_EQ(negative.code, 2);
+  EXPECT_NE(negative.err.find("--checkpoint-every"), std::string::npos) << negative.err;
+
+  // A checkpoint of another log: refused, naming both.
+  writeFile(dir / "first.clf", slurp(log.first) + "FLASER 181 1.0 2.0 damaged\n");
+  ASSERT_EQ(runCli("run --quiet --ini " + kIni + " --checkpoint-every 5 --out " + out + " " + (dir / "first.clf").string()).code, 2);
+  ASSERT_TRUE(fs::exists(out + ".checkpoint"));
+  const CliResult other = runCli("run --quiet --ini " + kIni + " --continue --out " + out + " " + log.rest);
+  EXPECT_EQ(other.code, 2);
+  EXPECT_NE(other.err.find("rest.clf"), std::string::npos) << other.err;
 }
