@@ -6,7 +6,9 @@
 #
 # Environment: CITIES="1 10 100" (km2), ROUTE_KM="3 10 30" (drive length per city),
 # LOGS="intel aces fr079 csail" (raw Freiburg logs, needs ../shared/data; "" for none),
-# PIPELINE_INI (the cities' pipeline configuration; default ini/default.ini).
+# PIPELINE_INI (the cities' pipeline configuration; default ini/default.ini), CHECKPOINT_EVERY=N
+# (each run saves itself every N keyframes to OUT_DIR/NAME.checkpoint/; the same command run again
+# after an interruption continues each run from its checkpoint).
 # Per run: OUT_DIR/NAME/ holds the run's outputs, steps.csv and step_time.png (step time against
 # the map's size) and progress.csv (CPU time, RSS, the heap in use, closures, full recoveries, factorisations and the filter's poses every 10,000
 # keyframes; while the run goes it is OUT_DIR/NAME.progress.csv, so a run stopped early still
@@ -29,12 +31,21 @@ LOGS=${LOGS-intel aces fr079 csail}
 D=../shared/data/freiburg_slam_benchmark/raw_logs
 mkdir -p "$OUT"
 
+# scale_bench's checkpoint arguments for run NAME: none, or every CHECKPOINT_EVERY keyframes,
+# continuing from the run's checkpoint when an interrupted earlier call left one.
+checkpointing() {
+  [ -n "${CHECKPOINT_EVERY:-}" ] || return 0
+  echo "--checkpoint-every $CHECKPOINT_EVERY"
+  [ -f "$OUT/$1.checkpoint/checkpoint.ini" ] && echo "--continue"
+  return 0
+}
+
 rows=()
 for i in "${!CITIES[@]}"; do
   a=${CITIES[$i]} km=${ROUTES[$i]} name=city-${CITIES[$i]}km2
   sed -e "s/^area_km2 .*/area_km2 = $a/" -e "s/^route_length_km .*/route_length_km = $km/" ini/city-1km2.ini > "$OUT/$name.ini"
   "$U" simulate --quiet --no-rawlog --ini "$OUT/$name.ini" --out "$OUT/$name-truth" > /dev/null
-  "$B" --city "$OUT/$name.ini" --ini "${PIPELINE_INI:-ini/default.ini}" --out "$OUT/$name" > "$OUT/$name.json"
+  "$B" --city "$OUT/$name.ini" --ini "${PIPELINE_INI:-ini/default.ini}" --out "$OUT/$name" $(checkpointing "$name") > "$OUT/$name.json"
   "$U" eval "$OUT/$name" --truth "$OUT/$name-truth" --json > "$OUT/$name.eval.json"
   rows+=("$name")
 done
@@ -42,7 +53,7 @@ declare -A FILE=([intel]=intel [aces]=aces [fr079]=fr079 [csail]=mit-csail)
 for log in $LOGS; do
   f=$D/${FILE[$log]:-$log}.clf.gz
   [ -f "$f" ] || { echo "run_scale.sh: $f not found, $log skipped" >&2; continue; }
-  "$B" --log "$f" --ini "ini/$log.ini" --out "$OUT/$log" > "$OUT/$log.json"
+  "$B" --log "$f" --ini "ini/$log.ini" --out "$OUT/$log" $(checkpointing "$log") > "$OUT/$log.json"
   rows+=("$log")
 done
 
