@@ -32,13 +32,6 @@ class ProgressObserver : public slam::PipelineObserver {
   common::ProgressBar& bar_;
 };
 
-// The same input named twice (a relative and an absolute path, a symbolic link).
-bool sameInput(const std::string& a, const std::string& b) {
-  std::error_code ea, eb;
-  const auto ca = std::filesystem::weakly_canonical(a, ea), cb = std::filesystem::weakly_canonical(b, eb);
-  return ea || eb ? a == b : ca == cb;
-}
-
 }  // namespace
 
 int runCommand(const Argv& args) {
@@ -123,9 +116,7 @@ int runCommand(const Argv& args) {
   std::vector<slam::NamedMap> maps;
   slam::CheckpointInfo earlier;
   if (ap.flag("continue")) {
-    slam::Checkpoint c = slam::loadCheckpoint(checkpoint, ini.empty() ? nullptr : &options);
-    if (!sameInput(c.info.input, log))
-      throw common::InputError(checkpoint + ": made from " + c.info.input + ", not from " + log + " (continue it with that input)");
+    slam::Checkpoint c = slam::loadCheckpoint(checkpoint, ini.empty() ? nullptr : &options, log);
     earlier = c.info;
     maps.push_back({std::move(c.pipeline), {c.info.resumed_map.empty() ? log : c.info.resumed_map}, 0});
   } else {

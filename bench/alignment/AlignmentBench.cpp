@@ -100,11 +100,7 @@ struct Outcome {
 };
 
 // CPU time of this thread: the machine is shared, and wall time counts the other jobs too.
-double threadCpuMs() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
-}
+double threadCpuMs() { return 1e3 * urbanslam::common::threadCpuSeconds(); }
 
 double uniform(std::mt19937& rng, double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); }
 

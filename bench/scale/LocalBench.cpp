@@ -6,8 +6,6 @@
 // SLAM's matching is measured to a few per cent, where a whole run varies by ten (global SLAM's
 // share and the machine's). `check` sums every keyframe step's x, y and heading: equal across
 // builds when the change leaves the matches as they were.
-#include <time.h>
-
 #include <algorithm>
 #include <cstdlib>
 #include <iostream>
@@ -18,6 +16,7 @@
 #include "urbanslam/common/Error.h"
 #include "urbanslam/common/Heap.h"
 #include "urbanslam/common/Json.h"
+#include "urbanslam/common/Timing.h"
 #include "urbanslam/io/DataSource.h"
 #include "urbanslam/sim/SimOptions.h"
 #include "urbanslam/sim/SimulatedSource.h"
@@ -25,16 +24,7 @@
 #include "urbanslam/slam/PipelineOptions.h"
 
 using namespace urbanslam;
-
-namespace {
-
-double threadCpuSeconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
-}  // namespace
+using common::threadCpuSeconds;
 
 int main(int argc, char** argv) {
   urbanslam::common::keepFreedBuffers();  // as the urbanslam command does

@@ -13,11 +13,10 @@
 // (the filter's poses at the last recovery: fewer than the keyframes where they hang from others').
 //
 // A run continued from a checkpoint (slam/Checkpoint.h) appends to the same file: the rows written
-// after the checkpoint are dropped, and the times and counts go on from the checkpoint's totals
-// (totals()). The time spent loading the checkpoint is not counted; peak_rss_mb is then the peak
+// after the checkpoint are dropped, and the times and counts go on from the checkpoint's (its CPU
+// and wall time, and the counters totals() saved with it). The time spent loading the checkpoint is not counted; peak_rss_mb is then the peak
 // since the continuation.
 #include <malloc.h>
-#include <time.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -28,21 +27,13 @@
 #include <string>
 
 #include "urbanslam/common/Timing.h"
+#include "urbanslam/slam/Checkpoint.h"
 #include "urbanslam/slam/Observer.h"
 
 namespace urbanslam::bench {
 
-inline double threadCpuSeconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
-inline double processCpuSeconds() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
+using common::processCpuSeconds;
+using common::threadCpuSeconds;
 
 inline double residentMegabytes() {
   long pages = 0, resident = 0;
@@ -76,28 +67,28 @@ class ProgressLog : public slam::PipelineObserver {
   static constexpr const char* kHeader =
       "keyframes,log_s,wall_s,cpu_s,front_cpu_s,rss_mb,peak_rss_mb,heap_mb,closures,attempts,laser_attempts,full_recoveries,full_"
       "recovery_s,factorisations,filter_poses";
-  // `earlier`: a checkpoint's totals() (empty for a run from its start).
-  ProgressLog(const std::string& path, size_t every, const std::map<std::string, double>& earlier = {}) : every_(every) {
+  // `earlier`: the checkpoint the run continues, its counters this log's totals() (a default
+  // one for a run from its start).
+  explicit ProgressLog(const std::string& path, size_t every, const slam::CheckpointInfo& earlier = {}) : every_(every) {
     const auto get = [&](const char* key) {
-      const auto it = earlier.find(key);
-      return it == earlier.end() ? 0.0 : it->second;
+      const auto it = earlier.counters.find(key);
+      return it == earlier.counters.end() ? 0.0 : it->second;
     };
     keepCsvRows(path, static_cast<size_t>(get("progress_rows")), kHeader);
     csv_.open(path, std::ios::app);
     rows_ = static_cast<size_t>(get("progress_rows"));
-    wall0_ = get("wall_s"), cpu0_ = get("cpu_s") - processCpuSeconds(), front0_ = get("front_cpu_s") - threadCpuSeconds();
-    if (earlier.count("first_timestamp")) first_timestamp_ = get("first_timestamp");
+    wall0_ = earlier.wall_s, cpu0_ = earlier.cpu_s - processCpuSeconds(), front0_ = get("front_cpu_s") - threadCpuSeconds();
+    if (earlier.counters.count("first_timestamp")) first_timestamp_ = get("first_timestamp");
     closures_ = static_cast<size_t>(get("closures")), attempts_ = static_cast<size_t>(get("attempts"));
     laser_attempts_ = static_cast<size_t>(get("laser_attempts")), recoveries_ = static_cast<size_t>(get("full_recoveries"));
     recovery_us_ = static_cast<long long>(get("full_recovery_s") * 1e6);
     factorisations_ = static_cast<long long>(get("factorisations")), filter_poses_ = static_cast<int>(get("filter_poses"));
   }
-  // Everything a continued run goes on from; read while global SLAM is idle.
+  // What a continued run goes on from besides the checkpoint's own CPU and wall time; read while
+  // global SLAM is idle.
   std::map<std::string, double> totals() const {
     return {{"progress_rows", static_cast<double>(rows_)},
             {"first_timestamp", first_timestamp_},
-            {"wall_s", wall0_ + wall_.seconds()},
-            {"cpu_s", cpu0_ + processCpuSeconds()},
             {"front_cpu_s", front0_ + threadCpuSeconds()},
             {"closures", static_cast<double>(closures_.load())},
             {"attempts", static_cast<double>(attempts_.load())},

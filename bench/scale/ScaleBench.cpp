@@ -151,8 +151,7 @@ int main(int argc, char** argv) {
     std::unique_ptr<slam::Pipeline> pipeline;
     slam::CheckpointInfo earlier;
     if (continuing) {
-      slam::Checkpoint c = slam::loadCheckpoint(checkpoint_dir, &options);
-      if (c.info.input != input) throw common::InputError(checkpoint_dir + ": made from " + c.info.input + ", not from " + input);
+      slam::Checkpoint c = slam::loadCheckpoint(checkpoint_dir, &options, input);
       std::cerr << "scale_bench: continuing from " << checkpoint_dir << " at " << c.info.keyframes << " keyframes\n";
       slam::skipMeasurements(*source, c.info.input_measurements, input);
       pipeline = std::move(c.pipeline);
@@ -166,7 +165,7 @@ int main(int argc, char** argv) {
       return it == earlier.counters.end() ? size_t{0} : static_cast<size_t>(it->second);
     };
     rec.emplace(out + ".steps.csv", out + ".corrections.csv", counter("step_rows"), counter("correction_rows"));
-    progress.emplace(out + ".progress.csv", static_cast<size_t>(progress_every), earlier.counters);
+    progress.emplace(out + ".progress.csv", static_cast<size_t>(progress_every), earlier);
     pipeline->addObserver(&*rec);
     pipeline->addObserver(&*progress);
     slam::Checkpointer saver(checkpoint_dir, static_cast<size_t>(checkpoint_every), earlier, 0);
@@ -177,11 +176,9 @@ int main(int argc, char** argv) {
       c["correction_rows"] = static_cast<double>(rec->correction_rows.load());
       return c;
     });
-    const auto earlier_cpu = earlier.counters.find("cpu_s");
-    const double cpu0 = bench::processCpuSeconds() - (earlier_cpu == earlier.counters.end() ? 0.0 : earlier_cpu->second);
     slam::runCheckpointed(*pipeline, *source, saver);
     pipeline->finish(*source);
-    const double cpu_s = bench::processCpuSeconds() - cpu0;
+    const double cpu_s = saver.cpuSeconds();
     const common::Json stats =
         slam::writeRunOutputs(*pipeline, out, {city.empty() ? log : city, source->format(), ini, resolved, {}, {}, {}});
     rec->flush();

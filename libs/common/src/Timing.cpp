@@ -1,5 +1,7 @@
 #include "urbanslam/common/Timing.h"
 
+#include <time.h>
+
 #include <sys/resource.h>
 
 #include <algorithm>
@@ -16,6 +18,17 @@ double percentile(std::vector<double> sample, double p) {
   const double f = pos - static_cast<double>(lo);
   return sample[lo] + f * (sample[hi] - sample[lo]);
 }
+
+namespace {
+double clockSeconds(clockid_t clock) {
+  timespec t{};
+  clock_gettime(clock, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+}  // namespace
+
+double processCpuSeconds() { return clockSeconds(CLOCK_PROCESS_CPUTIME_ID); }
+double threadCpuSeconds() { return clockSeconds(CLOCK_THREAD_CPUTIME_ID); }
 
 long long peakResidentBytes() {
   rusage ru{};

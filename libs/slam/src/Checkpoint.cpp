@@ -1,7 +1,5 @@
 #include "urbanslam/slam/Checkpoint.h"
 
-#include <time.h>
-
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -20,12 +18,6 @@ namespace {
 
 constexpr const char* kInfoFile = "checkpoint.ini";
 constexpr const char* kInfoHeader = "; urbanslam checkpoint";
-
-double processCpuSeconds() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
 
 bool isCheckpointFolder(const std::string& dir) {
   return common::isReplaceableOutputFolder(dir, kInfoFile, [](const std::string& first) { return first.rfind(kInfoHeader, 0) == 0; });
@@ -53,6 +45,13 @@ double toNonNegative(const std::map<std::string, std::string>& kv, const std::st
   } catch (const std::exception&) {
   }
   throw common::InputError(file + ": " + key + " = " + it->second + " is not a number of at least 0");
+}
+
+// The same file named twice (a relative and an absolute path, a symbolic link).
+bool sameFile(const std::string& a, const std::string& b) {
+  std::error_code ea, eb;
+  const fs::path ca = fs::weakly_canonical(a, ea), cb = fs::weakly_canonical(b, eb);
+  return ea || eb ? a == b : ca == cb;
 }
 
 }  // namespace
@@ -85,7 +84,7 @@ void saveCheckpoint(const Pipeline& pipeline, const std::string& dir, const Chec
   folder.commit();
 }
 
-Checkpoint loadCheckpoint(const std::string& dir, const PipelineOptions* options) {
+Checkpoint loadCheckpoint(const std::string& dir, const PipelineOptions* options, const std::string& input) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw common::InputError(dir + ": no checkpoint here (a run saves one with --checkpoint-every)");
   const std::string file = (fs::path(dir) / kInfoFile).string();
@@ -98,6 +97,8 @@ Checkpoint loadCheckpoint(const std::string& dir, const PipelineOptions* options
   for (const auto& [key, value] : counters) c.info.counters[key] = toNonNegative(counters, key, file);
   c.info.input = kv.count("input") ? kv["input"] : "";
   if (c.info.input.empty()) throw common::InputError(file + ": no [checkpoint] input (an incomplete checkpoint)");
+  if (!input.empty() && !sameFile(c.info.input, input))
+    throw common::InputError(dir + ": made from " + c.info.input + ", not from " + input + " (continue it with that input)");
   c.info.input_measurements = toCount(kv, "input_measurements", file);
   c.info.keyframes = toCount(kv, "keyframes", file);
   c.info.cpu_s = toNonNegative(kv, "cpu_s", file);
@@ -124,7 +125,7 @@ Checkpointer::Checkpointer(std::string dir, size_t every_keyframes, CheckpointIn
       earlier_(std::move(earlier)),
       start_measurements_(start_measurements),
       last_keyframes_(earlier_.keyframes),
-      cpu0_(processCpuSeconds()) {}
+      cpu0_(common::processCpuSeconds()) {}
 
 bool Checkpointer::afterStep(Pipeline& pipeline, const io::DataSource& source) {
   const size_t k = pipeline.keyframesMade();
@@ -151,7 +152,7 @@ void runCheckpointed(Pipeline& pipeline, io::DataSource& source, Checkpointer& s
   pipeline.waitForGlobalSlam(source);
 }
 
-double Checkpointer::cpuSeconds() const { return earlier_.cpu_s + processCpuSeconds() - cpu0_; }
+double Checkpointer::cpuSeconds() const { return earlier_.cpu_s + common::processCpuSeconds() - cpu0_; }
 double Checkpointer::wallSeconds() const { return earlier_.wall_s + wall_.seconds(); }
 
 }  // namespace urbanslam::slam

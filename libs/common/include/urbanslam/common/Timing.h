@@ -20,6 +20,11 @@ class Stopwatch {
 // Returns 0 for an empty sample. Takes a copy: callers keep their sample order.
 double percentile(std::vector<double> sample, double p);
 
+// CPU time used so far by the whole process (every thread) and by the calling thread, in seconds:
+// what a run costs on one core, apart from the other jobs that share the machine's wall time.
+double processCpuSeconds();
+double threadCpuSeconds();
+
 // Peak resident memory of this process in bytes (0 where unknown).
 long long peakResidentBytes();
 

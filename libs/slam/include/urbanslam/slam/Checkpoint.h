@@ -21,7 +21,7 @@ namespace urbanslam::slam {
 struct CheckpointInfo {
   std::string input;                       // the log (or simulated city's ini) the run reads
   std::uint64_t input_measurements = 0;    // of that input, taken by the map (what a continued run skips)
-  std::uint64_t keyframes = 0;             // the map's keyframes then (for messages)
+  std::uint64_t keyframes = 0;             // the map's keyframes then (checked against the map)
   double cpu_s = 0;                        // the run's CPU time (all threads) and wall time up to the checkpoint,
   double wall_s = 0;                       // over every earlier stretch of it
   std::string resumed_map;                 // the map file the run continued (run --resume), "" for none
@@ -41,9 +41,11 @@ struct Checkpoint {
 };
 
 // The checkpoint at `dir`. `options` (optional): the continued run's, which must equal the
-// map's on every key that changes the result (loadMap). Throws common::InputError naming the
-// folder or file for a missing, incomplete or corrupt checkpoint.
-Checkpoint loadCheckpoint(const std::string& dir, const PipelineOptions* options = nullptr);
+// map's on every key that changes the result (loadMap). `input` (optional): the log or city the
+// continued run reads, which must be the checkpoint's (the same file, however it is named).
+// Throws common::InputError naming the folder or file for a missing, incomplete or corrupt
+// checkpoint, or one of another input.
+Checkpoint loadCheckpoint(const std::string& dir, const PipelineOptions* options = nullptr, const std::string& input = "");
 
 // Reads past the first `n` measurements of `source` (named `name` in errors): InputError when it
 // ends before them (not the input the checkpoint was made from).
