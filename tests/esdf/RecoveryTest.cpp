@@ -47,6 +47,18 @@ struct LinearGraph {
   Esdf f;
 };
 
+// A drive along parallel streets, each closed to the one before every few metres: a planar graph,
+// as a city's, whose factor has small separators (a path solve touches a small part of it).
+void streets(Esdf& f, int poses) {
+  constexpr int kStreet = 100;
+  for (int k = f.size(); k < poses; ++k) {
+    const bool turn = k % kStreet == 0;
+    f.augmentRelative(k - 1, turn ? Vec3(0, 1, M_PI) : Vec3(1, 0, 0), kOdoInfo);
+    const int across = k - 2 * (k % kStreet) - 1;  // the pose beside it on the street before
+    if (k % 2 == 0 && across >= 0 && across < k - 1) f.observeRelative(across, k, between(f.mean(across), f.mean(k)), kLoopInfo);
+  }
+}
+
 Mat3 blk(const Eigen::MatrixXd& m, int i, int j) { return m.block<3, 3>(3 * i, 3 * j); }
 
 TEST(Recovery, FullRecoveryEqualsDenseSolve) {
@@ -112,6 +124,49 @@ TEST(Recovery, ASimplicialFactorReadByTheSparseInverseStillSolvesAndRefactorises
     EXPECT_LT(worst, 1e-9) << "round " << round;
     EXPECT_LT((chol.solve(b) - x_ref).cwiseAbs().maxCoeff() / x_ref.cwiseAbs().maxCoeff(), 1e-9) << "round " << round;
   }
+}
+
+// Covariance blocks between chosen poses from their path solves against the dense inverse, with
+// both kinds of factor; a path holds the pose's ancestors only, a small part of a large factor.
+TEST(Recovery, PathSolvesGiveTheDenseInverseBetweenAnyTwoPoses) {
+  for (const auto& [poses, closures, supernodal] : {std::tuple{60, 3, false}, std::tuple{300, 400, true}, std::tuple{2000, 0, true}}) {
+    LinearGraph g(34, closures > 0 ? poses : 1, closures);
+    if (closures == 0) streets(g.f, poses);
+    SparseCholesky chol;
+    chol.factorize(g.f.state(), 0, g.f.size());
+    ASSERT_EQ(chol.supernodal(), supernodal) << poses << " poses";
+    // The reference: the dense inverse, or for the large graph CHOLMOD's own column solves.
+    const bool large = poses > 1000;
+    const Eigen::MatrixXd sigma = large ? Eigen::MatrixXd() : g.f.state().denseInformation().inverse();
+    const auto reference = [&](int a, int b) -> Mat3 {
+      if (!large) return blk(sigma, a, b);
+      Eigen::MatrixXd e = Eigen::MatrixXd::Zero(3 * poses, 3);
+      e.block<3, 3>(3 * b, 0).setIdentity();
+      return chol.solve(e).block<3, 3>(3 * a, 0);
+    };
+    std::mt19937 rng(9);
+    std::uniform_int_distribution<int> pick(0, poses - 1);
+    double worst = 0;
+    long rows = 0;
+    for (int t = 0; t < 40; ++t) {
+      const int a = t == 0 ? 0 : pick(rng), b = t == 1 ? poses - 1 : pick(rng);
+      const PathSolution pa = chol.pathSolve(a), pb = chol.pathSolve(b);
+      rows += pa.begin.back();
+      const Mat3 ref = reference(a, b), saa = reference(a, a);
+      worst = std::max(worst, (SparseCholesky::covarianceBetween(pa, pb) - ref).cwiseAbs().maxCoeff() / saa.norm());
+      EXPECT_LT((SparseCholesky::covarianceBetween(pb, pa) - ref.transpose()).cwiseAbs().maxCoeff(), 1e-9 * saa.norm());
+    }
+    EXPECT_LT(worst, 1e-9) << poses << " poses";
+    if (poses == 2000) {
+      EXPECT_LT(rows / 40, 3 * poses / 10) << "a path holds a tenth of the factor's rows or more";
+    }
+  }
+  SparseCholesky none;
+  EXPECT_THROW(none.pathSolve(0), std::logic_error);
+  LinearGraph g(35, 20, 2);
+  SparseCholesky chol;
+  chol.factorize(g.f.state(), 0, g.f.size());
+  EXPECT_THROW(chol.pathSolve(20), std::out_of_range);
 }
 
 TEST(Recovery, EnvelopeCholeskySolvesEveryWindowLikeDenseLlt) {

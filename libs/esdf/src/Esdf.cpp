@@ -288,6 +288,7 @@ void Esdf::ensureFactor() {
   factors_at_factor_ = factors_.size();
   explained_stamp_ = values_stamp_;
   involved_.clear();
+  involved_paths_.clear();
   involved_at_.clear();
   involved_cov_.resize(0, 0);
   // A new reference for conservative covariances: chain restarts after the factored poses.
@@ -500,11 +501,7 @@ Mat6 Esdf::conservativeJoint(int i, int j, Mat3* relative) {
     return factored_marginals_[static_cast<size_t>(p)];
   };
   auto cross = [&](int a, int b) -> Mat3 {  // Sigma(a, b) for a < b
-    if (b < m) {
-      Eigen::MatrixXd cols;
-      covarianceColumnsBlock(b, &cols);
-      return cols.block<3, 3>(3 * a, 0);
-    }
+    if (b < m) return SparseCholesky::covarianceBetween(full_factor_.pathSolve(a), full_factor_.pathSolve(b));
     return chainedCovariance(a, b);
   };
   const auto joint = [&](const Mat3& saa, const Mat3& sbb, const Mat3& sab) {

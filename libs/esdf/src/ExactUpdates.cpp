@@ -6,9 +6,9 @@
 // predecessor: exact dead reckoning, as the conservative covariance has it) and a few closures,
 // each a rank-3 term H' W H. Woodbury then gives the current covariance from the old one:
 //   (Lambda_c + H' W H)^-1 = Sigma_c - Sigma_c H' (I + W H Sigma_c H')^-1 W H Sigma_c,
-// which needs Sigma_c only among the poses of the closures and of the asked pair: column solves
-// of the old factor for the factored ones (kept until the next factorisation), the chain's
-// propagation for the newer ones.
+// which needs Sigma_c only among the poses of the closures and of the asked pair: path solves
+// of the old factor for the factored ones (PathSolve.h; kept until the next factorisation), the
+// chain's propagation for the newer ones.
 #include <Eigen/LU>
 #include <algorithm>
 
@@ -17,8 +17,10 @@
 namespace urbanslam::esdf {
 
 namespace {
-// A solve of 3k columns passes over the factor twice with k times the work per entry; beyond a
-// few poses a refactorisation (which the queries after it reuse) costs less.
+// Poses new to one query beyond this, and the factorisation is due. (Their path solves cost a
+// small part of the factor each, PathSolve.h; but a refactorisation also tightens the
+// conservative covariances that pick the loop-closure candidates, which come from the last
+// factorisation.)
 constexpr size_t kMaxNewSolvedPoses = 4;
 // The update's dense system is 3K square: closures since the factorisation beyond this, and the
 // factorisation is due anyway.
@@ -27,23 +29,20 @@ constexpr size_t kMaxUpdateFactors = 64;
 
 void Esdf::solveInvolved(const std::vector<int>& poses) {
   if (poses.empty()) return;
-  const int m = full_factor_.last();
-  const int u = static_cast<int>(poses.size());
-  Eigen::MatrixXd e = Eigen::MatrixXd::Zero(3 * m, 3 * u);
-  for (int c = 0; c < u; ++c) e.block<3, 3>(3 * poses[static_cast<size_t>(c)], 3 * c).setIdentity();
-  const Eigen::MatrixXd x = full_factor_.solve(e);
   const int k = static_cast<int>(involved_.size());
+  const int u = static_cast<int>(poses.size());
   for (int p : poses) {
     involved_at_[p] = static_cast<int>(involved_.size());
     involved_.push_back(p);
+    involved_paths_.push_back(full_factor_.pathSolve(p));
   }
   Eigen::MatrixXd grown(3 * (k + u), 3 * (k + u));
   grown.topLeftCorner(3 * k, 3 * k) = involved_cov_;
-  for (int c = 0; c < u; ++c)
-    for (int b = 0; b < k + u; ++b) {
-      const Mat3 s = x.block<3, 3>(3 * involved_[static_cast<size_t>(b)], 3 * c);  // Sigma(b, new c)
-      grown.block<3, 3>(3 * b, 3 * (k + c)) = s;
-      grown.block<3, 3>(3 * (k + c), 3 * b) = s.transpose();
+  for (int c = k; c < k + u; ++c)
+    for (int b = 0; b <= c; ++b) {
+      const Mat3 s = SparseCholesky::covarianceBetween(involved_paths_[static_cast<size_t>(b)], involved_paths_[static_cast<size_t>(c)]);
+      grown.block<3, 3>(3 * b, 3 * c) = s;
+      grown.block<3, 3>(3 * c, 3 * b) = s.transpose();
     }
   involved_cov_ = std::move(grown);
 }

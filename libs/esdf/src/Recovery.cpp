@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "PathSolve.h"
 #include "SparseInverse.h"
 
 namespace urbanslam::esdf {
@@ -82,6 +83,10 @@ struct SparseCholesky::Impl {
   // unnamed temporary file rather than held (8 of the 12 bytes per non-zero of the matrix's lower
   // triangle), or held when no temporary file can be written.
   KeptValues last_x;
+  // The factor as SupernodalFactorView reads it (view()), and what the path solves of this
+  // factor share: built on first use after a factorisation.
+  std::vector<int> simplicial_columns;
+  std::unique_ptr<FactorPaths> paths;
 
   explicit Impl(FillReducingOrdering o) : ordering(o) {
     cholmod_start(&common);
@@ -195,6 +200,7 @@ void SparseCholesky::factorizeLower(std::vector<int> colptr, std::vector<int> ro
     impl_->last_p = std::move(colptr);
     impl_->last_i = std::move(rowind);
   }
+  impl_->paths.reset();
   cholmod_factorize(&a, impl_->factor, cm);
   if (cm->status != CHOLMOD_OK || impl_->factor->minor < n) {
     cholmod_free_factor(&impl_->factor, cm);
@@ -270,8 +276,8 @@ Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& b) const {
 
 bool SparseCholesky::supernodal() const { return impl_->factor && impl_->factor->is_super; }
 
-std::vector<Mat3> SparseCholesky::inverseDiagonalBlocks() const {
-  if (!impl_->factor) throw std::logic_error("inverseDiagonalBlocks without a factor");
+SupernodalFactorView SparseCholesky::view() const {
+  if (!impl_->factor) throw std::logic_error("no factor to read");
   cholmod_common* cm = &impl_->common;
   const cholmod_factor* f = impl_->factor;
   SupernodalFactorView v;
@@ -284,15 +290,16 @@ std::vector<Mat3> SparseCholesky::inverseDiagonalBlocks() const {
     v.rows = static_cast<const int*>(f->s);
     v.value_begin = static_cast<const int*>(f->px);
     v.values = static_cast<const double*>(f->x);
-    return esdf::inverseDiagonalBlocks(v);
+    return v;
   }
-  std::vector<int> columns(f->n + 1);
+  std::vector<int>& columns = impl_->simplicial_columns;
+  columns.resize(f->n + 1);
   for (size_t c = 0; c <= f->n; ++c) columns[c] = static_cast<int>(c);
   v.supernodes = v.columns;
   v.first_column = columns.data();
   // A simplicial factor is read in place, its columns made to lie in order, each where the next
   // begins (one column per supernode); CHOLMOD packs them within the factor's own arrays (the
-  // solves read it either way). A copy would hold a second factor while the inverse runs.
+  // solves read it either way). A copy would hold a second factor while it is read.
   cholmod_factor* l = impl_->factor;
   if (!cholmod_change_factor(static_cast<int>(l->xtype), static_cast<int>(l->is_ll), 0, 1, 1, l, cm))
     throw std::runtime_error("CHOLMOD could not pack the factor (status " + std::to_string(cm->status) + ")");
@@ -301,8 +308,22 @@ std::vector<Mat3> SparseCholesky::inverseDiagonalBlocks() const {
   v.rows = static_cast<const int*>(l->i);
   v.value_begin = static_cast<const int*>(l->p);
   v.values = static_cast<const double*>(l->x);
-  return esdf::inverseDiagonalBlocks(v);
+  return v;
 }
+
+std::vector<Mat3> SparseCholesky::inverseDiagonalBlocks() const {
+  if (!impl_->factor) throw std::logic_error("inverseDiagonalBlocks without a factor");
+  return esdf::inverseDiagonalBlocks(view());
+}
+
+PathSolution SparseCholesky::pathSolve(int pose) const {
+  if (!impl_->factor) throw std::logic_error("pathSolve without a factor");
+  const SupernodalFactorView v = view();
+  if (!impl_->paths) impl_->paths = std::make_unique<FactorPaths>(v);
+  return esdf::pathSolve(v, *impl_->paths, pose);
+}
+
+Mat3 SparseCholesky::covarianceBetween(const PathSolution& a, const PathSolution& b) { return pathCovariance(a, b); }
 
 long long SparseCholesky::factorNonZeros() const {
   if (!impl_->factor) return 0;

@@ -305,6 +305,7 @@ class Esdf {
   size_t factors_at_factor_ = 0;
   std::uint64_t explained_stamp_ = ~std::uint64_t{0};
   std::vector<int> involved_;               // factored poses whose Sigma blocks are known ...
+  std::vector<PathSolution> involved_paths_;  // ... their path solves (PathSolve.h)
   std::unordered_map<int, int> involved_at_;  // ... their place in involved_
   Eigen::MatrixXd involved_cov_;            // ... the blocks among them (3|involved| square)
 

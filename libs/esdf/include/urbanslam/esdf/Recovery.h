@@ -14,6 +14,8 @@
 
 namespace urbanslam::esdf {
 
+struct SupernodalFactorView;
+
 // Lambda (or the factorised block of it) is not numerically positive definite: the information
 // added so far is inconsistent or too extreme for double precision. Callers that fed the filter
 // from a file turn it into an error naming the measurement.
@@ -27,6 +29,16 @@ enum class FillReducingOrdering {
   Metis,   // METIS nested dissection
   Auto,    // CHOLMOD's default strategy (AMD, then METIS when AMD's fill is high)
   Natural  // pose order (no reordering; for comparisons)
+};
+
+// L^-1 P e_p for the three columns of one pose p (A = P' L L' P, SparseCholesky::pathSolve):
+// non-zero only on the pose's path to the root of L's elimination tree, held as the rows of
+// the supernodes there. Two of them give the covariance block between their poses.
+struct PathSolution {
+  int pose = -1;
+  std::vector<int> supernodes;  // ascending
+  std::vector<int> begin;       // each supernode's first row in values (one more at the end)
+  std::vector<double> values;   // three per row: the pose's three columns
 };
 
 class SparseCholesky {
@@ -53,6 +65,11 @@ class SparseCholesky {
   // covariances, all at once for about the cost of one more factorisation (SparseInverse.h).
   std::vector<Mat3> inverseDiagonalBlocks() const;
   bool supernodal() const;
+  // Covariance blocks among a few poses of the range (indices from first()) at the cost of their
+  // paths in the factor, not of column solves over all of it (PathSolve.h): pathSolve once per
+  // pose, then covarianceBetween(a, b) = Sigma(a, b) for any two of them.
+  PathSolution pathSolve(int pose) const;
+  static Mat3 covarianceBetween(const PathSolution& a, const PathSolution& b);
 
   // The matrix the current factor was computed from (lower triangle, compressed columns), kept
   // so that a saved filter can rebuild exactly this factor: a covariance from an older
@@ -70,6 +87,8 @@ class SparseCholesky {
   void factorize(const Matrix& m);
 
  private:
+  // The factor as the sparse inverse and the path solves read it (a simplicial one packed in place).
+  SupernodalFactorView view() const;
   void factorizeLower(std::vector<int> colptr, std::vector<int> rowind, std::vector<double> values);
 
   struct Impl;
