@@ -81,8 +81,8 @@ void BinaryWriter::endSection() {
   if (!*sink_) throw InputError("cannot write the file (disk full?)");
 }
 
-BinaryReader::BinaryReader(const char* data, size_t size, std::string name, std::string problem)
-    : data_(reinterpret_cast<const unsigned char*>(data)), size_(size), name_(std::move(name)), problem_(std::move(problem)) {}
+BinaryReader::BinaryReader(const char* data, size_t size, std::string name, std::string problem, ReadProgress* progress)
+    : data_(reinterpret_cast<const unsigned char*>(data)), size_(size), name_(std::move(name)), problem_(std::move(problem)), progress_(progress) {}
 
 void BinaryReader::fail(const std::string& what) const { throw InputError(name_ + ": " + problem_ + ": " + what); }
 
@@ -90,6 +90,7 @@ const unsigned char* BinaryReader::take(size_t n) {
   if (n > remaining()) fail("it ends " + std::to_string(n - remaining()) + " bytes before a value it announces");
   const unsigned char* p = data_ + pos_;
   pos_ += n;
+  if (progress_ && p > progress_->next) progress_->reached(p);
   return p;
 }
 
@@ -181,7 +182,7 @@ BinaryReader BinaryReader::section(std::uint32_t tag) {
   const size_t n = size();
   if (n > remaining()) fail("a section of " + std::to_string(n) + " bytes in " + std::to_string(remaining()));
   const unsigned char* p = take(n);
-  return BinaryReader(reinterpret_cast<const char*>(p), n, name_, problem_);
+  return BinaryReader(reinterpret_cast<const char*>(p), n, name_, problem_, progress_);
 }
 
 void BinaryReader::expectEnd() const {

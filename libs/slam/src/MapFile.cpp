@@ -4,12 +4,14 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <memory>
 #include <sstream>
 #include <vector>
 
 #include "urbanslam/common/AtomicFile.h"
 #include "urbanslam/common/BinaryStream.h"
 #include "urbanslam/common/Error.h"
+#include "urbanslam/common/MappedFile.h"
 #include "urbanslam/common/OptionsSchema.h"
 
 namespace urbanslam::slam {
@@ -43,17 +45,15 @@ void checkSameAlgorithmOptions(const PipelineOptions& saved, const PipelineOptio
   }
 }
 
-std::string readWholeFile(const std::string& path) {
+// The map file mapped into memory (its pages given back as they are read: MappedFile).
+std::unique_ptr<common::MappedFile> mapWholeFile(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw common::InputError(path + ": a folder, not a map file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw common::InputError(path + ": cannot open the map file");
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw common::InputError(path + ": cannot read the map file");
-  return bytes;
+  if (!std::filesystem::exists(path, ec)) throw common::InputError(path + ": cannot open the map file");
+  return std::make_unique<common::MappedFile>(path);
 }
 
-std::uint64_t readU64(const std::string& bytes, size_t at) {
+std::uint64_t readU64(const char* bytes, size_t at) {
   std::uint64_t v = 0;
   for (size_t i = 0; i < 8; ++i) v |= static_cast<std::uint64_t>(static_cast<unsigned char>(bytes[at + i])) << (8 * i);
   return v;
@@ -132,30 +132,38 @@ std::string mapFilePath(const std::string& file_or_run_folder) {
 
 std::unique_ptr<Pipeline> loadMap(const std::string& path, const PipelineOptions* options,
                                   std::vector<std::unique_ptr<Pipeline>>* separate, MapUse use) {
-  const std::string bytes = readWholeFile(path);
+  const std::unique_ptr<common::MappedFile> file = mapWholeFile(path);
+  const char* bytes = file->data();
+  const size_t size = file->size();
   // The signature first: a file that is not a map is told so, even a short one.
-  const size_t sig = std::min(bytes.size(), sizeof kMagic);
-  if (bytes.empty() || std::memcmp(bytes.data(), kMagic, sig) != 0)
+  const size_t sig = std::min(size, sizeof kMagic);
+  if (size == 0 || std::memcmp(bytes, kMagic, sig) != 0)
     throw common::InputError(path + ": not an urbanslam map (it does not start with the USMAP signature)");
-  if (bytes.size() < kHeaderBytes)
-    throw common::InputError(path + ": truncated map: " + std::to_string(bytes.size()) + " bytes, shorter than the header");
-  common::BinaryReader header(bytes.data() + sizeof kMagic, kHeaderBytes - sizeof kMagic, path, "corrupt map");
+  if (size < kHeaderBytes) throw common::InputError(path + ": truncated map: " + std::to_string(size) + " bytes, shorter than the header");
+  common::BinaryReader header(bytes + sizeof kMagic, kHeaderBytes - sizeof kMagic, path, "corrupt map");
   const std::uint32_t version = header.u32();
   if (version < kOldestMapFormatVersion || version > kMapFormatVersion)
     throw common::InputError(path + ": map format version " + std::to_string(version) + ", but this urbanslam reads versions " +
                              std::to_string(kOldestMapFormatVersion) + " to " + std::to_string(kMapFormatVersion) + " only");
   const std::uint64_t length = readU64(bytes, kLengthOffset), checksum = readU64(bytes, kLengthOffset + 8);
-  const size_t available = bytes.size() - kHeaderBytes;
+  const size_t available = size - kHeaderBytes;
   if (length > available)
     throw common::InputError(path + ": truncated map: " + std::to_string(available) + " of its " + std::to_string(length) +
                              " payload bytes");
   if (length < available)
     throw common::InputError(path + ": corrupt map: " + std::to_string(available - length) + " bytes after the payload");
-  const char* payload = bytes.data() + kHeaderBytes;
-  if (common::fnv1a64(payload, available) != checksum)
+  const char* payload = bytes + kHeaderBytes;
+  // The checksum a stretch at a time, each stretch's pages given back after it.
+  std::uint64_t h = common::kFnv1a64Start;
+  for (size_t at = 0; at < available; at += file->stretchBytes()) {
+    const size_t n = std::min(file->stretchBytes(), available - at);
+    h = common::fnv1a64(payload + at, n, h);
+    file->release(payload + at, payload + at + n);
+  }
+  if (h != checksum)
     throw common::InputError(path + ": corrupt map: the payload's checksum does not match (changed or damaged after it was written)");
 
-  common::BinaryReader r(payload, available, path, "corrupt map");
+  common::BinaryReader r(payload, available, path, "corrupt map", file.get());
   common::BinaryReader opts = r.section(kOptionsTag);
   const PipelineOptions saved = parsePipelineOptions(opts.string(), path + " (its saved options)");
   opts.expectEnd();

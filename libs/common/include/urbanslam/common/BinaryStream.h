@@ -75,10 +75,19 @@ class BinaryWriter {
   std::vector<size_t> open_sections_;  // positions of the open sections' length fields
 };
 
+// Told how far readers over a buffer have read, so that the buffer can give back what lies
+// behind (MappedFile): reached(p) once a read passes `next`, which it then moves on.
+struct ReadProgress {
+  virtual ~ReadProgress() = default;
+  virtual void reached(const unsigned char* p) = 0;
+  const unsigned char* next = nullptr;
+};
+
 class BinaryReader {
  public:
   // Error messages read "NAME: PROBLEM: what", e.g. "run/map.usmap: corrupt map: ...".
-  BinaryReader(const char* data, size_t size, std::string name, std::string problem = "corrupt data");
+  // `progress` (optional, shared with the readers of its sections) hears how far reads got.
+  BinaryReader(const char* data, size_t size, std::string name, std::string problem = "corrupt data", ReadProgress* progress = nullptr);
 
   std::uint8_t u8();
   bool boolean();
@@ -120,6 +129,7 @@ class BinaryReader {
   const unsigned char* data_;
   size_t size_, pos_ = 0;
   std::string name_, problem_;
+  ReadProgress* progress_ = nullptr;
 };
 
 // A section tag from four characters ("MAP "), so a hex dump shows what a section is.
