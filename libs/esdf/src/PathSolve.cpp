@@ -15,13 +15,14 @@ using ConstBlock = Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
 inline size_t at(int i) { return static_cast<size_t>(i); }
 }  // namespace
 
-FactorPaths::FactorPaths(const SupernodalFactorView& l) : supernode_of(at(l.columns)), row_of(at(l.columns)) {
+FactorPaths::FactorPaths(const SupernodalFactorView& l)
+    : supernode_of(at(l.columns)), row_of(at(l.columns)), offset_of(at(l.supernodes), -1) {
   for (int s = 0; s < l.supernodes; ++s)
     for (int c = l.first_column[s]; c < l.first_column[s + 1]; ++c) supernode_of[at(c)] = s;
   for (int k = 0; k < l.columns; ++k) row_of[at(l.perm ? l.perm[k] : k)] = k;
 }
 
-PathSolution pathSolve(const SupernodalFactorView& l, const FactorPaths& paths, int pose) {
+PathSolution pathSolve(const SupernodalFactorView& l, FactorPaths& paths, int pose) {
   if (pose < 0 || 3 * pose + 2 >= l.columns) throw std::out_of_range("pathSolve: no such pose in the factor");
   const auto columns = [&](int s) { return l.first_column[s + 1] - l.first_column[s]; };
   // The parent of a supernode holds the first row below its columns (every row below is an
@@ -34,7 +35,7 @@ PathSolution pathSolve(const SupernodalFactorView& l, const FactorPaths& paths, 
   PathSolution out;
   out.pose = pose;
   // The three columns' paths to the root; every row a forward solve from them writes lies there.
-  std::vector<int> offset_of(at(l.supernodes), -1);
+  std::vector<int>& offset_of = paths.offset_of;
   for (int c = 0; c < 3; ++c)
     for (int s = paths.supernode_of[at(paths.row_of[at(3 * pose + c)])]; s >= 0 && offset_of[at(s)] < 0; s = parent(s)) {
       offset_of[at(s)] = 0;
@@ -74,6 +75,7 @@ PathSolution pathSolve(const SupernodalFactorView& l, const FactorPaths& paths, 
       y[2] -= below(t, 2);
     }
   }
+  for (const int s : out.supernodes) offset_of[at(s)] = -1;
   // Sigma = (L^-1 P)' D^-1 (L^-1 P) for an LDL' factor: D^-1/2 goes into y (D > 0: A is
   // positive definite), so that every covariance is a plain product.
   if (l.unit_diagonal_ldl)

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -86,6 +87,7 @@ struct SparseCholesky::Impl {
   // The factor as SupernodalFactorView reads it (view()), and what the path solves of this
   // factor share: built on first use after a factorisation.
   std::vector<int> simplicial_columns;
+  std::optional<SupernodalFactorView> view;
   std::unique_ptr<FactorPaths> paths;
 
   explicit Impl(FillReducingOrdering o) : ordering(o) {
@@ -200,6 +202,7 @@ void SparseCholesky::factorizeLower(std::vector<int> colptr, std::vector<int> ro
     impl_->last_p = std::move(colptr);
     impl_->last_i = std::move(rowind);
   }
+  impl_->view.reset();
   impl_->paths.reset();
   cholmod_factorize(&a, impl_->factor, cm);
   if (cm->status != CHOLMOD_OK || impl_->factor->minor < n) {
@@ -278,6 +281,7 @@ bool SparseCholesky::supernodal() const { return impl_->factor && impl_->factor-
 
 SupernodalFactorView SparseCholesky::view() const {
   if (!impl_->factor) throw std::logic_error("no factor to read");
+  if (impl_->view) return *impl_->view;  // (read once per factorisation)
   cholmod_common* cm = &impl_->common;
   const cholmod_factor* f = impl_->factor;
   SupernodalFactorView v;
@@ -290,6 +294,7 @@ SupernodalFactorView SparseCholesky::view() const {
     v.rows = static_cast<const int*>(f->s);
     v.value_begin = static_cast<const int*>(f->px);
     v.values = static_cast<const double*>(f->x);
+    impl_->view = v;
     return v;
   }
   std::vector<int>& columns = impl_->simplicial_columns;
@@ -308,6 +313,7 @@ SupernodalFactorView SparseCholesky::view() const {
   v.rows = static_cast<const int*>(l->i);
   v.value_begin = static_cast<const int*>(l->p);
   v.values = static_cast<const double*>(l->x);
+  impl_->view = v;
   return v;
 }
 
