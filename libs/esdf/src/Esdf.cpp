@@ -266,7 +266,7 @@ GateResult Esdf::gateRelative(int i, int j, const Vec3& z, const Mat3& omega) {
   // The conservative covariance bounds the exact one from above, so its d^2 bounds the exact d^2
   // from below: a closure it refuses, the exact test refuses too. Only the closures it admits
   // need the exact covariance, which refactorises the whole map when the factor is stale (with a
-  // current factor the exact covariance is column solves, and the bound is skipped).
+  // current factor the exact covariance is solves with it, and the bound is skipped).
   const bool bound_only = options_.gate_covariance == CovarianceMode::Conservative;
   if (bound_only || (!factorCurrent() && conservativeReady())) {
     const GateResult r = test(relativeCovariance(i, j, CovarianceMode::Conservative));

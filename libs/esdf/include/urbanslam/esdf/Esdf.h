@@ -9,7 +9,8 @@
 //   block rows only, after an optional Mahalanobis gate.
 // * The mean is not maintained by the information form itself: recover() solves
 //   Lambda mu = eta with CHOLMOD; recoverRecent() solves for a window of recent poses with the
-//   older ones held fixed. Covariances of selected poses (and pairs) come from column solves.
+//   older ones held fixed. Covariances of selected poses (and pairs) come from solves with the
+//   last factor (path solves for pairs between factorisations, PathSolve.h).
 //
 // Beyond the thesis: every measurement is kept as a factor with its linearisation point, so
 // after a recovery the factors whose poses moved are re-linearised (their old contribution to
@@ -38,7 +39,7 @@ using Mat6 = Eigen::Matrix<double, 6, 6>;
 
 enum class CovarianceMode {
   Exact,        // the current Lambda's: from the last factor and the few factors added since
-                // (ExactUpdates.cpp), else refactorised; then column solves
+                // (ExactUpdates.cpp), else refactorised; then solves with the factor
   Conservative  // last factorisation + dead-reckoning propagation: no refactorisation, never smaller
 };
 
@@ -277,14 +278,14 @@ class Esdf {
   // The exact joint covariance of poses i and j without refactorising (ExactUpdates.cpp): the
   // last factor, the dead-reckoning chain after it, and the factors added since as a low-rank
   // update (Woodbury). False when Lambda changed otherwise since the factorisation, or the
-  // update needs more column solves than a refactorisation is worth.
+  // update asks for more poses not solved for yet than ExactUpdates.cpp allows.
   bool updatedJoint(int i, int j, Mat6* joint);
   // Sigma(p, q) of the factorised Lambda with the chain after it: for a chain pose, the
   // conservative covariance's dead reckoning (exact while no closure came since); for two
   // factored poses, the blocks solveInvolved kept.
   Mat3 chainedCovariance(int p, int q);
-  // Makes the blocks of Sigma among `poses` (factored) available: one multi-column solve for
-  // those not solved for yet.
+  // Makes the blocks of Sigma among `poses` (factored) available: a path solve (PathSolve.h)
+  // for each not solved for yet, its blocks with the others from the paths.
   void solveInvolved(const std::vector<int>& poses);
 
   EsdfOptions options_;
