@@ -14,8 +14,8 @@
 //
 // A run continued from a checkpoint (slam/Checkpoint.h) appends to the same file: the rows written
 // after the checkpoint are dropped, and the times and counts go on from the checkpoint's (its CPU
-// and wall time, and the counters totals() saved with it). The time spent loading the checkpoint is not counted; peak_rss_mb is then the peak
-// since the continuation.
+// and wall time, and the counters totals() saved with it). The time spent loading the checkpoint
+// is not counted; peak_rss_mb is then the peak since the continuation.
 #include <malloc.h>
 #include <unistd.h>
 

@@ -15,14 +15,7 @@ using ConstBlock = Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
 inline size_t at(int i) { return static_cast<size_t>(i); }
 }  // namespace
 
-FactorPaths::FactorPaths(const SupernodalFactorView& l)
-    : supernode_of(at(l.columns)), row_of(at(l.columns)), offset_of(at(l.supernodes), -1) {
-  for (int s = 0; s < l.supernodes; ++s)
-    for (int c = l.first_column[s]; c < l.first_column[s + 1]; ++c) supernode_of[at(c)] = s;
-  for (int k = 0; k < l.columns; ++k) row_of[at(l.perm ? l.perm[k] : k)] = k;
-}
-
-PathSolution pathSolve(const SupernodalFactorView& l, FactorPaths& paths, int pose) {
+PathSolution pathSolve(const SupernodalFactorView& l, const FactorIndex& index, std::vector<int>& offset_of, int pose) {
   if (pose < 0 || 3 * pose + 2 >= l.columns) throw std::out_of_range("pathSolve: no such pose in the factor");
   const auto columns = [&](int s) { return l.first_column[s + 1] - l.first_column[s]; };
   // The parent of a supernode holds the first row below its columns (every row below is an
@@ -30,14 +23,13 @@ PathSolution pathSolve(const SupernodalFactorView& l, FactorPaths& paths, int po
   const auto parent = [&](int s) {
     int first = INT_MAX;
     for (int k = l.row_begin[s] + columns(s); k < l.row_begin[s + 1]; ++k) first = std::min(first, l.rows[k]);
-    return first == INT_MAX ? -1 : paths.supernode_of[at(first)];
+    return first == INT_MAX ? -1 : index.supernode_of[at(first)];
   };
   PathSolution out;
   out.pose = pose;
   // The three columns' paths to the root; every row a forward solve from them writes lies there.
-  std::vector<int>& offset_of = paths.offset_of;
   for (int c = 0; c < 3; ++c)
-    for (int s = paths.supernode_of[at(paths.row_of[at(3 * pose + c)])]; s >= 0 && offset_of[at(s)] < 0; s = parent(s)) {
+    for (int s = index.supernode_of[at(index.row_of[at(3 * pose + c)])]; s >= 0 && offset_of[at(s)] < 0; s = parent(s)) {
       offset_of[at(s)] = 0;
       out.supernodes.push_back(s);
     }
@@ -53,10 +45,10 @@ PathSolution pathSolve(const SupernodalFactorView& l, FactorPaths& paths, int po
   out.begin.push_back(rows);
   out.values.assign(3 * at(rows), 0.0);
   const auto slot = [&](int row) {
-    const int s = paths.supernode_of[at(row)];
+    const int s = index.supernode_of[at(row)];
     return &out.values[3 * at(offset_of[at(s)] + row - l.first_column[s])];
   };
-  for (int c = 0; c < 3; ++c) slot(paths.row_of[at(3 * pose + c)])[c] = 1.0;
+  for (int c = 0; c < 3; ++c) slot(index.row_of[at(3 * pose + c)])[c] = 1.0;
   Eigen::Matrix<double, Eigen::Dynamic, 3> below;
   for (size_t k = 0; k < out.supernodes.size(); ++k) {
     const int s = out.supernodes[k];

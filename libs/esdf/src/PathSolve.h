@@ -13,19 +13,10 @@
 
 namespace urbanslam::esdf {
 
-// What the path solves of one factor share: the supernode of each column of L and L's row for
-// each row of A (the inverse of the view's permutation).
-struct FactorPaths {
-  std::vector<int> supernode_of, row_of;
-  // Each supernode's first row in the solution being built, -1 when off its path (a workspace
-  // reset after each solve, so that a solve costs its path and not the number of supernodes).
-  std::vector<int> offset_of;
-  explicit FactorPaths(const SupernodalFactorView& l);
-};
-
 // y_p for pose p (rows 3p .. 3p + 2 of A), scaled so that the covariance is a plain product
-// (a unit-diagonal LDL' factor's D^-1/2 folded in).
-PathSolution pathSolve(const SupernodalFactorView& l, FactorPaths& paths, int pose);
+// (a unit-diagonal LDL' factor's D^-1/2 folded in). `offset_of`: a workspace of one entry per
+// supernode, all -1, left so (a solve costs its path, not the number of supernodes).
+PathSolution pathSolve(const SupernodalFactorView& l, const FactorIndex& index, std::vector<int>& offset_of, int pose);
 
 // Sigma(a, b) (a's rows, b's columns) from the two poses' path solutions.
 Mat3 pathCovariance(const PathSolution& a, const PathSolution& b);

@@ -84,11 +84,12 @@ struct SparseCholesky::Impl {
   // unnamed temporary file rather than held (8 of the 12 bytes per non-zero of the matrix's lower
   // triangle), or held when no temporary file can be written.
   KeptValues last_x;
-  // The factor as SupernodalFactorView reads it (view()), and what the path solves of this
-  // factor share: built on first use after a factorisation.
+  // The factor as SupernodalFactorView reads it (view()) and its FactorIndex (index()): built on
+  // first use after a factorisation.
   std::vector<int> simplicial_columns;
   std::optional<SupernodalFactorView> view;
-  std::unique_ptr<FactorPaths> paths;
+  std::unique_ptr<FactorIndex> index;
+  std::vector<int> path_workspace;  // pathSolve's, one entry per supernode
 
   explicit Impl(FillReducingOrdering o) : ordering(o) {
     cholmod_start(&common);
@@ -203,7 +204,7 @@ void SparseCholesky::factorizeLower(std::vector<int> colptr, std::vector<int> ro
     impl_->last_i = std::move(rowind);
   }
   impl_->view.reset();
-  impl_->paths.reset();
+  impl_->index.reset();
   cholmod_factorize(&a, impl_->factor, cm);
   if (cm->status != CHOLMOD_OK || impl_->factor->minor < n) {
     cholmod_free_factor(&impl_->factor, cm);
@@ -319,14 +320,23 @@ SupernodalFactorView SparseCholesky::view() const {
 
 std::vector<Mat3> SparseCholesky::inverseDiagonalBlocks() const {
   if (!impl_->factor) throw std::logic_error("inverseDiagonalBlocks without a factor");
-  return esdf::inverseDiagonalBlocks(view());
+  const SupernodalFactorView v = view();
+  return esdf::inverseDiagonalBlocks(v, index(v));
+}
+
+const FactorIndex& SparseCholesky::index(const SupernodalFactorView& v) const {
+  if (!impl_->index) {
+    impl_->index = std::make_unique<FactorIndex>(v);
+    impl_->path_workspace.assign(static_cast<size_t>(v.supernodes), -1);
+  }
+  return *impl_->index;
 }
 
 PathSolution SparseCholesky::pathSolve(int pose) const {
   if (!impl_->factor) throw std::logic_error("pathSolve without a factor");
   const SupernodalFactorView v = view();
-  if (!impl_->paths) impl_->paths = std::make_unique<FactorPaths>(v);
-  return esdf::pathSolve(v, *impl_->paths, pose);
+  const FactorIndex& ix = index(v);
+  return esdf::pathSolve(v, ix, impl_->path_workspace, pose);
 }
 
 Mat3 SparseCholesky::covarianceBetween(const PathSolution& a, const PathSolution& b) { return pathCovariance(a, b); }

@@ -37,12 +37,17 @@ ReleaseSchedule releaseSchedule(const SupernodalFactorView& l, const std::vector
 }
 }  // namespace
 
-std::vector<Mat3> inverseDiagonalBlocks(const SupernodalFactorView& l) {
-  const int n = l.columns;
-  if (n % 3 != 0) throw std::invalid_argument("inverseDiagonalBlocks: the size is not three per pose");
-  std::vector<int> supernode_of(static_cast<size_t>(n));
+FactorIndex::FactorIndex(const SupernodalFactorView& l)
+    : supernode_of(static_cast<size_t>(l.columns)), row_of(static_cast<size_t>(l.columns)) {
   for (int s = 0; s < l.supernodes; ++s)
     for (int c = l.first_column[s]; c < l.first_column[s + 1]; ++c) supernode_of[static_cast<size_t>(c)] = s;
+  for (int k = 0; k < l.columns; ++k) row_of[static_cast<size_t>(l.perm ? l.perm[k] : k)] = k;
+}
+
+std::vector<Mat3> inverseDiagonalBlocks(const SupernodalFactorView& l, const FactorIndex& index) {
+  const int n = l.columns;
+  if (n % 3 != 0) throw std::invalid_argument("inverseDiagonalBlocks: the size is not three per pose");
+  const std::vector<int>& supernode_of = index.supernode_of;
   std::vector<int> position_of(static_cast<size_t>(n), -1);  // row -> place in the supernode scattered last
   int scattered = -1;
   const auto scatter = [&](int s) {
@@ -50,8 +55,7 @@ std::vector<Mat3> inverseDiagonalBlocks(const SupernodalFactorView& l) {
     for (int k = l.row_begin[s]; k < l.row_begin[s + 1]; ++k) position_of[static_cast<size_t>(l.rows[k])] = k - l.row_begin[s];
     scattered = s;
   };
-  std::vector<int> row_of(static_cast<size_t>(n));  // A's row -> L's row
-  for (int k = 0; k < n; ++k) row_of[static_cast<size_t>(l.perm[k])] = k;
+  const std::vector<int>& row_of = index.row_of;  // A's row -> L's row
 
   // Z = A^-1 in L's layout. With L's supernode S (columns) over its rows S and R below:
   //   L' Z = L^-1 gives Z_RS = -Z_RR W and Z_SS = (L_SS L_SS')^-1 - W' Z_RS, W = L_RS L_SS^-1,

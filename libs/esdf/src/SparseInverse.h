@@ -31,7 +31,15 @@ struct SupernodalFactorView {
   const int* perm = nullptr;
 };
 
+// Where a factor's columns and rows lie: the supernode of each column of L, and L's row for each
+// row of A (the inverse of the view's permutation). Built once per factorisation and shared by
+// the sparse inverse and the path solves (PathSolve.h).
+struct FactorIndex {
+  std::vector<int> supernode_of, row_of;
+  explicit FactorIndex(const SupernodalFactorView& l);
+};
+
 // The 3x3 diagonal blocks of A^-1 for A of size 3 * poses (rows 3p .. 3p + 2 are pose p).
-std::vector<Mat3> inverseDiagonalBlocks(const SupernodalFactorView& l);
+std::vector<Mat3> inverseDiagonalBlocks(const SupernodalFactorView& l, const FactorIndex& index);
 
 }  // namespace urbanslam::esdf

@@ -15,6 +15,7 @@
 namespace urbanslam::esdf {
 
 struct SupernodalFactorView;
+struct FactorIndex;
 
 // Lambda (or the factorised block of it) is not numerically positive definite: the information
 // added so far is inconsistent or too extreme for double precision. Callers that fed the filter
@@ -89,6 +90,7 @@ class SparseCholesky {
  private:
   // The factor as the sparse inverse and the path solves read it (a simplicial one packed in place).
   SupernodalFactorView view() const;
+  const FactorIndex& index(const SupernodalFactorView& v) const;
   void factorizeLower(std::vector<int> colptr, std::vector<int> rowind, std::vector<double> values);
 
   struct Impl;
