@@ -4,10 +4,13 @@
 #include <mrpt/maps/COccupancyGridMap2D.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <map>
+#include <thread>
 #include <tuple>
 #include <utility>
 
@@ -22,6 +25,9 @@ namespace {
 // A block of tiles is drawn from one grid: at most this many cells a side besides its scans' rays
 // (two 2000-cell tiles), which bounds the grid's memory while most scans go into one block.
 constexpr int kBlockCells = 4000;
+// Threads drawing blocks at once, each holding a block's grid (up to 110 MB): two halve the
+// tiles' time and bound the output phase's memory whatever the machine's cores.
+constexpr size_t kMaxWorkers = 2;
 }  // namespace
 
 std::vector<GridTile> writeOccupancyGridTiles(const std::string& dir, const std::vector<PosedScan>& scans, const OccupancyGridOptions& o,
@@ -83,13 +89,10 @@ std::vector<GridTile> writeOccupancyGridTiles(const std::string& dir, const std:
     }
   }
 
-  std::vector<GridTile> written;
-  LaserScan buffer;
-  // One grid for every block: its cells are reused, not allocated and faulted in again.
-  mrpt::maps::COccupancyGridMap2D grid;
-  detail::configureGridInsertion(grid);
-  mrpt::img::CImage tile(t, t, mrpt::img::CH_GRAY);
-  for (const auto& [bij, members] : takes) {
+  using Job = std::pair<const std::pair<long, long>, std::vector<size_t>>;  // a block and the scans it takes
+  const auto drawBlock = [&](const Job& job, mrpt::maps::COccupancyGridMap2D& grid, mrpt::img::CImage& tile, LaserScan& buffer,
+                             std::vector<GridTile>& written) {
+    const auto& [bij, members] = job;
     const double bx0 = bij.first * block * side, by0 = bij.second * block * side;
     const double bx1 = bx0 + block * side, by1 = by0 + block * side;
     // The block and every member's rays, 2 m more (beyond MRPT's own resizing margin of 15
@@ -139,7 +142,36 @@ std::vector<GridTile> writeOccupancyGridTiles(const std::string& dir, const std:
         detail::writeMapServerYaml(base + ".yaml", g.png, r, tx0, ty0, o);
         written.push_back(g);
       }
-  }
+  };
+  // Blocks are drawn by a few worker threads, each with its own grid and image (the scans are
+  // only read; a spilled store locks its reads): the tiles are most of a city run's output time.
+  // Each block's tiles are the same whichever thread draws it; the index is sorted below.
+  std::vector<const Job*> jobs;
+  for (const Job& job : takes) jobs.push_back(&job);
+  const size_t workers = std::min<size_t>({jobs.size(), kMaxWorkers, std::max(1u, std::thread::hardware_concurrency())});
+  std::atomic<size_t> next_job{0};
+  std::vector<std::vector<GridTile>> drawn(std::max<size_t>(1, workers));
+  std::vector<std::exception_ptr> failed(drawn.size());
+  const auto work = [&](size_t w) {
+    try {
+      LaserScan buffer;
+      mrpt::maps::COccupancyGridMap2D grid;  // one grid for every block: its cells are reused
+      detail::configureGridInsertion(grid);
+      mrpt::img::CImage tile(t, t, mrpt::img::CH_GRAY);
+      for (size_t b = next_job++; b < jobs.size(); b = next_job++) drawBlock(*jobs[b], grid, tile, buffer, drawn[w]);
+    } catch (...) {
+      failed[w] = std::current_exception();
+      next_job = jobs.size();  // the others stop after their block
+    }
+  };
+  std::vector<std::thread> threads;
+  for (size_t w = 1; w < workers; ++w) threads.emplace_back(work, w);
+  if (workers > 0) work(0);
+  for (auto& th : threads) th.join();
+  for (const auto& e : failed)
+    if (e) std::rethrow_exception(e);
+  std::vector<GridTile> written;
+  for (const auto& d : drawn) written.insert(written.end(), d.begin(), d.end());
   std::sort(written.begin(), written.end(), [](const GridTile& a, const GridTile& b) { return std::tie(a.i, a.j) < std::tie(b.i, b.j); });
   common::AtomicFile index((std::filesystem::path(dir) / "tiles.csv").string());
   index.stream() << "i,j,png,origin_x_m,origin_y_m,width_cells,height_cells,resolution_m\n";
