@@ -4,13 +4,10 @@
 #include <mrpt/maps/COccupancyGridMap2D.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdio>
-#include <exception>
 #include <filesystem>
 #include <map>
-#include <thread>
 #include <tuple>
 #include <utility>
 
@@ -18,6 +15,7 @@
 #include "OccupancyGridMrpt.h"
 #include "urbanslam/common/AtomicFile.h"
 #include "urbanslam/common/Error.h"
+#include "urbanslam/common/ParallelJobs.h"
 
 namespace urbanslam::io {
 
@@ -148,30 +146,23 @@ std::vector<GridTile> writeOccupancyGridTiles(const std::string& dir, const std:
   // Each block's tiles are the same whichever thread draws it; the index is sorted below.
   std::vector<const Job*> jobs;
   for (const Job& job : takes) jobs.push_back(&job);
-  const size_t workers = std::min<size_t>({jobs.size(), kMaxWorkers, std::max(1u, std::thread::hardware_concurrency())});
-  std::atomic<size_t> next_job{0};
-  std::vector<std::vector<GridTile>> drawn(std::max<size_t>(1, workers));
-  std::vector<std::exception_ptr> failed(drawn.size());
-  const auto work = [&](size_t w) {
-    try {
-      LaserScan buffer;
-      mrpt::maps::COccupancyGridMap2D grid;  // one grid for every block: its cells are reused
-      detail::configureGridInsertion(grid);
-      mrpt::img::CImage tile(t, t, mrpt::img::CH_GRAY);
-      for (size_t b = next_job++; b < jobs.size(); b = next_job++) drawBlock(*jobs[b], grid, tile, buffer, drawn[w]);
-    } catch (...) {
-      failed[w] = std::current_exception();
-      next_job = jobs.size();  // the others stop after their block
-    }
+  struct Worker {
+    LaserScan buffer;
+    mrpt::maps::COccupancyGridMap2D grid;  // one grid for every block it draws: its cells are reused
+    mrpt::img::CImage tile;
+    std::vector<GridTile> drawn;
   };
-  std::vector<std::thread> threads;
-  for (size_t w = 1; w < workers; ++w) threads.emplace_back(work, w);
-  if (workers > 0) work(0);
-  for (auto& th : threads) th.join();
-  for (const auto& e : failed)
-    if (e) std::rethrow_exception(e);
+  std::vector<Worker> workers(common::workerCount(jobs.size(), kMaxWorkers));
+  for (Worker& w : workers) {
+    detail::configureGridInsertion(w.grid);
+    w.tile = mrpt::img::CImage(t, t, mrpt::img::CH_GRAY);
+  }
+  common::runJobs(jobs.size(), workers.size(), [&](size_t w, size_t b) {
+    Worker& worker = workers[w];
+    drawBlock(*jobs[b], worker.grid, worker.tile, worker.buffer, worker.drawn);
+  });
   std::vector<GridTile> written;
-  for (const auto& d : drawn) written.insert(written.end(), d.begin(), d.end());
+  for (const Worker& w : workers) written.insert(written.end(), w.drawn.begin(), w.drawn.end());
   std::sort(written.begin(), written.end(), [](const GridTile& a, const GridTile& b) { return std::tie(a.i, a.j) < std::tie(b.i, b.j); });
   common::AtomicFile index((std::filesystem::path(dir) / "tiles.csv").string());
   index.stream() << "i,j,png,origin_x_m,origin_y_m,width_cells,height_cells,resolution_m\n";

@@ -8,12 +8,17 @@
 
 #include "urbanslam/alignment/BeamFreeSpace.h"
 #include "urbanslam/alignment/ScanModel.h"
+#include "urbanslam/common/ParallelJobs.h"
 #include "urbanslam/common/Timing.h"
 #include "urbanslam/slam/KeyframeGrid.h"
 
 namespace urbanslam::slam {
 
 namespace {
+
+// Keyframes a thread takes at a time, and the threads (each holding its cache of free space).
+constexpr size_t kRunKeyframes = 256;
+constexpr size_t kMaxWorkers = 2;
 
 // The free space of the scans judged with recently, least recently used dropped: consecutive
 // keyframes mostly share their judges.
@@ -58,46 +63,60 @@ MovingPointsResult findMovingPoints(const std::vector<io::PosedScan>& scans, con
   // The map's own spatial index, over the scans' positions.
   KeyframeGrid grid(std::max(o.reach_m, 1.0));
   for (size_t i = 0; i < scans.size(); ++i) grid.insert(i, scans[i].pose.x, scans[i].pose.y);
-  FreeSpaceCache cache(scans, o, std::max<size_t>(64, 8 * views));
-  io::LaserScan buffer;
-  std::vector<Eigen::Vector2d> world;
-  std::vector<size_t> near, judges;
-  std::vector<int> votes;
-  std::vector<char> state;
-  for (size_t i = 0; i < scans.size(); ++i) {
-    const common::Pose2& pose = scans[i].pose;
-    const double c = std::cos(pose.phi), s = std::sin(pose.phi);
-    world.clear();
-    // The points in the order the cloud writers visit them (forEachMapPoint).
-    for (const auto& p : io::scanToPoints(scans[i].get(buffer), true))
-      world.emplace_back(pose.x + c * p.x - s * p.y, pose.y + s * p.x + c * p.y);
-    near.clear();
-    grid.query(pose.x, pose.y, o.reach_m, near);
-    // Within reach, in log order, the keyframe itself left out.
-    near.erase(
-        std::remove_if(near.begin(), near.end(),
-                       [&](size_t k) { return k == i || !(std::hypot(scans[k].pose.x - pose.x, scans[k].pose.y - pose.y) <= o.reach_m); }),
-        near.end());
-    std::sort(near.begin(), near.end());
-    // Spread over time: the judges evenly among the keyframes within reach, in log order.
-    judges.clear();
-    if (near.size() <= views) {
-      judges = near;
-    } else {
-      for (size_t m = 0; m < views; ++m) judges.push_back(near[(2 * m + 1) * near.size() / (2 * views)]);
+  // Runs of consecutive keyframes (which mostly share their judges) shared out to two threads,
+  // each with its own cache of free space; every point's verdict is the same whichever thread
+  // gives it, and the runs' verdicts are joined in order.
+  struct Worker {
+    FreeSpaceCache cache;
+    io::LaserScan buffer;
+    std::vector<Eigen::Vector2d> world;
+    std::vector<size_t> near, judges;
+    std::vector<int> votes;
+    std::vector<char> state;
+  };
+  std::vector<Worker> workers;
+  const size_t runs = (scans.size() + kRunKeyframes - 1) / kRunKeyframes;
+  for (size_t w = common::workerCount(runs, kMaxWorkers); w-- > 0;)
+    workers.push_back({FreeSpaceCache(scans, o, std::max<size_t>(64, 8 * views))});
+  std::vector<io::PointMask> kept(runs);  // per run, a bit per point (10^6 keyframes hold 10^8 points)
+  common::runJobs(runs, workers.size(), [&](size_t w, size_t run) {
+    Worker& k = workers[w];
+    for (size_t i = run * kRunKeyframes; i < std::min(scans.size(), (run + 1) * kRunKeyframes); ++i) {
+      const common::Pose2& pose = scans[i].pose;
+      const double c = std::cos(pose.phi), s = std::sin(pose.phi);
+      k.world.clear();
+      // The points in the order the cloud writers visit them (forEachMapPoint).
+      for (const auto& p : io::scanToPoints(scans[i].get(k.buffer), true))
+        k.world.emplace_back(pose.x + c * p.x - s * p.y, pose.y + s * p.x + c * p.y);
+      k.near.clear();
+      grid.query(pose.x, pose.y, o.reach_m, k.near);
+      // Within reach, in log order, the keyframe itself left out.
+      k.near.erase(std::remove_if(
+                       k.near.begin(), k.near.end(),
+                       [&](size_t j) { return j == i || !(std::hypot(scans[j].pose.x - pose.x, scans[j].pose.y - pose.y) <= o.reach_m); }),
+                   k.near.end());
+      std::sort(k.near.begin(), k.near.end());
+      // Spread over time: the judges evenly among the keyframes within reach, in log order.
+      k.judges.clear();
+      if (k.near.size() <= views) {
+        k.judges = k.near;
+      } else {
+        for (size_t m = 0; m < views; ++m) k.judges.push_back(k.near[(2 * m + 1) * k.near.size() / (2 * views)]);
+      }
+      k.votes.assign(k.world.size(), 0);
+      for (size_t j : k.judges) {
+        k.state.assign(k.world.size(), alignment::BeamFreeSpace::kUnseen);
+        k.cache.get(j).classify(k.world, scans[j].pose, k.state);
+        for (size_t p = 0; p < k.world.size(); ++p) k.votes[p] += k.state[p] == alignment::BeamFreeSpace::kSeenThrough ? 1 : 0;
+      }
+      for (int v : k.votes) kept[run].push(v < o.min_views);
     }
-    votes.assign(world.size(), 0);
-    for (size_t j : judges) {
-      state.assign(world.size(), alignment::BeamFreeSpace::kUnseen);
-      cache.get(j).classify(world, scans[j].pose, state);
-      for (size_t k = 0; k < world.size(); ++k) votes[k] += state[k] == alignment::BeamFreeSpace::kSeenThrough ? 1 : 0;
+  });
+  for (const io::PointMask& run : kept)
+    for (size_t p = 0; p < run.size(); ++p) {
+      out.static_points.push(run.keeps(p));
+      out.moving += run.keeps(p) ? 0 : 1;
     }
-    for (int v : votes) {
-      const bool moved = v >= o.min_views;
-      out.static_points.push(!moved);
-      out.moving += moved ? 1 : 0;
-    }
-  }
   out.seconds = sw.seconds();
   return out;
 }
