@@ -71,12 +71,15 @@ struct Drive {
   }
 };
 
-// Along the room heading +x, then back heading -x; the box is there for the scans `box_at` says.
-Drive drive(const std::function<bool(size_t)>& box_at) {
+// Along the room heading +x, then back heading -x (`laps` times); the box is there for the scans
+// `box_at` says.
+Drive drive(const std::function<bool(size_t)>& box_at, int laps = 1) {
   Drive d;
   std::mt19937 rng(7);
-  for (int k = 0; k <= 14; ++k) d.poses.push_back({-7.0 + k, -4, 0});
-  for (int k = 0; k <= 14; ++k) d.poses.push_back({7.0 - k, 4, M_PI});
+  for (int lap = 0; lap < laps; ++lap) {
+    for (int k = 0; k <= 14; ++k) d.poses.push_back({-7.0 + k, -4, 0});
+    for (int k = 0; k <= 14; ++k) d.poses.push_back({7.0 - k, 4, M_PI});
+  }
   std::vector<bool> hits;
   for (size_t i = 0; i < d.poses.size(); ++i) {
     d.scans.push_back(castScan(d.poses[i], world(box_at(i)), rng, hits));
@@ -109,6 +112,23 @@ TEST(MovingPoints, WhatLaterScansSawThroughIsLeftOutAndTheWallsStay) {
   EXPECT_EQ(r.moving, box_points);
   // The cloud written with the mask holds the walls only.
   EXPECT_EQ(io::countMapPoints(posed, 1, &r.static_points), d.box_point.size() - box_points);
+}
+
+// The same in a longer drive, the box seen in its second half only: the keyframes are judged in
+// runs on several threads, and the verdicts must land on their own points, in cloud order.
+TEST(MovingPoints, AcrossRunsOfKeyframesTheVerdictsKeepTheirPoints) {
+  const Drive d = drive([](size_t i) { return i >= 300 && i < 303; }, 12);  // 360 scans
+  const auto posed = d.posed();
+  size_t box_points = 0;
+  for (bool b : d.box_point) box_points += b ? 1 : 0;
+  ASSERT_GT(box_points, 30u);
+  const slam::MovingPointsResult r = slam::findMovingPoints(posed, {});
+  ASSERT_EQ(r.static_points.size(), d.box_point.size());
+  size_t box_left_out = 0, wall_left_out = 0;
+  for (size_t i = 0; i < d.box_point.size(); ++i) (d.box_point[i] ? box_left_out : wall_left_out) += r.static_points.keeps(i) ? 0 : 1;
+  EXPECT_EQ(box_left_out, box_points);
+  EXPECT_EQ(wall_left_out, 0u);
+  EXPECT_EQ(r.moving, box_points);
 }
 
 // A box that stays is part of the world: nothing is left out.
