@@ -2,12 +2,12 @@
 // again from the file when a reader goes back), and the errors of what cannot be mapped.
 #include <gtest/gtest.h>
 
-#include <filesystem>
 #include <algorithm>
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <random>
+#include <sstream>
 #include <string>
 
 #include "urbanslam/common/BinaryStream.h"

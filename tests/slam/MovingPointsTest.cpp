@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <random>
@@ -69,7 +70,18 @@ struct Drive {
     for (size_t i = 0; i < scans.size(); ++i) out.push_back({poses[i], &scans[i]});
     return out;
   }
+  size_t boxPoints() const { return static_cast<size_t>(std::count(box_point.begin(), box_point.end(), true)); }
 };
+
+// The box's and the walls' points a mask leaves out.
+struct LeftOut {
+  size_t box = 0, wall = 0;
+};
+LeftOut leftOut(const Drive& d, const io::PointMask& kept) {
+  LeftOut n;
+  for (size_t i = 0; i < d.box_point.size(); ++i) (d.box_point[i] ? n.box : n.wall) += kept.keeps(i) ? 0 : 1;
+  return n;
+}
 
 // Along the room heading +x, then back heading -x (`laps` times); the box is there for the scans
 // `box_at` says.
@@ -97,18 +109,13 @@ TEST(MovingPoints, WhatLaterScansSawThroughIsLeftOutAndTheWallsStay) {
   const Drive d = drive([](size_t i) { return i < 3; });
   const auto posed = d.posed();
   ASSERT_EQ(d.box_point.size(), io::countMapPoints(posed));
-  size_t box_points = 0;
-  for (bool b : d.box_point) box_points += b ? 1 : 0;
+  const size_t box_points = d.boxPoints();
   ASSERT_GT(box_points, 30u);
   const slam::MovingPointsResult r = slam::findMovingPoints(posed, {});
   ASSERT_EQ(r.static_points.size(), d.box_point.size());
-  size_t box_left_out = 0, wall_left_out = 0;
-  for (size_t i = 0; i < d.box_point.size(); ++i) {
-    const bool out = !r.static_points.keeps(i);
-    (d.box_point[i] ? box_left_out : wall_left_out) += out ? 1 : 0;
-  }
-  EXPECT_EQ(box_left_out, box_points);
-  EXPECT_EQ(wall_left_out, 0u);
+  const LeftOut out = leftOut(d, r.static_points);
+  EXPECT_EQ(out.box, box_points);
+  EXPECT_EQ(out.wall, 0u);
   EXPECT_EQ(r.moving, box_points);
   // The cloud written with the mask holds the walls only.
   EXPECT_EQ(io::countMapPoints(posed, 1, &r.static_points), d.box_point.size() - box_points);
@@ -118,16 +125,13 @@ TEST(MovingPoints, WhatLaterScansSawThroughIsLeftOutAndTheWallsStay) {
 // runs on several threads, and the verdicts must land on their own points, in cloud order.
 TEST(MovingPoints, AcrossRunsOfKeyframesTheVerdictsKeepTheirPoints) {
   const Drive d = drive([](size_t i) { return i >= 300 && i < 303; }, 12);  // 360 scans
-  const auto posed = d.posed();
-  size_t box_points = 0;
-  for (bool b : d.box_point) box_points += b ? 1 : 0;
+  const size_t box_points = d.boxPoints();
   ASSERT_GT(box_points, 30u);
-  const slam::MovingPointsResult r = slam::findMovingPoints(posed, {});
+  const slam::MovingPointsResult r = slam::findMovingPoints(d.posed(), {});
   ASSERT_EQ(r.static_points.size(), d.box_point.size());
-  size_t box_left_out = 0, wall_left_out = 0;
-  for (size_t i = 0; i < d.box_point.size(); ++i) (d.box_point[i] ? box_left_out : wall_left_out) += r.static_points.keeps(i) ? 0 : 1;
-  EXPECT_EQ(box_left_out, box_points);
-  EXPECT_EQ(wall_left_out, 0u);
+  const LeftOut out = leftOut(d, r.static_points);
+  EXPECT_EQ(out.box, box_points);
+  EXPECT_EQ(out.wall, 0u);
   EXPECT_EQ(r.moving, box_points);
 }
 

@@ -74,10 +74,11 @@ MovingPointsResult findMovingPoints(const std::vector<io::PosedScan>& scans, con
     std::vector<int> votes;
     std::vector<char> state;
   };
-  std::vector<Worker> workers;
   const size_t runs = (scans.size() + kRunKeyframes - 1) / kRunKeyframes;
-  for (size_t w = common::workerCount(runs, kMaxWorkers); w-- > 0;)
-    workers.push_back({FreeSpaceCache(scans, o, std::max<size_t>(64, 8 * views))});
+  const size_t n_workers = common::workerCount(runs, kMaxWorkers);
+  std::vector<Worker> workers;
+  workers.reserve(n_workers);
+  while (workers.size() < n_workers) workers.push_back({FreeSpaceCache(scans, o, std::max<size_t>(64, 8 * views))});
   std::vector<io::PointMask> kept(runs);  // per run, a bit per point (10^6 keyframes hold 10^8 points)
   common::runJobs(runs, workers.size(), [&](size_t w, size_t run) {
     Worker& k = workers[w];
@@ -114,8 +115,9 @@ MovingPointsResult findMovingPoints(const std::vector<io::PosedScan>& scans, con
   });
   for (const io::PointMask& run : kept)
     for (size_t p = 0; p < run.size(); ++p) {
-      out.static_points.push(run.keeps(p));
-      out.moving += run.keeps(p) ? 0 : 1;
+      const bool stays = run.keeps(p);
+      out.static_points.push(stays);
+      out.moving += stays ? 0 : 1;
     }
   out.seconds = sw.seconds();
   return out;
