@@ -238,7 +238,15 @@ ObservationResult Esdf::observeRelative(int i, int j, const Vec3& z, const Mat3&
   return r;
 }
 
-GateResult Esdf::gateRelative(int i, int j, const Vec3& z, const Mat3& omega) {
+GateResult Esdf::gateRelative(int i, int j, const Vec3& z, const Mat3& omega) { return *gate(i, j, z, omega, false); }
+
+std::optional<GateResult> Esdf::refusalWithoutFactorising(int i, int j, const Vec3& z, const Mat3& omega) {
+  const std::optional<GateResult> r = gate(i, j, z, omega, true);
+  if (r && !r->accepted) return r;
+  return std::nullopt;
+}
+
+std::optional<GateResult> Esdf::gate(int i, int j, const Vec3& z, const Mat3& omega, bool without_factorising) {
   if (i < 0 || j < 0 || i >= size() || j >= size() || i == j) throw std::out_of_range("gateRelative: bad pose indices");
   const Vec3 e0 = relativePoseError(state_.mean(i), state_.mean(j), z);
   if (gate_probability_ != options_.chi2_gate_probability) {
@@ -272,6 +280,7 @@ GateResult Esdf::gateRelative(int i, int j, const Vec3& z, const Mat3& omega) {
     const GateResult r = test(relativeCovariance(i, j, CovarianceMode::Conservative));
     if (bound_only || !r.accepted) return r;
   }
+  if (without_factorising) return std::nullopt;
   return test(relativeCovariance(i, j, CovarianceMode::Exact));
 }
 

@@ -169,6 +169,18 @@ esdf::GateResult KeyframeNodes::gateRelative(size_t i, size_t k, const Vec3& z, 
   return filter_.gateRelative(hangs_[i].node, hangs_[k].node, zn, cn.inverse());
 }
 
+std::optional<esdf::GateResult> KeyframeNodes::refusalWithoutFactorising(size_t i, size_t k, const Vec3& z, const Mat3& omega) {
+  if (!hung(i) && !hung(k)) return filter_.refusalWithoutFactorising(node(i), node(k), z, omega);
+  if (hangs_[i].node == hangs_[k].node) {
+    const esdf::GateResult r = gateWithinNode(i, k, z, omega);  // no covariance of the map's
+    return r.accepted ? std::nullopt : std::optional<esdf::GateResult>(r);
+  }
+  Vec3 zn;
+  Mat3 cn;
+  toNodes(i, k, z, omega.inverse(), 1.0, 1.0, &zn, &cn);
+  return filter_.refusalWithoutFactorising(hangs_[i].node, hangs_[k].node, zn, cn.inverse());
+}
+
 void KeyframeNodes::writeState(common::BinaryWriter& w) const {
   w.boolean(reduced_);
   if (!reduced_) return;

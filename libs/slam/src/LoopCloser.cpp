@@ -217,7 +217,22 @@ std::optional<size_t> LoopCloser::oppositeViewPartner(KeyframeNodes& filter, con
 alignment::AlignmentResult LoopCloser::verifyAlignment(const io::LaserScan& earlier_scan, const io::LaserScan& current_scan,
                                                        const common::Pose2& guess, alignment::Method method, double reach_m,
                                                        LoopClosureRecord& r, const alignment::PoseRegion* admitted) const {
-  alignment::AlignerOptions ao;
+  const AlignedScans a = alignScans(earlier_scan, current_scan, guess, method, reach_m, r, admitted);
+  if (r.reason != ClosureReason::None) return a.result;
+  if (ambiguous(a)) {
+    r.reason = ClosureReason::Ambiguous;
+    return a.result;
+  }
+  freeSpaceConflict(earlier_scan, current_scan, r);
+  return a.result;
+}
+
+LoopCloser::AlignedScans LoopCloser::alignScans(const io::LaserScan& earlier_scan, const io::LaserScan& current_scan,
+                                                const common::Pose2& guess, alignment::Method method, double reach_m, LoopClosureRecord& r,
+                                                const alignment::PoseRegion* admitted) const {
+  AlignedScans out;
+  out.reach_m = reach_m;
+  alignment::AlignerOptions& ao = out.options;
   ao.min_constraint_ratio = options_.min_constraint_ratio;
   ao.method = method;
   // ICP restarts from CRF-match's best two consensus hypotheses (and its transform and the guess),
@@ -227,7 +242,7 @@ alignment::AlignmentResult LoopCloser::verifyAlignment(const io::LaserScan& earl
   // 0.0369 m against 0.0370); the cities ran 3-6 % faster (bench/scale/RESULTS.md).
   ao.crf.hypotheses_kept = 2;
   alignment::PointSet earlier_set = alignment::pointSetFromScan(earlier_scan, ao.scan, ao.in_vehicle_frame);
-  const alignment::PointSet current_points = alignment::pointSetFromScan(current_scan, ao.scan, ao.in_vehicle_frame);
+  out.current = alignment::pointSetFromScan(current_scan, ao.scan, ao.in_vehicle_frame);
   // Two 180° scans that looked away from each other, or at places the other never saw, share no
   // points wherever the gate would put them: the check costs microseconds, a global alignment
   // that is bound to fail milliseconds (the most common failure in a city: the opposite lane).
@@ -235,28 +250,32 @@ alignment::AlignmentResult LoopCloser::verifyAlignment(const io::LaserScan& earl
     alignment::ViewOverlapOptions vo;
     vo.gate_m = ao.icp.gate_final_m;
     const alignment::ViewSector sector = alignment::viewSector(earlier_set, earlier_scan.sensor_pose);
-    if (!alignment::mayMatchShare(sector, current_points, *admitted, options_.min_matched_fraction, vo)) {
+    if (!alignment::mayMatchShare(sector, out.current, *admitted, options_.min_matched_fraction, vo)) {
       r.measurement = guess;
       r.reason = ClosureReason::NoOverlap;
-      return {};
+      return out;
     }
   }
   // The point sets, kd-tree and line normals built once for every alignment below (the
   // ambiguity test restarts PL-ICP up to 16 times).
-  const alignment::IndexedReference earlier_points(std::move(earlier_set));
+  out.earlier = std::make_unique<const alignment::IndexedReference>(std::move(earlier_set));
   // Below min_matched_fraction an alignment is refused: its ICP runs (from CRF-match's
   // hypotheses and the guess) that cannot reach it are given up early. The ambiguity test's
-  // restarts below are given up the same way below the count that would make them another
-  // minimum (`findsOtherMinimum`).
+  // restarts are given up the same way below the count that would make them another minimum
+  // (`findsOtherMinimum`).
   alignment::AlignerOptions first = ao;
   first.icp.abandon_below_fraction = options_.min_matched_fraction;
-  const alignment::AlignmentResult a = alignment::alignPointSets(earlier_points, current_points, guess, first);
+  out.result = alignment::alignPointSets(*out.earlier, out.current, guess, first);
+  const alignment::AlignmentResult& a = out.result;
   r.measurement = a.transform;
   r.rms_m = a.rms_residual_m;
-  if (!a.converged || a.rms_residual_m > options_.max_rms_m || a.matchedFraction() < options_.min_matched_fraction) {
+  if (!a.converged || a.rms_residual_m > options_.max_rms_m || a.matchedFraction() < options_.min_matched_fraction)
     r.reason = ClosureReason::Alignment;
-    return a;
-  }
+  return out;
+}
+
+bool LoopCloser::ambiguous(const AlignedScans& a) const {
+  if (options_.ambiguity_offset_m <= 0) return false;
   // A wrong closure is usually a wrong local minimum (aliasing along a corridor or a facade) that
   // the drifted estimate happened to start PL-ICP in: restarts from the result shifted by
   // ambiguity_offset_m, twice, four and eight times that, as far as reach_m (for a closure, 3
@@ -264,17 +283,18 @@ alignment::AlignmentResult LoopCloser::verifyAlignment(const io::LaserScan& earl
   // elsewhere that matches clearly more points.
   alignment::ShiftedRestarts restarts;
   restarts.first_shift_m = options_.ambiguity_offset_m;
-  restarts.last_shift_m = std::min(8 * options_.ambiguity_offset_m, 2 * reach_m);
+  restarts.last_shift_m = std::min(8 * options_.ambiguity_offset_m, 2 * a.reach_m);
   restarts.same_minimum_m = 0.25 * options_.ambiguity_offset_m;
   restarts.min_match_ratio = 1.0 + options_.ambiguity_min_gain;
   restarts.max_rms_m = options_.max_rms_m;
-  if (options_.ambiguity_offset_m > 0 && alignment::findsOtherMinimum(earlier_points, current_points, a, ao, restarts)) {
-    r.reason = ClosureReason::Ambiguous;
-    return a;
-  }
-  r.free_space_conflict = alignment::mutualFreeSpaceConflict(earlier_scan, current_scan, a.transform, freeSpaceOptions(options_));
-  if (r.free_space_conflict > options_.max_free_space_conflict) r.reason = ClosureReason::FreeSpace;
-  return a;
+  return alignment::findsOtherMinimum(*a.earlier, a.current, a.result, a.options, restarts);
+}
+
+bool LoopCloser::freeSpaceConflict(const io::LaserScan& earlier_scan, const io::LaserScan& current_scan, LoopClosureRecord& r) const {
+  r.free_space_conflict = alignment::mutualFreeSpaceConflict(earlier_scan, current_scan, r.measurement, freeSpaceOptions(options_));
+  if (r.free_space_conflict <= options_.max_free_space_conflict) return false;
+  r.reason = ClosureReason::FreeSpace;
+  return true;
 }
 
 LoopClosureRecord LoopCloser::tryClose(KeyframeNodes& filter, const Map& map, size_t earlier, size_t current, bool commit,
@@ -314,10 +334,13 @@ LoopClosureRecord LoopCloser::tryClose(KeyframeNodes& filter, const Map& map, si
   // Where the innovation gate admits a measurement: the relative pose's own uncertainty (the
   // alignment's, centimetres, is left out).
   const alignment::PoseRegion admitted{guess, s, chi2_3dof_gate_};
-  const alignment::AlignmentResult a =
-      verifyAlignment(earlier_scan, current_scan, guess, method, 3 * r.prior_sigma_m, r, options_.view_test ? &admitted : nullptr);
+  // The checks of verifyAlignment, with the ambiguity restarts (its costly part) left until the
+  // measurement is final and the gate has not refused it already.
+  const AlignedScans aligned =
+      alignScans(earlier_scan, current_scan, guess, method, 3 * r.prior_sigma_m, r, options_.view_test ? &admitted : nullptr);
+  const alignment::AlignmentResult& a = aligned.result;
   if (!detection) r.score = a.matchedFraction();
-  if (r.reason != ClosureReason::None) return r;
+  if (r.reason != ClosureReason::None || freeSpaceConflict(earlier_scan, current_scan, r)) return r;
   // A closure far beyond what the estimate knew (found by appearance or from a wide prior) is
   // where a consistently aliased street gets in: the two visits' path submaps, aligned from it,
   // must have no other alignment nearly as good within the gate's reach, and their alignment
@@ -325,28 +348,46 @@ LoopClosureRecord LoopCloser::tryClose(KeyframeNodes& filter, const Map& map, si
   // is kept, the conservative of the two).
   // Two narrow views heading opposite ways meet only ahead of both (oppositeViewPartner), on a
   // stretch of street that slides along itself as easily as a far closure's: the same check.
+  std::optional<PathSubmapAlignment> submaps;
   if (options_.submap_check_path_m > 0 && (r.prior_sigma_m > options_.appearance_min_sigma_m || headingOtherWay(map, xi, xk, current))) {
     PathSubmapOptions po;
     po.path_m = options_.submap_check_path_m;
-    const SubmapCheck c = alignPathSubmaps(map, earlier, current, a.transform, 3 * r.prior_sigma_m, po);
-    if (c.ambiguous) {
-      r.reason = ClosureReason::Submaps;
-      return r;
-    }
-    if (c.aligned) {
+    submaps.emplace(map, earlier, current, a.transform, po);
+    if (submaps->aligned()) {
       // The submaps' measurement replaces the scans' only where the two scans agree on free space
       // there too: along a street of one repeated design (window bays metres apart) the submaps
       // can settle one period away from where the scans fitted without conflict.
-      const double conflict = alignment::mutualFreeSpaceConflict(earlier_scan, current_scan, c.measurement, freeSpaceOptions(options_));
+      const double conflict =
+          alignment::mutualFreeSpaceConflict(earlier_scan, current_scan, submaps->measurement(), freeSpaceOptions(options_));
       if (conflict <= options_.max_free_space_conflict) {
-        r.measurement = c.measurement;
+        r.measurement = submaps->measurement();
         r.free_space_conflict = conflict;
       }
     }
   }
-  // Innovation gate, then the information-form update.
   const esdf::Mat3 cov = options_.covariance_scale * a.cov;
   r.information = cov.inverse();
+  // A closure the gate refuses whatever the restarts say is refused before them, when the
+  // conservative covariance already tells (no factorisation): far from the map most aligned
+  // candidates are look-alike places the gate refuses (the 1,000 km city drive on new streets:
+  // 467 of the 485 that reached the gate), and the restarts of the scans and of the submaps
+  // were most of their cost. The decisions are the same in either order; only the reason given
+  // to a candidate that fails several tests changes.
+  if (const auto refused = filter.refusalWithoutFactorising(earlier, current, esdf::toVec(r.measurement), r.information)) {
+    r.mahalanobis2 = refused->mahalanobis2;
+    r.gate_threshold = refused->threshold;
+    r.reason = ClosureReason::Gating;
+    return r;
+  }
+  if (ambiguous(aligned)) {
+    r.reason = ClosureReason::Ambiguous;
+    return r;
+  }
+  if (submaps && submaps->ambiguous(3 * r.prior_sigma_m)) {
+    r.reason = ClosureReason::Submaps;
+    return r;
+  }
+  // Innovation gate, then the information-form update.
   esdf::GateResult gate;
   if (commit) {
     gate =

@@ -41,27 +41,39 @@ alignment::PointSet pathSubmap(const Map& map, size_t center, size_t first, size
   return out;
 }
 
-SubmapCheck alignPathSubmaps(const Map& map, size_t earlier, size_t current, const common::Pose2& z, double reach_m,
-                             const PathSubmapOptions& options) {
-  SubmapCheck out;
-  if (earlier >= current || current >= map.size()) return out;
+PathSubmapAlignment::PathSubmapAlignment(const Map& map, size_t earlier, size_t current, const common::Pose2& z,
+                                         const PathSubmapOptions& options)
+    : options_(options) {
+  if (earlier >= current || current >= map.size()) return;
   // Each visit on its own side of the halfway keyframe: a short loop's two neighbourhoods must
   // not share keyframes (they would align as the trajectory says, not as the closure does).
   const size_t half = earlier + (current - earlier) / 2;
-  const alignment::IndexedReference before(pathSubmap(map, earlier, 0, half, options));
-  const alignment::PointSet now = pathSubmap(map, current, half + 1, current, options);
+  before_ = std::make_unique<const alignment::IndexedReference>(pathSubmap(map, earlier, 0, half, options));
+  now_ = pathSubmap(map, current, half + 1, current, options);
   alignment::AlignerOptions ao;
   ao.method = alignment::Method::PlIcp;
-  const alignment::AlignmentResult a = alignment::alignPointSets(before, now, z, ao);
-  out.aligned = a.converged;
-  out.measurement = a.transform;
-  if (!a.converged) return out;
+  result_ = alignment::alignPointSets(*before_, now_, z, ao);
+}
+
+bool PathSubmapAlignment::ambiguous(double reach_m) const {
+  if (!aligned()) return false;
+  alignment::AlignerOptions ao;
+  ao.method = alignment::Method::PlIcp;
   alignment::ShiftedRestarts restarts;
-  restarts.first_shift_m = options.min_shift_m;
+  restarts.first_shift_m = options_.min_shift_m;
   restarts.last_shift_m = reach_m;
-  restarts.same_minimum_m = 0.5 * options.min_shift_m;
-  restarts.min_match_ratio = 1.0 - options.ambiguity_loss;
-  out.ambiguous = alignment::findsOtherMinimum(before, now, a, ao, restarts);
+  restarts.same_minimum_m = 0.5 * options_.min_shift_m;
+  restarts.min_match_ratio = 1.0 - options_.ambiguity_loss;
+  return alignment::findsOtherMinimum(*before_, now_, result_, ao, restarts);
+}
+
+SubmapCheck alignPathSubmaps(const Map& map, size_t earlier, size_t current, const common::Pose2& z, double reach_m,
+                             const PathSubmapOptions& options) {
+  const PathSubmapAlignment p(map, earlier, current, z, options);
+  SubmapCheck out;
+  out.aligned = p.aligned();
+  out.measurement = p.measurement();
+  out.ambiguous = p.ambiguous(reach_m);
   return out;
 }
 

@@ -22,6 +22,7 @@
 #include <deque>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <queue>
 #include <unordered_map>
 #include <unordered_set>
@@ -121,6 +122,10 @@ class Esdf {
   ObservationResult observeRelative(int i, int j, const Vec3& z, const Mat3& omega, bool gate = false);
   // The gate test alone (nothing is added): d^2 of the innovation at the current mean.
   GateResult gateRelative(int i, int j, const Vec3& z, const Mat3& omega);
+  // The gate's refusal when it is known without a factorisation (the conservative covariance
+  // refuses z; gateRelative then refuses it too, with this result); nothing when the gate may
+  // admit z. For a caller with costly checks of its own to skip when the gate will refuse anyway.
+  std::optional<GateResult> refusalWithoutFactorising(int i, int j, const Vec3& z, const Mat3& omega);
 
   // Full recovery: factorise Lambda (CHOLMOD), mu = Lambda^-1 eta, then (if enabled) up to
   // max_relinearise_passes rounds of relinearise + re-solve (-1: options().relinearise_max_passes).
@@ -270,6 +275,9 @@ class Esdf {
   static constexpr int kAnchorPathLinks = 64;
   static constexpr size_t kAnchorPathPoses = 4096;  // the path search settles at most this many poses
   const PathBound* anchorPath(int p);
+  // gateRelative, stopping short of the exact covariance when without_factorising: nothing then
+  // where only the exact covariance (a factorisation) could decide.
+  std::optional<GateResult> gate(int i, int j, const Vec3& z, const Mat3& omega, bool without_factorising);
   // A relative factor from its end a (from_a) or b to the other: d_x the Jacobian of the other
   // pose in this one, d_e in the factor's noise (AnchorPaths.cpp).
   static void factorStep(const Factor& f, bool from_a, Mat3* d_x, Mat3* d_e);

@@ -24,6 +24,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <deque>
+#include <optional>
 
 #include "urbanslam/common/BinaryStream.h"
 #include "urbanslam/esdf/Esdf.h"
@@ -70,6 +71,8 @@ class KeyframeNodes {
   // share as the header says, or is gated and adds nothing.
   esdf::ObservationResult observeRelative(size_t i, size_t k, const esdf::Vec3& z, const esdf::Mat3& omega, bool gate);
   esdf::GateResult gateRelative(size_t i, size_t k, const esdf::Vec3& z, const esdf::Mat3& omega);
+  // ... and its refusal when known without a factorisation (Esdf::refusalWithoutFactorising).
+  std::optional<esdf::GateResult> refusalWithoutFactorising(size_t i, size_t k, const esdf::Vec3& z, const esdf::Mat3& omega);
   void writeState(common::BinaryWriter& w) const;
   // After the filter's state; `keyframes`: the map's. Map format 10 hung keyframes otherwise:
   // such a map is refused.

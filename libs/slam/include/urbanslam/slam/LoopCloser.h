@@ -7,12 +7,14 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
 
 #include "urbanslam/alignment/Aligner.h"
+#include "urbanslam/alignment/IndexedReference.h"
 #include "urbanslam/alignment/ViewOverlap.h"
 #include "urbanslam/common/BinaryStream.h"
 #include "urbanslam/esdf/Esdf.h"
@@ -172,6 +174,22 @@ class LoopCloser {
   size_t cached_for_ = static_cast<size_t>(-1);
   std::unordered_map<size_t, Eigen::Matrix3d> cached_;  // relative covariances for cached_for_
   std::optional<bool> narrow_view_;                     // the laser covers well under the full circle (read once)
+
+  // Two scans aligned by verifyAlignment's first step, kept for its ambiguity restarts (which
+  // tryClose runs only when the gate does not refuse the closure anyway).
+  struct AlignedScans {
+    alignment::AlignmentResult result;
+    std::unique_ptr<const alignment::IndexedReference> earlier;
+    alignment::PointSet current;
+    alignment::AlignerOptions options;
+    double reach_m = 0;
+  };
+  // verifyAlignment's steps: the alignment with its residual and matched share (r's measurement,
+  // rms_m and, when it fails, reason), then the ambiguity restarts, then the free-space test.
+  AlignedScans alignScans(const io::LaserScan& earlier, const io::LaserScan& current, const common::Pose2& guess, alignment::Method method,
+                          double reach_m, LoopClosureRecord& r, const alignment::PoseRegion* admitted) const;
+  bool ambiguous(const AlignedScans& a) const;
+  bool freeSpaceConflict(const io::LaserScan& earlier, const io::LaserScan& current, LoopClosureRecord& r) const;
 
   // For a candidate heading the other way, the keyframe of its visit whose view meets the current
   // scan's ([loop_closure] opposite_view_offset_m); none when the candidate stays.

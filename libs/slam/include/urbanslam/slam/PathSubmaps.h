@@ -9,7 +9,10 @@
 // along a street comes back to within centimetres), and another alignment nearly as good within
 // the gate's reach says that the street repeats itself beyond what even they can tell.
 #include <cstddef>
+#include <memory>
 
+#include "urbanslam/alignment/Aligner.h"
+#include "urbanslam/alignment/IndexedReference.h"
 #include "urbanslam/alignment/PointSet.h"
 #include "urbanslam/common/Pose2.h"
 
@@ -39,9 +42,25 @@ struct SubmapCheck {
 
 // The two visits' submaps (the current one's path up to `current`, the earlier one's around
 // `earlier`, each on its own side of the halfway keyframe between them) aligned by PL-ICP from
-// the closure's measurement z (pose of current in earlier's frame); then restarted from that
-// alignment shifted along x and y by min_shift_m, twice and four times that, ... as far as
-// reach_m (what the innovation gate could admit).
+// the closure's measurement z (pose of current in earlier's frame). They are kept for the
+// ambiguity test, the costly part, which a caller runs only when nothing else refuses the
+// closure: restarts from that alignment shifted along x and y by min_shift_m, twice and four
+// times that, ... as far as reach_m (what the innovation gate could admit).
+class PathSubmapAlignment {
+ public:
+  PathSubmapAlignment(const Map& map, size_t earlier, size_t current, const common::Pose2& z, const PathSubmapOptions& options);
+  bool aligned() const { return result_.converged; }
+  const common::Pose2& measurement() const { return result_.transform; }
+  bool ambiguous(double reach_m) const;
+
+ private:
+  PathSubmapOptions options_;
+  std::unique_ptr<const alignment::IndexedReference> before_;
+  alignment::PointSet now_;
+  alignment::AlignmentResult result_;
+};
+
+// Both steps at once.
 SubmapCheck alignPathSubmaps(const Map& map, size_t earlier, size_t current, const common::Pose2& z, double reach_m,
                              const PathSubmapOptions& options);
 
