@@ -174,23 +174,31 @@ TEST(Gating, ConservativeBoundDecidesOnlyWhatTheExactTestWouldDecideAlike) {
 TEST(Gating, ARefusalWithoutFactorisingIsTheGatesOwnAndCostsNoFactorisation) {
   // A caller with costly checks left (the loop closer's shifted restarts) asks first whether
   // the gate will refuse a closure anyway. The answer comes from what needs no factorisation
-  // (the bound from R alone, the conservative covariance); when it is a refusal, gateRelative
-  // refuses the same closure with the same d^2, and when it is none, the closure may be admitted.
+  // (the bound from R alone, the conservative covariance, the exact one from the last
+  // factorisation and the closures since); when it is a refusal, gateRelative refuses the same
+  // closure with the same d^2, and when it is none, the closure may be admitted. A closure
+  // after the factorisation makes the conservative covariance looser than the exact one, so
+  // some refusals need the exact one.
   std::mt19937 rng(7);
   EsdfOptions o;
   o.chi2_gate_probability = 0.95;
   o.gate_covariance = CovarianceMode::Exact;
-  Esdf f(o), reference(o);
+  EsdfOptions oc = o;
+  oc.gate_covariance = CovarianceMode::Conservative;
+  Esdf f(o), reference(o), conservative(oc);
+  const std::vector<Esdf*> all{&f, &reference, &conservative};
   const Mat3 odo = Vec3(400.0, 400.0, 4000.0).asDiagonal();
   const Mat3 omega = Vec3(100.0, 100.0, 1000.0).asDiagonal();
-  for (Esdf* g : {&f, &reference}) g->initialise(Vec3::Zero(), Mat3::Identity() * 1e-8);
+  for (Esdf* g : all) g->initialise(Vec3::Zero(), Mat3::Identity() * 1e-8);
   for (int k = 1; k <= 70; ++k) {
     const Vec3 step(1.0, 0.0, (k % 20 == 0) ? M_PI / 2 : 0.0);
-    for (Esdf* g : {&f, &reference}) g->augmentRelative(k - 1, step, odo);
+    for (Esdf* g : all) g->augmentRelative(k - 1, step, odo);
     if (k == 40)
-      for (Esdf* g : {&f, &reference}) g->recover();
+      for (Esdf* g : all) g->recover();
+    if (k == 55)
+      for (Esdf* g : all) g->observeRelative(5, 55, between(g->mean(5), g->mean(55)), omega);
   }
-  int refused = 0, undecided = 0;
+  int refused = 0, undecided = 0, refused_by_the_exact_covariance = 0;
   for (int t = 0; t < 200; ++t) {
     const int i = t % 40, j = 41 + (t * 7) % 29;
     const double spread = t % 2 == 0 ? 0.05 : 3.0;  // consistent closures and look-alike places
@@ -204,13 +212,17 @@ TEST(Gating, ARefusalWithoutFactorisingIsTheGatesOwnAndCostsNoFactorisation) {
       EXPECT_FALSE(early->accepted);
       EXPECT_FALSE(full.accepted) << i << " " << j;
       EXPECT_NEAR(early->mahalanobis2, full.mahalanobis2, 1e-9 * full.mahalanobis2);
+      refused_by_the_exact_covariance += conservative.gateRelative(i, j, z, omega).accepted;
     } else {
       ++undecided;
     }
   }
-  // Both kinds occur: far-off measurements the bound refuses, and the rest.
+  // Every kind occurs: far-off measurements the bounds refuse, some only the exact covariance
+  // refuses, and the rest.
   EXPECT_GT(refused, 20);
+  EXPECT_GT(refused_by_the_exact_covariance, 0);
   EXPECT_GT(undecided, 20);
+  RecordProperty("refused_by_the_exact_covariance", refused_by_the_exact_covariance);
 }
 
 INSTANTIATE_TEST_SUITE_P(Modes, GatingLoop, ::testing::Values(CovarianceMode::Exact, CovarianceMode::Conservative));

@@ -280,7 +280,13 @@ std::optional<GateResult> Esdf::gate(int i, int j, const Vec3& z, const Mat3& om
     const GateResult r = test(relativeCovariance(i, j, CovarianceMode::Conservative));
     if (bound_only || !r.accepted) return r;
   }
-  if (without_factorising) return std::nullopt;
+  if (without_factorising) {
+    // The exact covariance without a factorisation: the last one corrected by what came since
+    // (ExactUpdates.cpp), as the exact gate would take it.
+    Mat6 joint;
+    if (factorCurrent() || !updatedJoint(i, j, &joint)) return std::nullopt;
+    return test(betweenCovariance(state_.mean(i), state_.mean(j), joint));
+  }
   return test(relativeCovariance(i, j, CovarianceMode::Exact));
 }
 

@@ -367,8 +367,8 @@ LoopClosureRecord LoopCloser::tryClose(KeyframeNodes& filter, const Map& map, si
   }
   const esdf::Mat3 cov = options_.covariance_scale * a.cov;
   r.information = cov.inverse();
-  // A closure the gate refuses whatever the restarts say is refused before them, when the
-  // conservative covariance already tells (no factorisation): far from the map most aligned
+  // A closure the gate refuses whatever the restarts say is refused before them, when that is
+  // known without a factorisation (Esdf::refusalWithoutFactorising): far from the map most aligned
   // candidates are look-alike places the gate refuses (the 1,000 km city drive on new streets:
   // 467 of the 485 that reached the gate), and the restarts of the scans and of the submaps
   // were most of their cost. The decisions are the same in either order; only the reason given

@@ -122,9 +122,11 @@ class Esdf {
   ObservationResult observeRelative(int i, int j, const Vec3& z, const Mat3& omega, bool gate = false);
   // The gate test alone (nothing is added): d^2 of the innovation at the current mean.
   GateResult gateRelative(int i, int j, const Vec3& z, const Mat3& omega);
-  // The gate's refusal when it is known without a factorisation (the conservative covariance
-  // refuses z; gateRelative then refuses it too, with this result); nothing when the gate may
-  // admit z. For a caller with costly checks of its own to skip when the gate will refuse anyway.
+  // The gate's refusal when it is known without a factorisation (by the conservative covariance,
+  // or by the exact one from the last factorisation and the closures since, ExactUpdates.cpp):
+  // gateRelative then refuses z too, with this result. Nothing when the gate may admit z or only
+  // a factorisation could tell. For a caller with costly checks of its own to skip when the gate
+  // will refuse anyway.
   std::optional<GateResult> refusalWithoutFactorising(int i, int j, const Vec3& z, const Mat3& omega);
 
   // Full recovery: factorise Lambda (CHOLMOD), mu = Lambda^-1 eta, then (if enabled) up to
