@@ -371,7 +371,7 @@ LoopClosureRecord LoopCloser::tryClose(KeyframeNodes& filter, const Map& map, si
   // known without a factorisation (Esdf::refusalWithoutFactorising): far from the map most aligned
   // candidates are look-alike places the gate refuses (the 1,000 km city drive on new streets:
   // 467 of the 485 that reached the gate), and the restarts of the scans and of the submaps
-  // were most of their cost. The decisions are the same in either order; only the reason given
+  // were most of their cost. Every test's verdict is the same in either order; the reason given
   // to a candidate that fails several tests changes.
   if (const auto refused = filter.refusalWithoutFactorising(earlier, current, esdf::toVec(r.measurement), r.information)) {
     r.mahalanobis2 = refused->mahalanobis2;
