@@ -95,6 +95,21 @@ TEST(Gating, BoundShortcutNeverAcceptsWhatTheFullTestRejects) {
   EXPECT_GT(full, 0);
 }
 
+// The same drive in every filter: metre steps turning left every 20 (information odo), the map
+// factorised at pose 40, and a closure from pose 5 to pose closure_to of the dead-reckoned chain
+// after it (information omega).
+void squareDrive(const std::vector<Esdf*>& filters, int poses, int closure_to, const Mat3& odo, const Mat3& omega) {
+  for (Esdf* f : filters) f->initialise(Vec3::Zero(), Mat3::Identity() * 1e-8);
+  for (int k = 1; k < poses; ++k) {
+    const Vec3 step(1.0, 0.0, (k % 20 == 0) ? M_PI / 2 : 0.0);
+    for (Esdf* f : filters) f->augmentRelative(k - 1, step, odo);
+    if (k == 40)
+      for (Esdf* f : filters) f->recover();
+    if (k == closure_to)
+      for (Esdf* f : filters) f->observeRelative(5, closure_to, between(f->mean(5), f->mean(closure_to)), omega);
+  }
+}
+
 TEST(Gating, ConservativeBoundDecidesOnlyWhatTheExactTestWouldDecideAlike) {
   // The conservative covariance bounds the exact one from above (the last factorisation holds
   // less information; dead reckoning and the newest closure's path add, never remove), so its
@@ -113,15 +128,7 @@ TEST(Gating, ConservativeBoundDecidesOnlyWhatTheExactTestWouldDecideAlike) {
   const Mat3 odo = Vec3(400.0, 400.0, 4000.0).asDiagonal();
   const Mat3 omega = Vec3(100.0, 100.0, 1000.0).asDiagonal();
   const std::vector<Esdf*> all{&fe, &fc, &fr};
-  for (Esdf* f : all) f->initialise(Vec3::Zero(), Mat3::Identity() * 1e-8);
-  for (int k = 1; k <= 80; ++k) {
-    const Vec3 step(1.0, 0.0, (k % 20 == 0) ? M_PI / 2 : 0.0);
-    for (Esdf* f : all) f->augmentRelative(k - 1, step, odo);
-    if (k == 40)
-      for (Esdf* f : all) f->recover();
-    if (k == 60)  // a closure into the dead-reckoned chain, for the conservative path through it
-      for (Esdf* f : all) f->observeRelative(5, 60, between(f->mean(5), f->mean(60)), omega);
-  }
+  squareDrive(all, 81, 60, odo, omega);  // the closure for the conservative path through it
   int compared = 0, admitted_more = 0, refused_by_bound = 0, exact_accepted = 0, stale_rounds = 0;
   const long long factorisations_before = fe.factorisations();
   for (int t = 0; t < 300; ++t) {
@@ -186,18 +193,9 @@ TEST(Gating, ARefusalWithoutFactorisingIsTheGatesOwnAndCostsNoFactorisation) {
   EsdfOptions oc = o;
   oc.gate_covariance = CovarianceMode::Conservative;
   Esdf f(o), reference(o), conservative(oc);
-  const std::vector<Esdf*> all{&f, &reference, &conservative};
   const Mat3 odo = Vec3(400.0, 400.0, 4000.0).asDiagonal();
   const Mat3 omega = Vec3(100.0, 100.0, 1000.0).asDiagonal();
-  for (Esdf* g : all) g->initialise(Vec3::Zero(), Mat3::Identity() * 1e-8);
-  for (int k = 1; k <= 70; ++k) {
-    const Vec3 step(1.0, 0.0, (k % 20 == 0) ? M_PI / 2 : 0.0);
-    for (Esdf* g : all) g->augmentRelative(k - 1, step, odo);
-    if (k == 40)
-      for (Esdf* g : all) g->recover();
-    if (k == 55)
-      for (Esdf* g : all) g->observeRelative(5, 55, between(g->mean(5), g->mean(55)), omega);
-  }
+  squareDrive({&f, &reference, &conservative}, 71, 55, odo, omega);
   int refused = 0, undecided = 0, refused_by_the_exact_covariance = 0;
   for (int t = 0; t < 200; ++t) {
     const int i = t % 40, j = 41 + (t * 7) % 29;

@@ -8,8 +8,10 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "ConstantScan.h"
@@ -338,4 +340,36 @@ TEST(KeyframeNodes, ARevisitAddsInformationNotPoses) {
     EXPECT_NEAR(a.y, b.y, 0.05) << k;
     EXPECT_NEAR(a.x, static_cast<double>(k) - 100, 0.1) << k;
   }
+}
+
+// The early gate the loop closer asks before its costly tests: for keyframes that are filter
+// poses, hung from two of them, or hung from one, a refusal it gives is the gate's own (the same
+// d^2), and it gives none for a closure the gate admits.
+TEST(KeyframeNodes, AnEarlyRefusalIsTheGatesOwnForHungKeyframesToo) {
+  esdf::Esdf filter;
+  slam::KeyframeNodes nodes(filter, true);
+  chain(filter, nodes);
+  filter.recover();
+  // Three keyframes more, the last a filter pose: the factor is stale again, so the gate's exact
+  // covariance would take a factorisation.
+  for (size_t k = kChain; k < kChain + 3; ++k) nodes.add(k - 1, step(k), stepOmega());
+  const Mat3 omega = Vec3(1 / 0.0004, 1 / 0.0004, 1 / 3e-5).asDiagonal();
+  // Filter poses 0 and 8; 4 and the hung kChain; 25 and 27, both hung from 24.
+  const std::vector<std::pair<size_t, size_t>> pairs{{0, 8}, {4, kChain}, {25, 27}};
+  ASSERT_FALSE(nodes.hung(0) || nodes.hung(8) || nodes.hung(4));
+  ASSERT_TRUE(nodes.hung(kChain) && nodes.hung(25) && nodes.hung(27));
+  int refused = 0;
+  for (const auto& [i, k] : pairs)
+    for (const double off : {0.0, 3.0}) {
+      const Vec3 z = esdf::between(nodes.mean(i), nodes.mean(k)) + Vec3(off, -off, 0);
+      const std::optional<esdf::GateResult> early = nodes.refusalWithoutFactorising(i, k, z, omega);
+      const esdf::GateResult full = nodes.gateRelative(i, k, z, omega);
+      EXPECT_EQ(full.accepted, off == 0.0) << i << " " << k;
+      if (off == 0.0) EXPECT_FALSE(early) << i << " " << k;
+      if (!early) continue;
+      ++refused;
+      EXPECT_FALSE(early->accepted);
+      EXPECT_NEAR(early->mahalanobis2, full.mahalanobis2, 1e-9 * full.mahalanobis2) << i << " " << k;
+    }
+  EXPECT_EQ(refused, 3);  // 3 m off, each kind is refused without a factorisation
 }

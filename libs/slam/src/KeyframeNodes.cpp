@@ -160,25 +160,27 @@ esdf::ObservationResult KeyframeNodes::observeRelative(size_t i, size_t k, const
   return r;
 }
 
-esdf::GateResult KeyframeNodes::gateRelative(size_t i, size_t k, const Vec3& z, const Mat3& omega) {
-  if (!hung(i) && !hung(k)) return filter_.gateRelative(node(i), node(k), z, omega);
+esdf::GateResult KeyframeNodes::gateRelative(size_t i, size_t k, const Vec3& z, const Mat3& omega) { return *gate(i, k, z, omega, false); }
+
+std::optional<esdf::GateResult> KeyframeNodes::refusalWithoutFactorising(size_t i, size_t k, const Vec3& z, const Mat3& omega) {
+  std::optional<esdf::GateResult> r = gate(i, k, z, omega, true);
+  if (r && r->accepted) r.reset();
+  return r;
+}
+
+std::optional<esdf::GateResult> KeyframeNodes::gate(size_t i, size_t k, const Vec3& z, const Mat3& omega, bool without_factorising) {
+  // The filter's gate on the closure of the filter poses the two keyframes are or hang from;
+  // two keyframes hung from one pose are judged by their offsets alone (no map covariance).
+  const auto filters = [&](int a, int b, const Vec3& zn, const Mat3& on) -> std::optional<esdf::GateResult> {
+    if (without_factorising) return filter_.refusalWithoutFactorising(a, b, zn, on);
+    return filter_.gateRelative(a, b, zn, on);
+  };
+  if (!hung(i) && !hung(k)) return filters(node(i), node(k), z, omega);
   if (hangs_[i].node == hangs_[k].node) return gateWithinNode(i, k, z, omega);
   Vec3 zn;
   Mat3 cn;
   toNodes(i, k, z, omega.inverse(), 1.0, 1.0, &zn, &cn);
-  return filter_.gateRelative(hangs_[i].node, hangs_[k].node, zn, cn.inverse());
-}
-
-std::optional<esdf::GateResult> KeyframeNodes::refusalWithoutFactorising(size_t i, size_t k, const Vec3& z, const Mat3& omega) {
-  if (!hung(i) && !hung(k)) return filter_.refusalWithoutFactorising(node(i), node(k), z, omega);
-  if (hangs_[i].node == hangs_[k].node) {
-    const esdf::GateResult r = gateWithinNode(i, k, z, omega);  // no covariance of the map's
-    return r.accepted ? std::nullopt : std::optional<esdf::GateResult>(r);
-  }
-  Vec3 zn;
-  Mat3 cn;
-  toNodes(i, k, z, omega.inverse(), 1.0, 1.0, &zn, &cn);
-  return filter_.refusalWithoutFactorising(hangs_[i].node, hangs_[k].node, zn, cn.inverse());
+  return filters(hangs_[i].node, hangs_[k].node, zn, cn.inverse());
 }
 
 void KeyframeNodes::writeState(common::BinaryWriter& w) const {

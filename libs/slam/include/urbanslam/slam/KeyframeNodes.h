@@ -95,6 +95,8 @@ class KeyframeNodes {
   void toNodes(size_t i, size_t k, const esdf::Vec3& z, const esdf::Mat3& cov, double scale_i, double scale_k,
                esdf::Vec3* z_nodes, esdf::Mat3* cov_nodes) const;
   esdf::GateResult gateWithinNode(size_t i, size_t k, const esdf::Vec3& z, const esdf::Mat3& omega) const;
+  // gateRelative, and refusalWithoutFactorising's answer before it drops an admission.
+  std::optional<esdf::GateResult> gate(size_t i, size_t k, const esdf::Vec3& z, const esdf::Mat3& omega, bool without_factorising);
   // The multiple of keyframe k's offset covariance its next closure goes in with (1: no offset).
   double offsetScale(size_t k) const;
 
