@@ -223,6 +223,61 @@ TEST(Gating, ARefusalWithoutFactorisingIsTheGatesOwnAndCostsNoFactorisation) {
   RecordProperty("refused_by_the_exact_covariance", refused_by_the_exact_covariance);
 }
 
+// Two closures gated jointly: d^2 of the stacked innovations against the 6-dof quantile, with
+// the covariance of both relative poses from the dense inverse of Lambda (the reference knows
+// nothing of factors or path solves). A drift that puts each of two neighbouring closures just
+// beyond the single gate passes when the two measure it alike, and fails when they disagree.
+TEST(Gating, TwoClosuresThatAgreePassTheJointGateWhereEachAloneFails) {
+  EsdfOptions o;
+  o.chi2_gate_probability = 0.99;
+  Esdf f(o);
+  const Mat3 odo = Vec3(400.0, 400.0, 4000.0).asDiagonal(), omega = Vec3(400.0, 400.0, 4000.0).asDiagonal();
+  squareDrive({&f}, 61, -1, odo, omega);
+  const auto reference = [&](int i1, int j1, const Vec3& z1, int i2, int j2, const Vec3& z2) {
+    const Eigen::MatrixXd sigma = Eigen::MatrixXd(f.state().denseInformation()).inverse();
+    Eigen::MatrixXd h = Eigen::MatrixXd::Zero(6, sigma.cols());
+    Eigen::VectorXd nu(6);
+    Mat3 a, b;
+    relativePoseErrorJacobians(f.mean(i1), f.mean(j1), z1, &a, &b);
+    h.block<3, 3>(0, 3 * i1) += a, h.block<3, 3>(0, 3 * j1) += b;
+    relativePoseErrorJacobians(f.mean(i2), f.mean(j2), z2, &a, &b);
+    h.block<3, 3>(3, 3 * i2) += a, h.block<3, 3>(3, 3 * j2) += b;
+    nu << -relativePoseError(f.mean(i1), f.mean(j1), z1), -relativePoseError(f.mean(i2), f.mean(j2), z2);
+    Eigen::MatrixXd s = h * sigma * h.transpose();
+    s.block<3, 3>(0, 0) += omega.inverse(), s.block<3, 3>(3, 3) += omega.inverse();
+    return nu.dot(s.ldlt().solve(nu));
+  };
+  // Closures (5, 55) and (6, 56) of a drive that never came back: both say the second end lies
+  // `shift` further along pose 5's heading than the estimate has it. d^2 of one grows as shift^2.
+  const auto closures = [&](double shift1, double shift2) {
+    const Vec3 z1 = between(f.mean(5), f.mean(55)), z2 = between(f.mean(6), f.mean(56));
+    const Vec3 d1 = Vec3(std::cos(f.mean(5).z()), std::sin(f.mean(5).z()), 0);
+    // The shift along pose 5's x as seen from each closure's earlier pose.
+    const auto shifted = [&](int i, const Vec3& z, double shift) -> Vec3 {
+      const Vec3 world = shift * d1;
+      const double c = std::cos(f.mean(i).z()), s = std::sin(f.mean(i).z());
+      return z + Vec3(c * world.x() + s * world.y(), -s * world.x() + c * world.y(), 0);
+    };
+    return std::make_pair(shifted(5, z1, shift1), shifted(6, z2, shift2));
+  };
+  const double unit = f.gateRelative(5, 55, closures(1.0, 1.0).first, omega).mahalanobis2;
+  const double shift = std::sqrt(13.0 / unit);  // d^2 about 13: beyond 11.34 (3 dof), within 16.81 (6 dof)
+  const auto [z1, z2] = closures(shift, shift);
+  const GateResult one = f.gateRelative(5, 55, z1, omega), two = f.gateRelative(6, 56, z2, omega);
+  EXPECT_FALSE(one.accepted) << one.mahalanobis2;
+  EXPECT_FALSE(two.accepted) << two.mahalanobis2;
+  const GateResult both = f.gateRelativePair(5, 55, z1, omega, 6, 56, z2, omega);
+  EXPECT_NEAR(both.threshold, chi2Quantile(0.99, 6), 1e-9);
+  EXPECT_NEAR(both.mahalanobis2, reference(5, 55, z1, 6, 56, z2), 1e-8 * both.mahalanobis2);
+  EXPECT_GE(both.mahalanobis2, std::max(one.mahalanobis2, two.mahalanobis2) - 1e-9);  // a marginal is never larger
+  EXPECT_TRUE(both.accepted) << both.mahalanobis2;
+  // The second closure measuring the opposite shift: each alone as far, jointly refused.
+  const auto [w1, w2] = closures(shift, -shift);
+  const GateResult apart = f.gateRelativePair(5, 55, w1, omega, 6, 56, w2, omega);
+  EXPECT_NEAR(apart.mahalanobis2, reference(5, 55, w1, 6, 56, w2), 1e-8 * apart.mahalanobis2);
+  EXPECT_FALSE(apart.accepted) << apart.mahalanobis2;
+}
+
 INSTANTIATE_TEST_SUITE_P(Modes, GatingLoop, ::testing::Values(CovarianceMode::Exact, CovarianceMode::Conservative));
 
 }  // namespace

@@ -3,6 +3,7 @@
 // hypothesis waits for its confirmation, which only the next keyframes' searches can bring.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -228,6 +229,52 @@ TEST(GlobalSlam, ACameraClosureIsNotConfirmedByItsOwnImages) {
   r.global->finish();
   ASSERT_EQ(r.global->closures().size(), 1u);
   EXPECT_EQ(r.global->closures()[0].reason, slam::ClosureReason::Unconfirmed);
+}
+
+// A closure that the gate refuses by less than two closures' quantile (6 dof) waits; the next keyframe's
+// closure, refused alike and agreeing with it, passes the joint gate with it and both go in
+// (confirmed "jointly"). Closures that disagree, or drift beyond the pair's quantile, stay refused.
+// The camera measures each pair's full pose here (keyframes without scans): the measurement is
+// what the test sets.
+TEST(GlobalSlam, TwoClosuresJustBeyondTheGateGoInWhenTheyAgreeAndPassItJointly) {
+  const auto run = [](double shift1_m, double shift2_m, bool joint_gate) {
+    auto r = std::make_unique<::Run>();
+    r->options.loop_closure.appearance_min_sigma_m = 3.0;
+    r->options.loop_closure.joint_gate = joint_gate;
+    driveStraight(*r, Eigen::Vector3d(0.09, 0.09, 1e-6).asDiagonal());
+    // Keyframes 150 -> 200 and 151 -> 201: 50 m along x, 2.1 m uncertain (sigma); each measured
+    // `shift` metres longer.
+    for (const auto& [earlier, shift] : {std::make_pair(size_t{150}, shift1_m), std::make_pair(size_t{151}, shift2_m)}) {
+      slam::CameraMeasurement m;
+      m.mount = common::Pose2{0.0, 0.0, 0.0};
+      m.relative.valid = true;
+      m.relative.cov = Eigen::Vector2d(1e-4, 1e-4).asDiagonal();
+      m.relative.depth_per_baseline = 0.5;  // a scene 20-25 m away, within max_scene_depth_m
+      m.metric.valid = true;
+      m.metric.pose = common::Pose2{50.0 + shift, 0.0, 0.0};
+      m.metric.cov = Eigen::Vector3d(1e-4, 1e-4, 1e-6).asDiagonal();
+      r->global->proposeImageClosure(earlier, earlier + 50, 1.0, m, std::chrono::steady_clock::now());
+    }
+    r->global->finish();
+    return r->global->closures();
+  };
+  const auto count = [](const std::vector<slam::LoopClosureRecord>& closures, bool accepted, slam::ClosureReason reason) {
+    return std::count_if(closures.begin(), closures.end(),
+                         [&](const slam::LoopClosureRecord& c) { return c.accepted == accepted && c.reason == reason; });
+  };
+  // The filter's gate (esdf::EsdfOptions, 0.999): 16.27 for one closure, 22.46 for two. sigma^2
+  // = 50 x 0.09 m^2: a shift of 9.25 m is d^2 19.0.
+  const auto agree = run(9.25, 9.25, true);
+  ASSERT_EQ(agree.size(), 2u);
+  for (const auto& c : agree) {
+    EXPECT_TRUE(c.accepted);
+    EXPECT_EQ(c.confirmed_by, slam::Confirmation::Jointly);
+    EXPECT_GT(c.mahalanobis2, 16.27);
+    EXPECT_LE(c.mahalanobis2, c.gate_threshold);
+  }
+  EXPECT_EQ(count(run(9.25, 9.25, false), false, slam::ClosureReason::Gating), 2);  // without the joint gate
+  EXPECT_EQ(count(run(9.25, -9.25, true), false, slam::ClosureReason::Gating), 2);  // they disagree
+  EXPECT_EQ(count(run(11.0, 11.0, true), false, slam::ClosureReason::Gating), 2);   // d^2 27: beyond the pair's quantile too
 }
 
 namespace {

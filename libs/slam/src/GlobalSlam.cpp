@@ -95,11 +95,7 @@ std::array<double, 9> GlobalSlam::addKeyframeFrom(size_t from, Keyframe kf, io::
 }
 
 void GlobalSlam::finish() {
-  for (LoopClosureRecord r : pending_) {  // hypotheses still waiting for a confirmation
-    r.reason = ClosureReason::Unconfirmed;
-    r.accepted = false;
-    reportClosure(r);
-  }
+  for (LoopClosureRecord r : pending_) reportExpired(r);  // hypotheses still waiting for a confirmation
   pending_.clear();
   if (dirty_since_recovery_) recoverAll(true);
 }
@@ -157,17 +153,67 @@ void GlobalSlam::expirePending(size_t current) {
   // Hypotheses that waited too long for a confirmation are dropped.
   const size_t window = static_cast<size_t>(options_.loop_closure.confirm_window);
   while (!pending_.empty() && current - pending_.front().to > window) {
-    LoopClosureRecord r = pending_.front();
+    reportExpired(pending_.front());
     pending_.pop_front();
-    r.accepted = false;
-    r.reason = ClosureReason::Unconfirmed;
-    reportClosure(r);
   }
+}
+
+void GlobalSlam::reportExpired(LoopClosureRecord r) {
+  // One that passed the gate was unconfirmed; one that waited for a joint gate stays refused by
+  // the gate (its reason already).
+  if (r.accepted) r.reason = ClosureReason::Unconfirmed;
+  r.accepted = false;
+  reportClosure(r);
+}
+
+bool GlobalSlam::waitsForJointGate(const LoopClosureRecord& r) const {
+  if (!options_.loop_closure.joint_gate || r.accepted || r.reason != ClosureReason::Gating) return false;
+  // The filter's own gate probability (the pipeline gives it chi2_gate_probability), 6 dof.
+  return r.mahalanobis2 <= esdf::chi2Quantile(map_.filter()->options().chi2_gate_probability, 6);
+}
+
+bool GlobalSlam::confirming() const {
+  return std::any_of(pending_.begin(), pending_.end(), [](const LoopClosureRecord& p) { return p.accepted; });
+}
+
+// A closure refused by the gate alone, by less than two closures' quantile, waits for a later one
+// that agrees with it (consistent) and was refused alike; the two go in when their joint gate
+// passes (Esdf::gateRelativePair), with no gate of their own.
+GlobalSlam::Admission GlobalSlam::admitJointly(LoopClosureRecord r, size_t current) {
+  auto match = std::find_if(pending_.begin(), pending_.end(),
+                            [&](const LoopClosureRecord& p) { return !p.accepted && p.to < current && consistent(p, r); });
+  if (match != pending_.end()) {
+    const esdf::GateResult joint =
+        map_.nodes()->gateRelativePair(match->from, match->to, esdf::toVec(match->measurement), match->information, r.from, r.to,
+                                       esdf::toVec(r.measurement), r.information);
+    if (joint.accepted) {
+      LoopClosureRecord first = *match;
+      pending_.erase(match);
+      for (LoopClosureRecord* c : {&first, &r}) {
+        map_.nodes()->observeRelative(c->from, c->to, esdf::toVec(c->measurement), c->information, false);
+        map_.addEdge({c->from, c->to, c->measurement, c->information, true});
+        c->accepted = true;
+        c->reason = ClosureReason::None;
+        c->confirmed_by = Confirmation::Jointly;
+        c->mahalanobis2 = joint.mahalanobis2;
+        c->gate_threshold = joint.threshold;
+        reportClosure(*c);
+      }
+      return Admission::Accepted;
+    }
+  }
+  if (pending_.size() < 4 * static_cast<size_t>(options_.loop_closure.confirm_window)) {
+    pending_.push_back(r);
+    return Admission::Pending;
+  }
+  reportClosure(r);
+  return Admission::Rejected;
 }
 
 GlobalSlam::Admission GlobalSlam::admit(LoopClosureRecord r, size_t current, MeasuredBy measured,
                                         const std::optional<CameraPairView>& view) {
   const size_t window = static_cast<size_t>(options_.loop_closure.confirm_window);
+  if (window > 0 && waitsForJointGate(r)) return admitJointly(std::move(r), current);
   if (!r.accepted) {
     reportClosure(r);
     return Admission::Rejected;
@@ -183,8 +229,8 @@ GlobalSlam::Admission GlobalSlam::admit(LoopClosureRecord r, size_t current, Mea
   // the second usually fails with a huge distance and only the first goes in. Gating both
   // before either goes in (what "current state" suggests) was measured worse: false closures
   // campus 4 -> 6, ACES 3 -> 6, CSAIL 1 -> 2 at the same ATE.
-  auto match =
-      std::find_if(pending_.begin(), pending_.end(), [&](const LoopClosureRecord& p) { return p.to < current && consistent(p, r); });
+  auto match = std::find_if(pending_.begin(), pending_.end(),
+                            [&](const LoopClosureRecord& p) { return p.accepted && p.to < current && consistent(p, r); });
   if (match != pending_.end()) {
     LoopClosureRecord first = *match;
     pending_.erase(match);
@@ -248,7 +294,7 @@ void GlobalSlam::searchLoops(size_t current, SteadyTime handed_over) {
   // the estimate is too uncertain the classifier's detections (keyframes with scans only:
   // alignment needs both).
   std::vector<Candidate> cands;
-  if (map_.keyframes()[current].hasScan()) cands = closer_.candidates(*map_.nodes(), map_, current, !pending_.empty());
+  if (map_.keyframes()[current].hasScan()) cands = closer_.candidates(*map_.nodes(), map_, current, confirming());
   std::vector<size_t> keyframes;
   for (const Candidate& c : cands) keyframes.push_back(c.keyframe);
   for (auto* o : observers_) o->onCandidates({current, &keyframes});

@@ -171,16 +171,37 @@ std::optional<esdf::GateResult> KeyframeNodes::refusalWithoutFactorising(size_t 
 std::optional<esdf::GateResult> KeyframeNodes::gate(size_t i, size_t k, const Vec3& z, const Mat3& omega, bool without_factorising) {
   // The filter's gate on the closure of the filter poses the two keyframes are or hang from;
   // two keyframes hung from one pose are judged by their offsets alone (no map covariance).
-  const auto filters = [&](int a, int b, const Vec3& zn, const Mat3& on) -> std::optional<esdf::GateResult> {
-    if (without_factorising) return filter_.refusalWithoutFactorising(a, b, zn, on);
-    return filter_.gateRelative(a, b, zn, on);
-  };
-  if (!hung(i) && !hung(k)) return filters(node(i), node(k), z, omega);
-  if (hangs_[i].node == hangs_[k].node) return gateWithinNode(i, k, z, omega);
+  int a, b;
   Vec3 zn;
+  Mat3 on;
+  if (!onNodes(i, k, z, omega, &a, &b, &zn, &on)) return gateWithinNode(i, k, z, omega);
+  if (without_factorising) return filter_.refusalWithoutFactorising(a, b, zn, on);
+  return filter_.gateRelative(a, b, zn, on);
+}
+
+bool KeyframeNodes::onNodes(size_t i, size_t k, const Vec3& z, const Mat3& omega, int* a, int* b, Vec3* z_nodes, Mat3* omega_nodes) const {
+  if (!hung(i) && !hung(k)) {
+    *a = node(i), *b = node(k), *z_nodes = z, *omega_nodes = omega;
+    return true;
+  }
+  if (hangs_[i].node == hangs_[k].node) return false;
   Mat3 cn;
-  toNodes(i, k, z, omega.inverse(), 1.0, 1.0, &zn, &cn);
-  return filters(hangs_[i].node, hangs_[k].node, zn, cn.inverse());
+  toNodes(i, k, z, omega.inverse(), 1.0, 1.0, z_nodes, &cn);
+  *a = hangs_[i].node, *b = hangs_[k].node, *omega_nodes = cn.inverse();
+  return true;
+}
+
+esdf::GateResult KeyframeNodes::gateRelativePair(size_t i1, size_t k1, const Vec3& z1, const Mat3& omega1, size_t i2, size_t k2,
+                                                 const Vec3& z2, const Mat3& omega2) {
+  int a1, b1, a2, b2;
+  Vec3 zn1, zn2;
+  Mat3 on1, on2;
+  if (!onNodes(i1, k1, z1, omega1, &a1, &b1, &zn1, &on1) || !onNodes(i2, k2, z2, omega2, &a2, &b2, &zn2, &on2)) {
+    esdf::GateResult refused;
+    refused.accepted = false;
+    return refused;
+  }
+  return filter_.gateRelativePair(a1, b1, zn1, on1, a2, b2, zn2, on2);
 }
 
 void KeyframeNodes::writeState(common::BinaryWriter& w) const {

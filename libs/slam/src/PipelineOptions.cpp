@@ -146,6 +146,9 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("camera_confirmation", o.loop_closure.camera_confirmation,
         "with a camera too: a closure the scans measured is confirmed at once when the images nearest its keyframes measure the same "
         "full relative pose (within the confirm tolerances)");
+  s.add("joint_gate", o.loop_closure.joint_gate,
+        "a closure the innovation gate refuses by less than two closures' quantile (6 dof) waits like an unconfirmed one: with one of "
+        "the next confirm_window keyframes that agrees with it, the two go in when they pass the gate jointly");
 
   s.section("image_loop", "Tree of Words image loop-closure detection (used when [loop_closure] image_detector = tree_of_words)");
   vision_loop::declareImageLoopOptions(s, o.image_loop);

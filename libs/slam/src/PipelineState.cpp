@@ -172,7 +172,7 @@ LoopClosureRecord readRecord(BinaryReader& r, size_t keyframes, std::uint32_t fo
   // Before version 7 what confirmed a closure was not kept.
   if (format_version >= 7) {
     const std::uint8_t confirmed = r.u8();
-    if (confirmed > static_cast<std::uint8_t>(Confirmation::Camera)) r.fail("loop closure confirmation " + std::to_string(confirmed));
+    if (confirmed > static_cast<std::uint8_t>(Confirmation::Jointly)) r.fail("loop closure confirmation " + std::to_string(confirmed));
     c.confirmed_by = static_cast<Confirmation>(confirmed);
   }
   return c;

@@ -128,6 +128,12 @@ class Esdf {
   // a factorisation could tell. For a caller with costly checks of its own to skip when the gate
   // will refuse anyway.
   std::optional<GateResult> refusalWithoutFactorising(int i, int j, const Vec3& z, const Mat3& omega);
+  // The joint gate of two relative-pose observations (JointGate.cpp): d^2 of their stacked
+  // innovations with the exact 6x6 covariance (the poses' cross-covariances included) against
+  // the 6-dof quantile of chi2_gate_probability. Nothing is added; it refactorises when stale.
+  GateResult gateRelativePair(int i1, int j1, const Vec3& z1, const Mat3& omega1, int i2, int j2, const Vec3& z2, const Mat3& omega2);
+  // The exact joint covariance of `poses` (3k x 3k, in the order given), from the current factor.
+  Eigen::MatrixXd covarianceAmong(const std::vector<int>& poses);
 
   // Full recovery: factorise Lambda (CHOLMOD), mu = Lambda^-1 eta, then (if enabled) up to
   // max_relinearise_passes rounds of relinearise + re-solve (-1: options().relinearise_max_passes).

@@ -100,6 +100,15 @@ class GlobalSlam {
   Admission admit(LoopClosureRecord r, size_t current, MeasuredBy measured = MeasuredBy::Scans,
                   const std::optional<CameraPairView>& view = std::nullopt);
   Admission commit(std::initializer_list<LoopClosureRecord*> records);
+  // A closure the gate refused by less than two closures' quantile ([loop_closure] joint_gate):
+  // in with an earlier such one that agrees and passes the joint gate, else waiting as pending.
+  bool waitsForJointGate(const LoopClosureRecord& r) const;
+  Admission admitJointly(LoopClosureRecord r, size_t current);
+  // A hypothesis that waited in vain, reported with its reason.
+  void reportExpired(LoopClosureRecord r);
+  // A hypothesis that passed the gate waits for its confirmation (the candidate search then
+  // looks near at every keyframe).
+  bool confirming() const;
   bool cameraConfirms(const LoopClosureRecord& r, const std::optional<CameraPairView>& given) const;
   void expirePending(size_t current);
   bool consistent(const LoopClosureRecord& a, const LoopClosureRecord& b) const;
@@ -127,7 +136,9 @@ class GlobalSlam {
   const std::vector<PipelineObserver*>& observers_;
   LoopCloser closer_;
   std::unique_ptr<laser_loop::LoopDetector> laser_detector_;  // [loop_closure] detector = laser, once read
-  std::deque<LoopClosureRecord> pending_;                     // passed alignment + gate, awaiting confirmation
+  // Passed alignment and gate, awaiting confirmation (accepted), or refused by the gate alone,
+  // awaiting a joint gate (not accepted).
+  std::deque<LoopClosureRecord> pending_;
   CameraPairMeasurer camera_measurer_;
   LoopClosureLog closures_;  // every hypothesis and its fate
   bool dirty_since_recovery_ = false;

@@ -73,6 +73,10 @@ class KeyframeNodes {
   esdf::GateResult gateRelative(size_t i, size_t k, const esdf::Vec3& z, const esdf::Mat3& omega);
   // ... and its refusal when known without a factorisation (Esdf::refusalWithoutFactorising).
   std::optional<esdf::GateResult> refusalWithoutFactorising(size_t i, size_t k, const esdf::Vec3& z, const esdf::Mat3& omega);
+  // The joint gate of two closures (Esdf::gateRelativePair) on the filter poses their keyframes
+  // are or hang from; a closure within one filter pose has no map covariance to share: refused.
+  esdf::GateResult gateRelativePair(size_t i1, size_t k1, const esdf::Vec3& z1, const esdf::Mat3& omega1, size_t i2, size_t k2,
+                                    const esdf::Vec3& z2, const esdf::Mat3& omega2);
   void writeState(common::BinaryWriter& w) const;
   // After the filter's state; `keyframes`: the map's. Map format 10 hung keyframes otherwise:
   // such a map is refused.
@@ -97,6 +101,10 @@ class KeyframeNodes {
   esdf::GateResult gateWithinNode(size_t i, size_t k, const esdf::Vec3& z, const esdf::Mat3& omega) const;
   // gateRelative, and refusalWithoutFactorising's answer before it drops an admission.
   std::optional<esdf::GateResult> gate(size_t i, size_t k, const esdf::Vec3& z, const esdf::Mat3& omega, bool without_factorising);
+  // The filter poses of closure (i, k) and its measurement and information between them; false
+  // when both keyframes hang from one pose.
+  bool onNodes(size_t i, size_t k, const esdf::Vec3& z, const esdf::Mat3& omega, int* a, int* b, esdf::Vec3* z_nodes,
+               esdf::Mat3* omega_nodes) const;
   // The multiple of keyframe k's offset covariance its next closure goes in with (1: no offset).
   double offsetScale(size_t k) const;
 

@@ -58,6 +58,7 @@ enum class Confirmation : std::uint8_t {
   None,     // nothing (confirm_window = 0: added at once), or not accepted
   Closure,  // a second closure of the next keyframes agreed with it (GlobalSlam::consistent)
   Camera,   // the two places' images measured the same relative pose as the scans (camera_confirmation)
+  Jointly,  // refused by the gate alone, it passed the joint gate with a later closure that agreed with it (joint_gate)
 };
 // Its name in loop_closures.csv ("" for None).
 const char* confirmationName(Confirmation c);
@@ -171,6 +172,7 @@ class LoopCloser {
   CandidateScorer scorer_;
   double chi2_2dof_;
   double chi2_3dof_gate_;  // the innovation gate's threshold
+  double chi2_6dof_gate_;  // the joint gate's of two closures
   size_t cached_for_ = static_cast<size_t>(-1);
   std::unordered_map<size_t, Eigen::Matrix3d> cached_;  // relative covariances for cached_for_
   std::optional<bool> narrow_view_;                     // the laser covers well under the full circle (read once)

@@ -147,6 +147,10 @@ struct LoopClosureOptions {
   // appearance_min_sigma_m (GlobalSlam::allowsFullCameraPose), so farther closures still wait for
   // a second closure.
   bool camera_confirmation = true;
+  // A closure that the gate refuses by less than two closures' quantile (6 dof) waits like an
+  // unconfirmed one; with a later one that agrees with it and passes the joint gate of the two,
+  // both go in (GlobalSlam::admit, Esdf::gateRelativePair).
+  bool joint_gate = true;
 };
 
 struct EstimatorOptions {
