@@ -16,14 +16,21 @@ namespace urbanslam::esdf {
 Eigen::MatrixXd Esdf::covarianceAmong(const std::vector<int>& poses) {
   for (int p : poses)
     if (p < 0 || p >= size()) throw std::out_of_range("covarianceAmong: bad pose");
+  // Path solves (PathSolve.h): each pose's path in the factor's elimination tree, not a column
+  // solve over the whole map (at 10^6 poses, 24 MB per column).
   ensureFactor();
-  const int n = size(), k = static_cast<int>(poses.size());
-  Eigen::MatrixXd e = Eigen::MatrixXd::Zero(3 * n, 3 * k);
-  for (int c = 0; c < k; ++c) e.block<3, 3>(3 * poses[static_cast<size_t>(c)], 3 * c) += Mat3::Identity();
-  const Eigen::MatrixXd x = full_factor_.solve(e);
+  const size_t k = poses.size();
+  std::vector<PathSolution> paths;
+  paths.reserve(k);
+  for (int p : poses) paths.push_back(full_factor_.pathSolve(p));
   Eigen::MatrixXd s(3 * k, 3 * k);
-  for (int r = 0; r < k; ++r) s.middleRows(3 * r, 3) = x.middleRows(3 * poses[static_cast<size_t>(r)], 3);
-  return 0.5 * (s + s.transpose());
+  for (size_t a = 0; a < k; ++a)
+    for (size_t b = a; b < k; ++b) {
+      const Mat3 c = SparseCholesky::covarianceBetween(paths[a], paths[b]);
+      s.block<3, 3>(3 * a, 3 * b) = c;
+      s.block<3, 3>(3 * b, 3 * a) = c.transpose();
+    }
+  return s;
 }
 
 GateResult Esdf::gateRelativePair(int i1, int j1, const Vec3& z1, const Mat3& omega1, int i2, int j2, const Vec3& z2, const Mat3& omega2) {
