@@ -48,6 +48,13 @@ void Esdf::solveInvolved(const std::vector<int>& poses) {
 }
 
 bool Esdf::updatedJoint(int i, int j, Mat6* joint) {
+  Eigen::MatrixXd s;
+  if (!updatedCovariance({i, j}, &s)) return false;
+  *joint = s;
+  return true;
+}
+
+bool Esdf::updatedCovariance(const std::vector<int>& targets, Eigen::MatrixXd* cov) {
   if (!full_factor_.valid() || explained_stamp_ != values_stamp_ || !conservativeReady()) return false;
   const int m = chain_base_;
   struct Update {
@@ -68,8 +75,7 @@ bool Esdf::updatedJoint(int i, int j, Mat6* joint) {
     if (p >= 0 && p < m && !involved_at_.count(p) && std::find(unsolved.begin(), unsolved.end(), p) == unsolved.end())
       unsolved.push_back(p);
   };
-  need(i);
-  need(j);
+  for (int t : targets) need(t);
   for (const Update& u : updates) {
     need(u.a);
     need(u.b);
@@ -78,18 +84,19 @@ bool Esdf::updatedJoint(int i, int j, Mat6* joint) {
   solveInvolved(unsolved);
 
   const int n_u = static_cast<int>(updates.size());
-  const int targets[2] = {i, j};
+  const int n_t = static_cast<int>(targets.size());
   // H_u Sigma_c(., t) for update u and pose t.
   const auto hs = [&](const Update& u, int t) -> Mat3 {
     Mat3 r = u.ja * chainedCovariance(u.a, t);
     if (u.b >= 0) r += u.jb * chainedCovariance(u.b, t);
     return r;
   };
-  Mat6 s;
-  for (int a = 0; a < 2; ++a)
-    for (int b = 0; b < 2; ++b) s.block<3, 3>(3 * a, 3 * b) = chainedCovariance(targets[a], targets[b]);
+  const auto target = [&](int a) { return targets[static_cast<size_t>(a)]; };
+  Eigen::MatrixXd s(3 * n_t, 3 * n_t);
+  for (int a = 0; a < n_t; ++a)
+    for (int b = 0; b < n_t; ++b) s.block<3, 3>(3 * a, 3 * b) = chainedCovariance(target(a), target(b));
   if (n_u > 0) {
-    Eigen::MatrixXd hsh(3 * n_u, 3 * n_u), hst(3 * n_u, 6), w_hst(3 * n_u, 6), m_mat(3 * n_u, 3 * n_u);
+    Eigen::MatrixXd hsh(3 * n_u, 3 * n_u), hst(3 * n_u, 3 * n_t), w_hst(3 * n_u, 3 * n_t), m_mat(3 * n_u, 3 * n_u);
     for (int k = 0; k < n_u; ++k) {
       const Update& uk = updates[static_cast<size_t>(k)];
       for (int l = 0; l < n_u; ++l) {
@@ -98,7 +105,7 @@ bool Esdf::updatedJoint(int i, int j, Mat6* joint) {
         if (ul.b >= 0) b += hs(uk, ul.b) * ul.jb.transpose();
         hsh.block<3, 3>(3 * k, 3 * l) = b;
       }
-      for (int t = 0; t < 2; ++t) hst.block<3, 3>(3 * k, 3 * t) = hs(uk, targets[t]);
+      for (int t = 0; t < n_t; ++t) hst.block<3, 3>(3 * k, 3 * t) = hs(uk, target(t));
     }
     // I + W H Sigma_c H' and W H Sigma_c E_T, W block-diagonal.
     for (int k = 0; k < n_u; ++k) {
@@ -109,7 +116,7 @@ bool Esdf::updatedJoint(int i, int j, Mat6* joint) {
     m_mat += Eigen::MatrixXd::Identity(3 * n_u, 3 * n_u);
     s -= hst.transpose() * m_mat.partialPivLu().solve(w_hst);
   }
-  *joint = 0.5 * (s + s.transpose());
+  *cov = 0.5 * (s + s.transpose());
   return true;
 }
 

@@ -16,8 +16,11 @@ namespace urbanslam::esdf {
 Eigen::MatrixXd Esdf::covarianceAmong(const std::vector<int>& poses) {
   for (int p : poses)
     if (p < 0 || p >= size()) throw std::out_of_range("covarianceAmong: bad pose");
-  // Path solves (PathSolve.h): each pose's path in the factor's elimination tree, not a column
-  // solve over the whole map (at 10^6 poses, 24 MB per column).
+  // Between factorisations, the last factor with the closures since (ExactUpdates.cpp), as the
+  // single gate takes it: a pair tested at every keyframe of a long revisit would otherwise
+  // refactorise the whole map each time. Else path solves of a current factor (PathSolve.h):
+  // each pose's path in the factor's elimination tree, not a column solve over the whole map.
+  if (Eigen::MatrixXd s; !factorCurrent() && updatedCovariance(poses, &s)) return s;
   ensureFactor();
   const size_t k = poses.size();
   std::vector<PathSolution> paths;

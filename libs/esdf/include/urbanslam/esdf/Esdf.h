@@ -296,6 +296,8 @@ class Esdf {
   // update (Woodbury). False when Lambda changed otherwise since the factorisation, or the
   // update asks for more poses not solved for yet than ExactUpdates.cpp allows.
   bool updatedJoint(int i, int j, Mat6* joint);
+  // The same for any few poses (3k x 3k, in the order given).
+  bool updatedCovariance(const std::vector<int>& targets, Eigen::MatrixXd* cov);
   // Sigma(p, q) of the factorised Lambda with the chain after it: for a chain pose, the
   // conservative covariance's dead reckoning (exact while no closure came since); for two
   // factored poses, the blocks solveInvolved kept.
