@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <algorithm>
 #include <stdexcept>
 #include <thread>
@@ -35,10 +36,20 @@ TEST(ParallelJobs, EveryJobRunsOnceOnAWorkerWithinTheCount) {
 
 TEST(ParallelJobs, AFailedJobIsRethrownAndTheOthersStop) {
   std::atomic<size_t> ran{0};
+  std::atomic<bool> failing{false};
   try {
     uc::runJobs(10000, 2, [&](size_t, size_t job) {
       ++ran;
-      if (job == 10) throw std::runtime_error("job 10 failed");
+      if (job == 10) {
+        failing = true;
+        throw std::runtime_error("job 10 failed");
+      }
+      // The jobs after it take a while once it fails: a loaded machine can hold the failing
+      // thread for milliseconds, in which the other could otherwise run every job left.
+      if (job > 10) {
+        while (!failing) std::this_thread::yield();
+        std::this_thread::sleep_for(std::chrono::microseconds(100));
+      }
     });
     FAIL() << "no exception";
   } catch (const std::runtime_error& e) {
