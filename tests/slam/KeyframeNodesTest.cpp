@@ -365,7 +365,9 @@ TEST(KeyframeNodes, AnEarlyRefusalIsTheGatesOwnForHungKeyframesToo) {
       const std::optional<esdf::GateResult> early = nodes.refusalWithoutFactorising(i, k, z, omega);
       const esdf::GateResult full = nodes.gateRelative(i, k, z, omega);
       EXPECT_EQ(full.accepted, off == 0.0) << i << " " << k;
-      if (off == 0.0) EXPECT_FALSE(early) << i << " " << k;
+      if (off == 0.0) {
+        EXPECT_FALSE(early) << i << " " << k;
+      }
       if (!early) continue;
       ++refused;
       EXPECT_FALSE(early->accepted);

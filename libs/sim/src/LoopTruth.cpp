@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <utility>
 
 namespace urbanslam::sim {
 
@@ -39,6 +41,8 @@ std::vector<LoopPair> LoopTruthFinder::add(double t, Vec2 sensor, const std::vec
   std::vector<LoopPair> out;
   const size_t n_new = e.xy.size() / 2;
   const double r2 = options_.match_radius_m * options_.match_radius_m;
+  // The window along x, a little wider than the radius: the test below is on float differences.
+  const double r = options_.match_radius_m + 1e-3;
   const double d = options_.max_distance_m;
   if (n_new > 0) {
     for (int dx = -1; dx <= 1; ++dx)
@@ -49,11 +53,26 @@ std::vector<LoopPair> LoopTruthFinder::add(double t, Vec2 sensor, const std::vec
           const Entry& o = scans_[k];
           const double dist = norm(o.sensor - e.sensor);
           if (e.t - o.t < options_.min_gap_s || dist > d || o.xy.empty()) continue;
+          // The older scan's points are sorted by x (below): only those within the radius along x
+          // are looked at, found by bisection, and none beyond its extent along y. A pair that can
+          // no longer reach min_overlap is given up (it would not be reported).
+          const size_t n_old = o.xy.size() / 2;
           size_t hit = 0;
-          for (size_t i = 0; i < n_new; ++i) {
+          bool reachable = true;
+          for (size_t i = 0; i < n_new && reachable; ++i) {
+            reachable = static_cast<double>(hit + n_new - i) / static_cast<double>(n_new) >= options_.min_overlap;
             const float px = e.xy[2 * i], py = e.xy[2 * i + 1];
-            for (size_t j = 0; j < o.xy.size(); j += 2) {
-              const double ex = px - o.xy[j], ey = py - o.xy[j + 1];
+            if (!reachable || py < o.min_y_max_y[0] - r || py > o.min_y_max_y[1] + r) continue;
+            size_t lo = 0, hi = n_old;
+            while (lo < hi) {
+              const size_t mid = (lo + hi) / 2;
+              if (static_cast<double>(o.xy[2 * mid]) < px - r)
+                lo = mid + 1;
+              else
+                hi = mid;
+            }
+            for (size_t j = lo; j < n_old && static_cast<double>(o.xy[2 * j]) <= px + r; ++j) {
+              const double ex = px - o.xy[2 * j], ey = py - o.xy[2 * j + 1];
               if (ex * ex + ey * ey <= r2) {
                 ++hit;
                 break;
@@ -61,11 +80,21 @@ std::vector<LoopPair> LoopTruthFinder::add(double t, Vec2 sensor, const std::vec
             }
           }
           const double overlap = static_cast<double>(hit) / static_cast<double>(n_new);
-          if (overlap >= options_.min_overlap) out.push_back({o.t, e.t, overlap, dist});
+          if (reachable && overlap >= options_.min_overlap) out.push_back({o.t, e.t, overlap, dist});
         }
       }
   }
   std::sort(out.begin(), out.end(), [](const LoopPair& a, const LoopPair& b) { return a.t_old < b.t_old; });
+  // Kept sorted by x for the later scans' bisection (the overlap asks only whether a point is near).
+  std::vector<std::pair<float, float>> sorted(n_new);
+  for (size_t i = 0; i < n_new; ++i) sorted[i] = {e.xy[2 * i], e.xy[2 * i + 1]};
+  std::sort(sorted.begin(), sorted.end());
+  e.min_y_max_y = {std::numeric_limits<float>::max(), std::numeric_limits<float>::lowest()};
+  for (size_t i = 0; i < n_new; ++i) {
+    e.xy[2 * i] = sorted[i].first, e.xy[2 * i + 1] = sorted[i].second;
+    e.min_y_max_y[0] = std::min(e.min_y_max_y[0], sorted[i].second);
+    e.min_y_max_y[1] = std::max(e.min_y_max_y[1], sorted[i].second);
+  }
   cells_[positionCellKey(e.sensor.x, e.sensor.y, options_.max_distance_m)].push_back(static_cast<uint32_t>(scans_.size()));
   scans_.push_back(std::move(e));
   return out;

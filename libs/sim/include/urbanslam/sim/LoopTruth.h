@@ -2,7 +2,9 @@
 // Ground-truth loop pairs: two scans far apart in time whose views overlap. Overlap is the
 // fraction of the newer scan's beam end points (world frame, true poses) that have an end point
 // of the older scan within match_radius_m. Candidates come from a spatial hash of the sensor
-// positions, so a drive costs O(n * revisits), not O(n^2).
+// positions, so a drive costs O(n * revisits), not O(n^2); each scan keeps its points sorted
+// along x, so a pair costs O(points * log points).
+#include <array>
 #include <cstdint>
 #include <unordered_map>
 #include <vector>
@@ -38,7 +40,8 @@ class LoopTruthFinder {
   struct Entry {
     double t;
     Vec2 sensor;
-    std::vector<float> xy;  // end points, interleaved (floats: half the memory of a long drive)
+    std::vector<float> xy;  // end points, interleaved (floats: half the memory of a long drive), sorted by x
+    std::array<float, 2> min_y_max_y;  // their extent across x
   };
 
   LoopTruthOptions options_;
