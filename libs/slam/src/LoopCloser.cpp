@@ -372,9 +372,9 @@ LoopClosureRecord LoopCloser::tryClose(KeyframeNodes& filter, const Map& map, si
   r.information = cov.inverse();
   // A closure the gate refuses whatever the restarts say is refused before them, when that is
   // known without a factorisation (Esdf::refusalWithoutFactorising): far from the map most aligned
-  // candidates are look-alike places the gate refuses (the 1,000 km city drive on new streets:
-  // 467 of the 485 that reached the gate), and the restarts of the scans and of the submaps
-  // were most of their cost. Every test's verdict is the same in either order; the reason given
+  // candidates are refused by the gate (the 1,000 km city drive after a long drift: 467 of the
+  // 485 that reached it), and the restarts of the scans and of the submaps were most of their
+  // cost. Every test's verdict is the same in either order; the reason given
   // to a candidate that fails several tests changes. With the joint gate, a refusal by less than
   // two closures' quantile still takes the tests: the closure may pass with a second one. (The
   // early refusal's d^2 is a lower bound of the exact one, so a pair beyond is beyond too.)
