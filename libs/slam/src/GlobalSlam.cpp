@@ -168,8 +168,7 @@ void GlobalSlam::reportExpired(LoopClosureRecord r) {
 
 bool GlobalSlam::waitsForJointGate(const LoopClosureRecord& r) const {
   if (!options_.loop_closure.joint_gate || r.accepted || r.reason != ClosureReason::Gating) return false;
-  // The filter's own gate probability (the pipeline gives it chi2_gate_probability), 6 dof.
-  return r.mahalanobis2 <= esdf::chi2Quantile(map_.filter()->options().chi2_gate_probability, 6);
+  return r.mahalanobis2 <= map_.nodes()->jointGateThreshold();
 }
 
 bool GlobalSlam::confirming() const {

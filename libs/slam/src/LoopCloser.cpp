@@ -74,8 +74,7 @@ const char* confirmationName(Confirmation c) {
 LoopCloser::LoopCloser(const LoopClosureOptions& options)
     : options_(options),
       chi2_2dof_(esdf::chi2Quantile(options.mahalanobis_probability, 2)),
-      chi2_3dof_gate_(esdf::chi2Quantile(options.chi2_gate_probability, 3)),
-      chi2_6dof_gate_(esdf::chi2Quantile(options.chi2_gate_probability, 6)) {}
+      chi2_3dof_gate_(esdf::chi2Quantile(options.chi2_gate_probability, 3)) {}
 
 void LoopCloser::setScorer(CandidateScorer scorer) { scorer_ = std::move(scorer); }
 
@@ -374,12 +373,12 @@ LoopClosureRecord LoopCloser::tryClose(KeyframeNodes& filter, const Map& map, si
   // known without a factorisation (Esdf::refusalWithoutFactorising): far from the map most aligned
   // candidates are refused by the gate (the 1,000 km city drive after a long drift: 467 of the
   // 485 that reached it), and the restarts of the scans and of the submaps were most of their
-  // cost. Every test's verdict is the same in either order; the reason given
-  // to a candidate that fails several tests changes. With the joint gate, a refusal by less than
-  // two closures' quantile still takes the tests: the closure may pass with a second one. (The
-  // early refusal's d^2 is a lower bound of the exact one, so a pair beyond is beyond too.)
+  // cost. Every test's verdict is the same in either order; the reason given to a candidate that
+  // fails several tests changes. With the joint gate, a refusal by less than two closures'
+  // quantile still takes the tests: the closure may pass with a second one. (The early refusal's
+  // d^2 is a lower bound of the exact one, so a pair beyond is beyond too.)
   const auto refused = filter.refusalWithoutFactorising(earlier, current, esdf::toVec(r.measurement), r.information);
-  if (refused && (!options_.joint_gate || refused->mahalanobis2 > chi2_6dof_gate_)) {
+  if (refused && (!options_.joint_gate || refused->mahalanobis2 > filter.jointGateThreshold())) {
     r.mahalanobis2 = refused->mahalanobis2;
     r.gate_threshold = refused->threshold;
     r.reason = ClosureReason::Gating;

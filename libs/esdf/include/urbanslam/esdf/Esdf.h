@@ -130,9 +130,13 @@ class Esdf {
   std::optional<GateResult> refusalWithoutFactorising(int i, int j, const Vec3& z, const Mat3& omega);
   // The joint gate of two relative-pose observations (JointGate.cpp): d^2 of their stacked
   // innovations with the exact 6x6 covariance (the poses' cross-covariances included) against
-  // the 6-dof quantile of chi2_gate_probability. Nothing is added; it refactorises when stale.
+  // jointGateThreshold(). Nothing is added; between factorisations no factorisation either.
   GateResult gateRelativePair(int i1, int j1, const Vec3& z1, const Mat3& omega1, int i2, int j2, const Vec3& z2, const Mat3& omega2);
-  // The exact joint covariance of `poses` (3k x 3k, in the order given), from the current factor.
+  // The 6-dof quantile of chi2_gate_probability: what two closures gated jointly may reach, and
+  // so what no single closure beyond it can pass with a second one.
+  double jointGateThreshold() const { return joint_gate_threshold_; }
+  // The exact joint covariance of `poses` (3k x 3k, in the order given): from the last factor and
+  // the closures since when it can (updatedCovariance), else path solves of a current factor.
   Eigen::MatrixXd covarianceAmong(const std::vector<int>& poses);
 
   // Full recovery: factorise Lambda (CHOLMOD), mu = Lambda^-1 eta, then (if enabled) up to
@@ -316,6 +320,7 @@ class Esdf {
   SparseCholesky full_factor_;
   EnvelopeCholesky window_factor_;                     // partial recovery of the recent poses
   double gate_probability_ = -1, gate_threshold_ = 0;  // cached chi2 quantile
+  double joint_gate_threshold_;                        // jointGateThreshold()
   std::uint64_t values_stamp_ = 0;                     // bumped on every change of Lambda or eta
   std::uint64_t full_factor_values_ = ~std::uint64_t{0};
   long long factorisations_ = 0;

@@ -77,6 +77,7 @@ class KeyframeNodes {
   // are or hang from; a closure within one filter pose has no map covariance to share: refused.
   esdf::GateResult gateRelativePair(size_t i1, size_t k1, const esdf::Vec3& z1, const esdf::Mat3& omega1, size_t i2, size_t k2,
                                     const esdf::Vec3& z2, const esdf::Mat3& omega2);
+  double jointGateThreshold() const { return filter_.jointGateThreshold(); }
   void writeState(common::BinaryWriter& w) const;
   // After the filter's state; `keyframes`: the map's. Map format 10 hung keyframes otherwise:
   // such a map is refused.
