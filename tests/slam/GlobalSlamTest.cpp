@@ -277,6 +277,43 @@ TEST(GlobalSlam, TwoClosuresJustBeyondTheGateGoInWhenTheyAgreeAndPassItJointly) 
   EXPECT_EQ(count(run(11.0, 11.0, true), false, slam::ClosureReason::Gating), 2);   // d^2 27: beyond the pair's quantile too
 }
 
+TEST(GlobalSlam, AClosureTheRecentWindowCannotTakeUpBringsTheWholeMapsRecoveryBeforeTheNext) {
+  // A straight drive whose odometry reads 1 m for every 1.005 m driven, each step 5 cm
+  // uncertain: 5 m short after a kilometre. Keyframe 1000 closes on keyframe 0 (10 cm): within
+  // the gate (d^2 about 10). The ten newest poses alone cannot take up 5 m against the closure,
+  // so without the whole map's recovery the mean still misses it by about 1.4 m while its
+  // covariance has shrunk to the closure's, and the next closure of the same loop (1001 on 1) is
+  // refused with d^2 about 80.
+  const double truth_step_m = 1.005;
+  auto r = std::make_unique<::Run>();
+  r->options.estimator.recent_window = 10;
+  r->options.estimator.full_recovery_min_growth = 1000;  // none for the map's growth after the first
+  r->global = std::make_unique<slam::GlobalSlam>(r->options, r->map, r->stats, r->observers);
+  slam::KeyframeConstraint c;
+  c.z = {1.0, 0, 0};
+  c.cov = Eigen::Vector3d(0.05 * 0.05, 0.05 * 0.05, 1e-8).asDiagonal();
+  const Eigen::Matrix3d closure_info = Eigen::Vector3d(100, 100, 1e6).asDiagonal();
+  const auto close = [&](size_t earlier, size_t current) {
+    const double along = truth_step_m * static_cast<double>(current - earlier);
+    r->global->addPlaceFix(earlier, current, common::Pose2{along, 0, 0}, closure_info, 1.0, slam::Proposer::Place);
+  };
+  for (size_t k = 0; k <= 1001; ++k) {
+    r->global->addKeyframe({k, static_cast<double>(k), {}, false, false, {}}, io::CompactScan(), c);
+    if (k == 10) close(0, 10);  // the map's first full recovery
+    if (k == 1000) close(0, 1000);
+    if (k == 1001) close(1, 1001);
+  }
+  const std::vector<slam::LoopClosureRecord> closures = r->global->closures();
+  ASSERT_EQ(closures.size(), 3u);
+  for (const auto& cl : closures) {
+    EXPECT_TRUE(cl.accepted) << cl.from << " -> " << cl.to << ": d^2 " << cl.mahalanobis2;
+    EXPECT_LT(cl.mahalanobis2, 16.27);  // the filter's gate (esdf::EsdfOptions, 0.999)
+  }
+  // The estimate where the drive truly is, before the run's last recovery.
+  EXPECT_NEAR(r->map.keyframes()[1001].pose.x, truth_step_m * 1001, 0.1);
+  EXPECT_NEAR(r->map.keyframes()[500].pose.x, truth_step_m * 500, 0.1);
+}
+
 namespace {
 
 // The optimum of the map's edges, with pose 0 held at the origin: dense Gauss-Newton with

@@ -11,7 +11,10 @@
 namespace urbanslam::esdf {
 
 Esdf::Esdf(EsdfOptions options)
-    : options_(options), full_factor_(options.ordering), joint_gate_threshold_(chi2Quantile(options.chi2_gate_probability, 6)) {}
+    : options_(options),
+      full_factor_(options.ordering),
+      joint_gate_threshold_(chi2Quantile(options.chi2_gate_probability, 6)),
+      single_gate_threshold_(chi2Quantile(options.chi2_gate_probability, 3)) {}
 Esdf::~Esdf() = default;
 
 void Esdf::reserve(int poses) { first_factor_of_pose_.reserve(static_cast<size_t>(poses)); }

@@ -110,9 +110,28 @@ void GlobalSlam::closureAdded(size_t current, SteadyTime handed_over) {
   const double growth = options_.estimator.full_recovery_min_growth;
   if (static_cast<double>(map_.size() - last_full_size_) >= growth * static_cast<double>(last_full_size_)) {
     recoverAll(false);
+    added_.clear();
     return;
   }
   recoverRecent();
+  // A window recovery moves only the newest poses. The first closure of a long loop corrects a
+  // drift of metres that they cannot take up: the mean then still misses the closure, while the
+  // exact covariance, with its information in, has shrunk to centimetres. The loop's next
+  // closures would be gated against that stale mean and refused, and a wrong alignment that
+  // happens to fit it admitted (on the 1,000 km drive this lost the map). So a closure the
+  // recovered mean still misses by more than the gate brings the whole map's recovery now.
+  if (missesAddedClosure()) recoverAll(false);
+  added_.clear();
+}
+
+bool GlobalSlam::missesAddedClosure() const {
+  const KeyframeNodes& nodes = *map_.nodes();
+  const double threshold = map_.filter()->gateThreshold();
+  for (const LoopClosureRecord& c : added_) {
+    const esdf::Vec3 e = esdf::relativePoseError(nodes.mean(c.from), nodes.mean(c.to), esdf::toVec(c.measurement));
+    if (e.dot(c.information * e) > threshold) return true;
+  }
+  return false;
 }
 
 void GlobalSlam::recoverRecent() {
@@ -125,6 +144,7 @@ void GlobalSlam::recoverRecent() {
 
 void GlobalSlam::reportClosure(const LoopClosureRecord& r) {
   ++(r.accepted ? stats_.closures_accepted : stats_.closures_rejected);
+  if (r.accepted) added_.push_back(r);
   closures_.push_back(r);
   const LoopClosureEvent e{r.from, r.to, r.to_time, r.detector, r.score, r.accepted, reasonName(r.reason)};
   for (auto* o : observers_) o->onLoopClosure(e);

@@ -135,6 +135,8 @@ class Esdf {
   // The 6-dof quantile of chi2_gate_probability: what two closures gated jointly may reach, and
   // so what no single closure beyond it can pass with a second one.
   double jointGateThreshold() const { return joint_gate_threshold_; }
+  // The 3-dof quantile of chi2_gate_probability: a single closure's gate.
+  double gateThreshold() const { return single_gate_threshold_; }
   // The exact joint covariance of `poses` (3k x 3k, in the order given): from the last factor and
   // the closures since when it can (updatedCovariance), else path solves of a current factor.
   Eigen::MatrixXd covarianceAmong(const std::vector<int>& poses);
@@ -321,6 +323,7 @@ class Esdf {
   EnvelopeCholesky window_factor_;                     // partial recovery of the recent poses
   double gate_probability_ = -1, gate_threshold_ = 0;  // cached chi2 quantile
   double joint_gate_threshold_;                        // jointGateThreshold()
+  double single_gate_threshold_;                       // gateThreshold()
   std::uint64_t values_stamp_ = 0;                     // bumped on every change of Lambda or eta
   std::uint64_t full_factor_values_ = ~std::uint64_t{0};
   long long factorisations_ = 0;

@@ -117,7 +117,10 @@ class GlobalSlam {
   void reportClosure(const LoopClosureRecord& r);
   // After an accepted closure of keyframe `current`: a full recovery when the map has grown
   // enough since the last one ([estimator] full_recovery_min_growth), else the recent poses.
+  // Then also a full recovery when the recovered mean still misses a closure just added by more
+  // than the gate (the window could not take up its correction).
   void closureAdded(size_t current, SteadyTime handed_over);
+  bool missesAddedClosure() const;
   // Candidates, alignment, gating and confirmation for keyframe `current`.
   void searchLoops(size_t current, SteadyTime handed_over);
   // The newest filter poses recovered ([estimator] recent_window), the newest keyframes' poses
@@ -146,6 +149,8 @@ class GlobalSlam {
   // The first closure since the last full recovery: its keyframe and when local SLAM handed
   // that over (not saved: a resumed run has no clock of the earlier one's).
   std::optional<std::pair<size_t, SteadyTime>> unrecovered_closure_;
+  // The closures accepted since the last closureAdded (not saved: a checkpoint falls between steps).
+  std::vector<LoopClosureRecord> added_;
 };
 
 }  // namespace urbanslam::slam
