@@ -277,6 +277,34 @@ TEST(GlobalSlam, TwoClosuresJustBeyondTheGateGoInWhenTheyAgreeAndPassItJointly) 
   EXPECT_EQ(count(run(11.0, 11.0, true), false, slam::ClosureReason::Gating), 2);   // d^2 27: beyond the pair's quantile too
 }
 
+TEST(GlobalSlam, AHypothesisWithNoRoomToWaitForItsConfirmationIsOnRecordAsUnconfirmed) {
+  // Five camera closures of keyframe 205, each within the gate, none confirming another (they
+  // name one keyframe, and a confirmation comes from a later one): four may wait (4 x
+  // confirm_window), the fifth has no room. Every one is on record, unconfirmed, by the end.
+  auto r = std::make_unique<::Run>();
+  r->options.loop_closure.confirm_window = 1;
+  driveStraight(*r, Eigen::Vector3d(0.09, 0.09, 1e-6).asDiagonal());
+  for (const double shift_m : {0.0, 1.0, -1.0, 2.0, -2.0}) {
+    slam::CameraMeasurement m;
+    m.mount = common::Pose2{0.0, 0.0, 0.0};
+    m.relative.valid = true;
+    m.relative.cov = Eigen::Vector2d(1e-4, 1e-4).asDiagonal();
+    m.relative.depth_per_baseline = 0.5;
+    m.metric.valid = true;
+    m.metric.pose = common::Pose2{50.0 + shift_m, 0.0, 0.0};
+    m.metric.cov = Eigen::Vector3d(1e-4, 1e-4, 1e-6).asDiagonal();
+    r->global->proposeImageClosure(155, 205, 1.0, m, std::chrono::steady_clock::now());
+  }
+  r->global->finish();
+  const std::vector<slam::LoopClosureRecord> closures = r->global->closures();
+  ASSERT_EQ(closures.size(), 5u);
+  for (const auto& c : closures) {
+    EXPECT_FALSE(c.accepted);
+    EXPECT_EQ(c.reason, slam::ClosureReason::Unconfirmed);
+  }
+  EXPECT_EQ(r->stats.closures_rejected, 5u);
+}
+
 TEST(GlobalSlam, AClosureTheRecentWindowCannotTakeUpBringsTheWholeMapsRecoveryBeforeTheNext) {
   // A straight drive whose odometry reads 1 m for every 1.005 m driven, each step 5 cm
   // uncertain: 5 m short after a kilometre. Keyframe 1000 closes on keyframe 0 (10 cm): within

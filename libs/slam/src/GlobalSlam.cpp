@@ -261,8 +261,13 @@ GlobalSlam::Admission GlobalSlam::admit(LoopClosureRecord r, size_t current, Mea
     r.confirmed_by = Confirmation::Camera;
     return commit({&r});
   }
-  if (pending_.size() < 4 * window) pending_.push_back(r);
-  return Admission::Pending;
+  if (pending_.size() < 4 * window) {
+    pending_.push_back(r);
+    return Admission::Pending;
+  }
+  // No room to wait: unconfirmed now, and on record as such.
+  reportExpired(std::move(r));
+  return Admission::Rejected;
 }
 
 GlobalSlam::Admission GlobalSlam::commit(std::initializer_list<LoopClosureRecord*> records) {

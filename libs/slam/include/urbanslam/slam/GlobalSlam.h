@@ -96,7 +96,8 @@ class GlobalSlam {
   enum class MeasuredBy { Scans, Camera };
   // A hypothesis's fate: confirmed by an earlier one that agrees with it, or, measured by the
   // scans, by the camera's view (`view`, when the caller measured it: an image proposal; else the
-  // measurer's), then gated again and added; else kept waiting for confirmation.
+  // measurer's), then gated again and added; else kept waiting for confirmation (4 x
+  // confirm_window at most: beyond, unconfirmed at once).
   Admission admit(LoopClosureRecord r, size_t current, MeasuredBy measured = MeasuredBy::Scans,
                   const std::optional<CameraPairView>& view = std::nullopt);
   Admission commit(std::initializer_list<LoopClosureRecord*> records);
