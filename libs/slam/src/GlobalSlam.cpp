@@ -128,6 +128,10 @@ bool GlobalSlam::missesAddedClosure() const {
   const KeyframeNodes& nodes = *map_.nodes();
   const double threshold = map_.filter()->gateThreshold();
   for (const LoopClosureRecord& c : added_) {
+    // A closure through a hung keyframe's offsets goes in with a share of their information, or
+    // none once they are spent (KeyframeNodes): its own information does not tell what the mean
+    // owes it.
+    if (nodes.hung(c.from) || nodes.hung(c.to)) continue;
     const esdf::Vec3 e = esdf::relativePoseError(nodes.mean(c.from), nodes.mean(c.to), esdf::toVec(c.measurement));
     if (e.dot(c.information * e) > threshold) return true;
   }
