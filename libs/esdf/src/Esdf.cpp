@@ -253,18 +253,14 @@ std::optional<GateResult> Esdf::refusalWithoutFactorising(int i, int j, const Ve
 std::optional<GateResult> Esdf::gate(int i, int j, const Vec3& z, const Mat3& omega, bool without_factorising) {
   if (i < 0 || j < 0 || i >= size() || j >= size() || i == j) throw std::out_of_range("gateRelative: bad pose indices");
   const Vec3 e0 = relativePoseError(state_.mean(i), state_.mean(j), z);
-  if (gate_probability_ != options_.chi2_gate_probability) {
-    gate_probability_ = options_.chi2_gate_probability;
-    gate_threshold_ = chi2Quantile(gate_probability_, 3);
-  }
   // S = H Sigma H' + R >= R, so d^2 = e' S^-1 e <= e' Omega e: a closure within the gate by
   // this bound is accepted without recovering any covariance (the common, consistent case).
   const double bound = e0.dot(omega * e0);
-  if (bound <= gate_threshold_) {
+  if (bound <= single_gate_threshold_) {
     GateResult r;
     r.accepted = true;
     r.mahalanobis2 = bound;
-    r.threshold = gate_threshold_;
+    r.threshold = single_gate_threshold_;
     r.covariance_used = false;
     return r;
   }
@@ -273,7 +269,7 @@ std::optional<GateResult> Esdf::gate(int i, int j, const Vec3& z, const Mat3& om
   composeJacobians(inverse(z), Vec3::Zero(), nullptr, &g);
   const auto test = [&](const Mat3& rel) {
     // S = G Cov(r) G' + R with the innovation -e0 (the measurement "e = 0").
-    return mahalanobisGate(-e0, g * rel * g.transpose() + omega.inverse(), gate_probability_);
+    return mahalanobisGateAt(-e0, g * rel * g.transpose() + omega.inverse(), single_gate_threshold_);
   };
   // The conservative covariance bounds the exact one from above, so its d^2 bounds the exact d^2
   // from below: a closure it refuses, the exact test refuses too. Only the closures it admits

@@ -100,8 +100,8 @@ void Esdf::writeState(common::BinaryWriter& w) const {
     for (double v : m.values) w.f64(v);
   }
 
-  w.f64(gate_probability_);
-  w.f64(gate_threshold_);
+  w.f64(unused_gate_slots_[0]);
+  w.f64(unused_gate_slots_[1]);
   w.u64(values_stamp_);
   w.u64(full_factor_values_);
   w.i32(chain_base_);
@@ -168,8 +168,8 @@ void Esdf::readState(common::BinaryReader& r, bool with_updates, bool with_linea
     }
   }
 
-  gate_probability_ = r.f64();
-  gate_threshold_ = r.f64();
+  unused_gate_slots_[0] = r.f64();
+  unused_gate_slots_[1] = r.f64();
   values_stamp_ = r.u64();
   full_factor_values_ = r.u64();
   chain_base_ = r.i32();

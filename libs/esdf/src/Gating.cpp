@@ -53,10 +53,14 @@ double chi2Quantile(double p, int dof) {
 }
 
 GateResult mahalanobisGate(const Eigen::VectorXd& nu, const Eigen::MatrixXd& s, double probability) {
+  return mahalanobisGateAt(nu, s, chi2Quantile(probability, static_cast<int>(nu.size())));
+}
+
+GateResult mahalanobisGateAt(const Eigen::VectorXd& nu, const Eigen::MatrixXd& s, double threshold) {
   GateResult r;
   Eigen::LDLT<Eigen::MatrixXd> ldlt(s);
   r.mahalanobis2 = nu.dot(ldlt.solve(nu));
-  r.threshold = chi2Quantile(probability, static_cast<int>(nu.size()));
+  r.threshold = threshold;
   r.accepted = std::isfinite(r.mahalanobis2) && r.mahalanobis2 <= r.threshold;
   return r;
 }

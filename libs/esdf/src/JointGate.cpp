@@ -58,7 +58,7 @@ GateResult Esdf::gateRelativePair(int i1, int j1, const Vec3& z1, const Mat3& om
   Eigen::MatrixXd s = h * sigma * h.transpose();
   s.block<3, 3>(0, 0) += omega1.inverse();
   s.block<3, 3>(3, 3) += omega2.inverse();
-  return mahalanobisGate(nu, s, options_.chi2_gate_probability);
+  return mahalanobisGateAt(nu, s, joint_gate_threshold_);
 }
 
 }  // namespace urbanslam::esdf

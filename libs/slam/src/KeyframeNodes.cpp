@@ -133,7 +133,7 @@ esdf::GateResult KeyframeNodes::gateWithinNode(size_t i, size_t k, const Vec3& z
   // plus the measurement's.
   const Mat3 s = addedToRight(z, esdf::betweenCovariance(hi.offset, hk.offset, joint)) + omega.inverse();
   const Eigen::VectorXd nu = -esdf::relativePoseError(hi.offset, hk.offset, z);
-  return esdf::mahalanobisGate(nu, s, filter_.options().chi2_gate_probability);
+  return esdf::mahalanobisGateAt(nu, s, filter_.gateThreshold());
 }
 
 double KeyframeNodes::offsetScale(size_t k) const {

@@ -73,8 +73,7 @@ const char* confirmationName(Confirmation c) {
 
 LoopCloser::LoopCloser(const LoopClosureOptions& options)
     : options_(options),
-      chi2_2dof_(esdf::chi2Quantile(options.mahalanobis_probability, 2)),
-      chi2_3dof_gate_(esdf::chi2Quantile(options.chi2_gate_probability, 3)) {}
+      chi2_2dof_(esdf::chi2Quantile(options.mahalanobis_probability, 2)) {}
 
 void LoopCloser::setScorer(CandidateScorer scorer) { scorer_ = std::move(scorer); }
 
@@ -334,8 +333,8 @@ LoopClosureRecord LoopCloser::tryClose(KeyframeNodes& filter, const Map& map, si
   const io::LaserScan earlier_scan = map.scan(earlier), current_scan = map.scan(current);
   const common::Pose2 guess = esdf::toPose(esdf::between(xi, xk));
   // Where the innovation gate admits a measurement: the relative pose's own uncertainty (the
-  // alignment's, centimetres, is left out).
-  const alignment::PoseRegion admitted{guess, s, chi2_3dof_gate_};
+  // alignment's, centimetres, is left out), at the filter's own quantile.
+  const alignment::PoseRegion admitted{guess, s, filter.gateThreshold()};
   // The checks of verifyAlignment, with the ambiguity restarts (its costly part) left until the
   // measurement is final and the gate has not refused it already.
   const AlignedScans aligned =

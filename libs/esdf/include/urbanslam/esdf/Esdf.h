@@ -18,6 +18,7 @@
 // filter reaches the batch (Gauss-Newton) optimum after a large loop closure instead of keeping
 // the first linearisation's error.
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <deque>
 #include <functional>
@@ -321,9 +322,12 @@ class Esdf {
 
   SparseCholesky full_factor_;
   EnvelopeCholesky window_factor_;                     // partial recovery of the recent poses
-  double gate_probability_ = -1, gate_threshold_ = 0;  // cached chi2 quantile
-  double joint_gate_threshold_;                        // jointGateThreshold()
-  double single_gate_threshold_;                       // gateThreshold()
+  double joint_gate_threshold_;   // jointGateThreshold()
+  double single_gate_threshold_;  // gateThreshold()
+  // Two slots of the state's format that held the gate's quantile, cached at its first use; the
+  // thresholds above come from the options now. Nothing reads them: they are carried as read, so
+  // that a filter written again gives the same bytes.
+  std::array<double, 2> unused_gate_slots_{-1, 0};
   std::uint64_t values_stamp_ = 0;                     // bumped on every change of Lambda or eta
   std::uint64_t full_factor_values_ = ~std::uint64_t{0};
   long long factorisations_ = 0;

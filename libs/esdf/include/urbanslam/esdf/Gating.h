@@ -27,5 +27,7 @@ struct GateResult {
 
 // d^2 of innovation nu with covariance s against the p-quantile (dof = nu.size()).
 GateResult mahalanobisGate(const Eigen::VectorXd& nu, const Eigen::MatrixXd& s, double probability);
+// The same against a quantile computed once by the caller (the bisection is not free per gate).
+GateResult mahalanobisGateAt(const Eigen::VectorXd& nu, const Eigen::MatrixXd& s, double threshold);
 
 }  // namespace urbanslam::esdf

@@ -78,6 +78,7 @@ class KeyframeNodes {
   esdf::GateResult gateRelativePair(size_t i1, size_t k1, const esdf::Vec3& z1, const esdf::Mat3& omega1, size_t i2, size_t k2,
                                     const esdf::Vec3& z2, const esdf::Mat3& omega2);
   double jointGateThreshold() const { return filter_.jointGateThreshold(); }
+  double gateThreshold() const { return filter_.gateThreshold(); }
   void writeState(common::BinaryWriter& w) const;
   // After the filter's state; `keyframes`: the map's. Map format 10 hung keyframes otherwise:
   // such a map is refused.

@@ -171,7 +171,6 @@ class LoopCloser {
   LoopClosureOptions options_;
   CandidateScorer scorer_;
   double chi2_2dof_;
-  double chi2_3dof_gate_;  // the innovation gate's threshold
   size_t cached_for_ = static_cast<size_t>(-1);
   std::unordered_map<size_t, Eigen::Matrix3d> cached_;  // relative covariances for cached_for_
   std::optional<bool> narrow_view_;                     // the laser covers well under the full circle (read once)
