@@ -73,8 +73,8 @@ std::array<double, 9> GlobalSlam::addKeyframeFrom(size_t from, Keyframe kf, io::
     if (filter) {
       // ESDF prediction with augmentation: the keyframe becomes a delayed pose, O(1); then the
       // recent poses are recovered (a bounded window: constant time between closures). In a
-      // reduced pose graph a keyframe on mapped ground hangs from an earlier visit's pose instead,
-      // the filter unchanged.
+      // reduced pose graph three keyframes in four hang from the newest pose instead, the filter
+      // unchanged.
       if (nodes->add(from, esdf::toVec(constraint.z), info)) {
         filter->recoverRecent(std::max(0, filter->size() - 1 - options_.estimator.recent_window));
         dirty_since_recovery_ = true;

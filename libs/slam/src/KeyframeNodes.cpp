@@ -33,7 +33,6 @@ KeyframeNodes::Hang KeyframeNodes::beyond(const Hang& h, const Vec3& z, const Ma
   Hang out;
   out.node = h.node;
   out.hung = true;
-  out.group = h.group;
   Mat3 j1, j2;
   esdf::composeJacobians(h.offset, z, &j1, &j2);
   out.offset = esdf::compose(h.offset, z);
@@ -41,14 +40,10 @@ KeyframeNodes::Hang KeyframeNodes::beyond(const Hang& h, const Vec3& z, const Ma
   return out;
 }
 
-std::uint32_t KeyframeNodes::newGroup() {
-  uses_.push_back(0);
-  return static_cast<std::uint32_t>(uses_.size() - 1);
-}
-
 void KeyframeNodes::addFirst() {
   if (!reduced_) return;
-  hangs_.push_back(Hang{filter_.size() - 1, false, Vec3::Zero(), Mat3::Zero(), newGroup()});
+  hangs_.push_back(Hang{filter_.size() - 1, false, Vec3::Zero(), Mat3::Zero()});
+  uses_.push_back(0);
 }
 
 bool KeyframeNodes::add(size_t from, const Vec3& z, const Mat3& omega) {
@@ -56,17 +51,7 @@ bool KeyframeNodes::add(size_t from, const Vec3& z, const Mat3& omega) {
     filter_.augmentRelative(static_cast<int>(from), z, omega);
     return true;
   }
-  const bool newest = from + 1 == size();
-  if (newest && root_) {
-    // Re-rooted: a new group hangs from the earlier visit's pose at the closure's measurement.
-    hangs_.push_back(beyond(*root_, z, omega.inverse()));
-    root_.reset();
-    tail_ = 1;
-    link_owed_ = true;
-    return false;
-  }
-  root_.reset();  // from an earlier keyframe than the newest: that closure's other half goes unused
-  if (newest && hung(from) && tail_ + 1 < kKeyframesPerPose) {
+  if (from + 1 == size() && tail_ + 1 < kKeyframesPerPose) {
     hangs_.push_back(beyond(hangs_.at(from), z, omega.inverse()));
     ++tail_;
     return false;
@@ -76,18 +61,14 @@ bool KeyframeNodes::add(size_t from, const Vec3& z, const Mat3& omega) {
     filter_.augmentRelative(f.node, z, omega);
   } else {
     // The link to the new pose: the group's constraints composed, with the share of their
-    // information that closures of the group's hung keyframes do not take (kReserved); or, when
-    // the group's link went in already (from a keyframe before the newest, its group re-rooted
-    // or ended), as one more closure through its offsets.
-    const bool link = link_owed_ && f.group == hangs_.back().group;
+    // information that closures of the group's hung keyframes do not take (kReserved).
     Hang h = beyond(f, z, omega.inverse());
-    h.cov *= link ? 1 / (1 - kReserved) : offsetScale(from);
-    if (!link) ++uses_[f.group];
+    h.cov /= 1 - kReserved;
     filter_.augmentRelative(h.node, h.offset, addedToRight(h.offset, h.cov).inverse());
   }
-  hangs_.push_back(Hang{filter_.size() - 1, false, Vec3::Zero(), Mat3::Zero(), newGroup()});
+  hangs_.push_back(Hang{filter_.size() - 1, false, Vec3::Zero(), Mat3::Zero()});
+  uses_.push_back(0);
   tail_ = 0;
-  link_owed_ = true;
   return true;
 }
 
@@ -158,66 +139,24 @@ esdf::GateResult KeyframeNodes::gateWithinNode(size_t i, size_t k, const Vec3& z
 double KeyframeNodes::offsetScale(size_t k) const {
   // The u-th closure through a group's offsets takes them with 2^(u+1) / kReserved times their
   // covariance: the shares 1/2, 1/4, ... of the reserve, never more than it in all.
-  return hung(k) ? std::ldexp(1.0, uses_[hangs_[k].group] + 1) / kReserved : 1.0;
-}
-
-void KeyframeNodes::fuseOffset(size_t k, const Vec3& z, const Mat3& cov) {
-  // Both estimate x_k relative to its filter pose; fused in the offset's chart (the heading's
-  // difference wrapped), the closure's noise carried from its right to the added form.
-  Hang& h = hangs_[k];
-  const Mat3 c = rightToAdded(z, cov);
-  Vec3 d = z - h.offset;
-  d.z() = common::wrapToPi(d.z());
-  const Mat3 gain = h.cov * (h.cov + c).inverse();
-  h.offset += gain * d;
-  h.cov = (Mat3::Identity() - gain) * h.cov;
-  h.cov = 0.5 * (h.cov + h.cov.transpose());
-}
-
-bool KeyframeNodes::reroots(size_t i, size_t k) const {
-  // The newest keyframe (its own pose, or hung with its group's link still owed) closed to a
-  // pose of its own of an earlier visit (loop closures are never of the last metres). Not to a
-  // hung one: the next group would hang from that one's pose through its offsets too, and
-  // passes closed to passes would carry the vehicle on offsets ever further from the pose they
-  // hang from (on Intel, re-rooting so mapped at 3.3 m where every pose's filter maps at 0.016 m).
-  return reduced_ && k + 1 == size() && (!hung(k) || link_owed_) && !root_ && !hung(i);
+  return hung(k) ? std::ldexp(1.0, uses_[static_cast<size_t>(hangs_[k].node)] + 1) / kReserved : 1.0;
 }
 
 esdf::ObservationResult KeyframeNodes::observeRelative(size_t i, size_t k, const Vec3& z, const Mat3& omega, bool gate) {
-  if (!hung(i) && !hung(k) && !reroots(i, k)) return filter_.observeRelative(node(i), node(k), z, omega, gate);
+  if (!hung(i) && !hung(k)) return filter_.observeRelative(node(i), node(k), z, omega, gate);
   esdf::ObservationResult r;
   if (gate) {
     r.gate = gateRelative(i, k, z, omega);
     r.accepted = r.gate.accepted;
   }
-  if (!r.accepted) return r;
+  const double scale_i = offsetScale(i), scale_k = offsetScale(k);
+  if (!r.accepted || hangs_[i].node == hangs_[k].node || std::max(scale_i, scale_k) > kMaxOffsetScale) return r;
   Vec3 zn;
   Mat3 cn;
-  if (reroots(i, k) && hangs_[i].node == hangs_[k].node) {
-    // The group hangs from i's pose already: the closure measures the newest keyframe's offset,
-    // which it is fused with (the offset's information goes into the filter later, with the
-    // group's link and closures, and the closure's with it, once).
-    fuseOffset(k, z, omega.inverse());
-    return r;
-  }
-  if (reroots(i, k)) {
-    // Half the closure's information, with the group's offsets at the link's share, is the
-    // group's link to i's pose; the other half is the next group's base there.
-    const Mat3 halved = 2 * omega.inverse();
-    toNodes(i, k, z, halved, 1.0, 1 / (1 - kReserved), &zn, &cn);
-    r.chi2 = filter_.observeRelative(hangs_[i].node, hangs_[k].node, zn, cn.inverse(), false).chi2;
-    root_ = beyond(hangs_[i], z, halved);
-    root_->group = newGroup();
-    link_owed_ = false;
-    return r;
-  }
-  if (hangs_[i].node == hangs_[k].node) return r;
-  const double scale_i = offsetScale(i), scale_k = offsetScale(k);
-  if (std::max(scale_i, scale_k) > kMaxOffsetScale) return r;
   toNodes(i, k, z, omega.inverse(), scale_i, scale_k, &zn, &cn);
   r.chi2 = filter_.observeRelative(hangs_[i].node, hangs_[k].node, zn, cn.inverse(), false).chi2;
   for (const size_t x : {i, k})
-    if (hung(x)) ++uses_[hangs_[x].group];
+    if (hung(x)) ++uses_[static_cast<size_t>(hangs_[x].node)];
   return r;
 }
 
@@ -268,23 +207,17 @@ esdf::GateResult KeyframeNodes::gateRelativePair(size_t i1, size_t k1, const Vec
 void KeyframeNodes::writeState(common::BinaryWriter& w) const {
   w.boolean(reduced_);
   if (!reduced_) return;
-  const auto writeHang = [&w](const Hang& h) {
+  w.size(hangs_.size());
+  for (const Hang& h : hangs_) {
     w.i32(h.node);
     w.boolean(h.hung);
-    if (h.hung) {
-      w.matrix(h.offset);
-      w.matrix(h.cov);
-    }
-    w.u32(h.group);
-  };
-  w.size(hangs_.size());
-  for (const Hang& h : hangs_) writeHang(h);
+    if (!h.hung) continue;
+    w.matrix(h.offset);
+    w.matrix(h.cov);
+  }
   w.size(tail_);
   w.size(uses_.size());
   for (const std::uint8_t u : uses_) w.u8(u);
-  w.boolean(link_owed_);
-  w.boolean(root_.has_value());
-  if (root_) writeHang(*root_);
 }
 
 void KeyframeNodes::readOwnPoses(common::BinaryReader& r, size_t keyframes) {
@@ -293,11 +226,8 @@ void KeyframeNodes::readOwnPoses(common::BinaryReader& r, size_t keyframes) {
   hangs_.clear();
   tail_ = 0;
   uses_.clear();
-  link_owed_ = true;
-  root_.reset();
   if (!reduced_) return;
-  for (size_t k = 0; k < keyframes; ++k)
-    hangs_.push_back(Hang{static_cast<int>(k), false, Vec3::Zero(), Mat3::Zero(), static_cast<std::uint32_t>(k)});
+  for (size_t k = 0; k < keyframes; ++k) hangs_.push_back(Hang{static_cast<int>(k), false, Vec3::Zero(), Mat3::Zero()});
   uses_.assign(keyframes, 0);
 }
 
@@ -310,40 +240,27 @@ void KeyframeNodes::readState(common::BinaryReader& r, size_t keyframes, std::ui
     r.fail(reduced ? "keyframes hang from others' filter poses, but [estimator] reduced_pose_graph is false"
                    : "every keyframe has a pose of its own, but [estimator] reduced_pose_graph is true");
   if (!reduced_) return readOwnPoses(r, keyframes);
-  // Format 11 had one group per filter pose, numbered as the poses, and no re-rooting.
-  const bool grouped = format_version >= 12;
-  const auto readHang = [&](const std::string& what) {
+  hangs_.clear();
+  const size_t n = r.count(5);
+  if (n != keyframes) r.fail(std::to_string(n) + " keyframe nodes for " + std::to_string(keyframes) + " keyframes");
+  for (size_t k = 0; k < n; ++k) {
     Hang h;
     h.node = r.i32();
     h.hung = r.boolean();
-    if (h.node < 0 || h.node >= filter_.size()) r.fail(what + " at filter pose " + std::to_string(h.node));
+    if (h.node < 0 || h.node >= filter_.size()) r.fail("keyframe " + std::to_string(k) + " at filter pose " + std::to_string(h.node));
     if (h.hung) {
       h.offset = r.matrix<3, 1>();
       h.cov = r.matrix<3, 3>();
     }
-    h.group = grouped ? r.u32() : static_cast<std::uint32_t>(h.node);
-    return h;
-  };
-  hangs_.clear();
-  const size_t n = r.count(grouped ? 9 : 5);
-  if (n != keyframes) r.fail(std::to_string(n) + " keyframe nodes for " + std::to_string(keyframes) + " keyframes");
-  for (size_t k = 0; k < n; ++k) hangs_.push_back(readHang("keyframe " + std::to_string(k)));
+    hangs_.push_back(h);
+  }
   tail_ = r.size();
   if (tail_ >= kKeyframesPerPose || tail_ >= n) r.fail("a tail of " + std::to_string(tail_) + " keyframes");
-  const size_t groups = r.count(1);
-  if (!grouped && groups != static_cast<size_t>(filter_.size()))
-    r.fail(std::to_string(groups) + " closure counts for " + std::to_string(filter_.size()) + " filter poses");
+  const size_t poses = r.count(1);
+  if (poses != static_cast<size_t>(filter_.size()))
+    r.fail(std::to_string(poses) + " closure counts for " + std::to_string(filter_.size()) + " filter poses");
   uses_.clear();
-  for (size_t p = 0; p < groups; ++p) uses_.push_back(r.u8());
-  link_owed_ = true;
-  root_.reset();
-  if (grouped) {
-    link_owed_ = r.boolean();
-    if (r.boolean()) root_ = readHang("the re-rooted group");
-  }
-  for (size_t k = 0; k < n; ++k)
-    if (hangs_[k].group >= groups) r.fail("keyframe " + std::to_string(k) + " in group " + std::to_string(hangs_[k].group));
-  if (root_ && (!root_->hung || root_->group >= groups)) r.fail("a re-rooted group " + std::to_string(root_->group));
+  for (size_t p = 0; p < poses; ++p) uses_.push_back(r.u8());
 }
 
 }  // namespace urbanslam::slam

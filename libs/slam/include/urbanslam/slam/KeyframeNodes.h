@@ -4,28 +4,21 @@
 //
 // A keyframe of its own for every metre of every pass makes the filter grow with time rather
 // than with the area, and the passes, linked by closures, thicken the whole-map factor with
-// every one (bench/scale/RESULTS.md). Reduced, a keyframe on ground the map has not seen is a
-// pose of its own, and a pass over mapped ground hangs from the earlier visit's poses instead:
-// * A closure of the newest keyframe to a pose of its own of an earlier visit re-roots: the next
-//   keyframes hang from that pose (x_k = x_node ⊕ offset, the offset's covariance kept beside
-//   it), at the closure's measurement composed with local SLAM's constraints since. They form a
-//   group, which the next such closure re-roots again: the closure, composed with the group's
-//   offsets, is the group's link to the new pose. (A closure to the pose the group hangs from
-//   already measures the newest keyframe's offset, and is fused with it.) A pass closed every few metres then adds links
-//   between the earlier visit's poses, not poses of its own: the filter grows with the area.
-// * A group that no closure re-roots ends after kKeyframesPerPose keyframes: the next is a pose
-//   of its own, linked to the group's pose by their composition (with no closure in between,
-//   the chain with its inner poses marginalised out: exact).
+// every one (bench/scale/RESULTS.md). Reduced, only every kKeyframesPerPose-th keyframe is a
+// pose of the filter; the ones between hang from the last such pose by local SLAM's constraints
+// (x_k = x_node ⊕ offset, the offset's covariance kept beside it), and the next pose is added
+// from it by their composition. Where no closure falls in between, that is the chain with its
+// inner poses marginalised out: exact.
 //
-// A group's constraints are then in several measurements (its link and every closure through
-// its offsets), so their information is shared out: the link takes 1 - kReserved of it, and the
-// u-th closure through the group's offsets takes kReserved / 2^(u+1) (the offsets' covariance
-// times 2^(u+1) / kReserved), which never adds up to more than there is: measurements that share
-// a part whose information is split so are together never more certain than they are (for two,
-// the difference of the covariances is [A; -B] S [A; -B]ᵀ ≥ 0). A closure that re-roots is in
-// two measurements itself (the link and the next group's base), each with half its information.
-// A closure whose offsets would weigh more than kMaxOffsetScale times their covariance is gated
-// and adds nothing.
+// A closure of a hung keyframe goes into the filter between the two filter poses, its
+// measurement composed with the offsets. A group's constraints are then in several measurements
+// (its link and every closure through its offsets), so their information is shared out: the
+// link takes 1 - kReserved of it, and the u-th closure through the group's offsets takes
+// kReserved / 2^(u+1) (the offsets' covariance times 2^(u+1) / kReserved), which never adds up
+// to more than there is: measurements that share a part whose information is split so are
+// together never more certain than they are (for two, the difference of the covariances is
+// [A; -B] S [A; -B]ᵀ ≥ 0). A closure whose offsets would weigh more than kMaxOffsetScale times
+// their covariance is gated and adds nothing.
 //
 // Without reduction every keyframe is its own filter pose, and each call forwards unchanged.
 #include <Eigen/Core>
@@ -41,8 +34,7 @@ namespace urbanslam::slam {
 
 class KeyframeNodes {
  public:
-  // Reduced: a group of hung keyframes that no closure re-roots ends in a pose of its own after
-  // this many keyframes.
+  // Reduced: one keyframe in this many is a pose of the filter.
   static constexpr size_t kKeyframesPerPose = 4;
   // The share of a group's constraints' information kept from its link for closures through its
   // offsets, and the largest multiple of an offset's covariance a closure goes in with.
@@ -58,10 +50,9 @@ class KeyframeNodes {
   int nodes() const { return filter_.size(); }
   int node(size_t k) const { return reduced_ ? hangs_[k].node : static_cast<int>(k); }
   bool hung(size_t k) const { return reduced_ && hangs_[k].hung; }
-  // The keyframes of the newest group (hung since its pose, or since it was re-rooted).
+  // The keyframes hung since the filter's newest pose: the newest keyframes, at most.
   size_t tailSize() const { return tail_; }
-  // Whether the next keyframe hangs from an earlier visit's pose (the newest closed to it).
-  bool rerooted() const { return root_.has_value(); }
+  bool inTail(size_t k) const { return tail_ > 0 && k >= size() - tail_; }
 
   // The first keyframe: the filter's first pose (initialised by the caller).
   void addFirst();
@@ -77,9 +68,7 @@ class KeyframeNodes {
   esdf::Mat3 relativeCovariance(size_t i, size_t k, esdf::CovarianceMode mode);
   // Relative-pose observation of keyframe k from keyframe i, as Esdf::observeRelative. Gated
   // with its own covariance; where a keyframe hangs, it goes into the filter with its offsets'
-  // share as the header says, or is gated and adds nothing. A closure of the newest keyframe
-  // (its own pose, or hung in a group whose link is still owed) to a pose of its own re-roots
-  // there (the header).
+  // share as the header says, or is gated and adds nothing.
   esdf::ObservationResult observeRelative(size_t i, size_t k, const esdf::Vec3& z, const esdf::Mat3& omega, bool gate);
   esdf::GateResult gateRelative(size_t i, size_t k, const esdf::Vec3& z, const esdf::Mat3& omega);
   // ... and its refusal when known without a factorisation (Esdf::refusalWithoutFactorising).
@@ -92,7 +81,7 @@ class KeyframeNodes {
   double gateThreshold() const { return filter_.gateThreshold(); }
   void writeState(common::BinaryWriter& w) const;
   // After the filter's state; `keyframes`: the map's. Map format 10 hung keyframes otherwise:
-  // such a map is refused; format 11 had no re-rooted groups (one group per filter pose).
+  // such a map is refused.
   void readState(common::BinaryReader& r, size_t keyframes, std::uint32_t format_version);
   // A map file from before keyframes could hang: every keyframe its own filter pose.
   void readOwnPoses(common::BinaryReader& r, size_t keyframes);
@@ -103,10 +92,7 @@ class KeyframeNodes {
     bool hung = false;
     esdf::Vec3 offset = esdf::Vec3::Zero();  // x_k = x_node ⊕ offset
     esdf::Mat3 cov = esdf::Mat3::Zero();     // the offset's
-    std::uint32_t group = 0;                 // whose closures share out the offsets' information
   };
-  // A new group's counter of closures through its offsets.
-  std::uint32_t newGroup();
   // `h` ⊕ z with covariance cov: where a keyframe at z from h's keyframe hangs.
   static Hang beyond(const Hang& h, const esdf::Vec3& z, const esdf::Mat3& cov);
   // The relative pose between the filter poses of i and k that a measurement z of ⊖x_i ⊕ x_k
@@ -123,18 +109,12 @@ class KeyframeNodes {
                esdf::Mat3* omega_nodes) const;
   // The multiple of keyframe k's offset covariance its next closure goes in with (1: no offset).
   double offsetScale(size_t k) const;
-  // Whether the accepted closure (i, k) re-roots the newest group (the header).
-  bool reroots(size_t i, size_t k) const;
-  // The offset of keyframe k fused with a measurement z of it (covariance cov, on its right).
-  void fuseOffset(size_t k, const esdf::Vec3& z, const esdf::Mat3& cov);
 
   esdf::Esdf& filter_;
   bool reduced_;
   std::deque<Hang> hangs_;  // per keyframe (reduced only)
-  size_t tail_ = 0;         // keyframes of the newest group
-  bool link_owed_ = true;   // the newest group's link has not gone in (no re-rooting closure yet)
-  std::optional<Hang> root_;       // where the next keyframe hangs from after a re-rooting closure
-  std::deque<std::uint8_t> uses_;  // per group: closures through its offsets so far
+  size_t tail_ = 0;         // keyframes hung since the newest filter pose
+  std::deque<std::uint8_t> uses_;  // per filter pose: closures through its group's offsets so far
 };
 
 }  // namespace urbanslam::slam

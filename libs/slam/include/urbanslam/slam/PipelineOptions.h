@@ -171,9 +171,9 @@ struct EstimatorOptions {
   // gate's exact covariances start from until the next recovery. The run's last recovery goes
   // on until nothing moves past 1 mm and 1e-4 rad.
   int full_recovery_steps = 1;
-  // Keyframes on mapped ground hang from the earlier visit's poses, re-rooted at their closures,
-  // instead of being poses of the filter (KeyframeNodes.h): the filter, and the whole-map
-  // factor's fill from passes over mapped streets, grow with the area rather than the drive.
+  // One keyframe in four is a pose of the filter, the others hang from it by local SLAM's
+  // constraints, their closures composed with the offsets (KeyframeNodes.h): a quarter of the
+  // filter, and of the whole-map factor's fill from passes over mapped streets.
   bool reduced_pose_graph = false;
 };
 
