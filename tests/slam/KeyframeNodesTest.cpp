@@ -98,6 +98,34 @@ TEST(KeyframeNodes, AChainIsThePlainChainWithItsInnerPosesMarginalised) {
   }
 }
 
+// With the first keyframes kept as poses of their own (a memory budget spent on them first),
+// those are the plain chain's poses exactly, and from there on one keyframe in kPer is a pose.
+TEST(KeyframeNodes, TheFirstKeyframesArePosesOfTheirOwn) {
+  constexpr size_t kOwn = 12;
+  esdf::Esdf reduced_filter, plain;
+  slam::KeyframeNodes nodes(reduced_filter, true, kOwn);
+  reduced_filter.initialise(Vec3::Zero(), Mat3::Identity() * 1e-9);
+  nodes.addFirst();
+  for (size_t k = 1; k < kChain; ++k) {
+    const bool own = k < kOwn || (k - (kOwn - 1)) % kPer == 0;
+    EXPECT_EQ(nodes.add(k - 1, step(k), stepOmega()), own) << k;
+    EXPECT_EQ(nodes.hung(k), !own) << k;
+  }
+  chain(plain);
+  EXPECT_EQ(nodes.nodes(), static_cast<int>(kOwn + (kChain - kOwn) / kPer));
+  reduced_filter.recover();
+  plain.recover();
+  const auto mode = esdf::CovarianceMode::Exact;
+  for (size_t k = 0; k < kChain; ++k) {
+    const int K = static_cast<int>(k);
+    EXPECT_LE((nodes.mean(k) - plain.mean(K)).norm(), 1e-9) << k;
+    if (k < kOwn) {
+      EXPECT_EQ(nodes.node(k), K);
+      expectNear(nodes.marginalCovariance(k, mode), plain.marginalCovariance(K, mode), 1e-12);
+    }
+  }
+}
+
 // A second pass over the first pass's places, closed at every keyframe to the keyframe of the
 // first pass beside it and to the nearest one with a pose of its own, against a filter in which every keyframe is a pose
 // of its own and every closure goes in once: that filter holds each measurement exactly once,

@@ -212,9 +212,21 @@ TEST(MapFile, AVersion3FileIsReadAsAMapWithoutSeparateMaps) {
   }
   // The filter as it was, with its chain's lineages (each pose's root and lineage, 8 bytes) and
   // then no record of factors since its factorisation (a count of 0 and false: it refactorises at
-  // its next exact covariance) and every keyframe its own filter pose (false).
+  // its next exact covariance) and the keyframe nodes of a reduced pose graph (the default) with
+  // every keyframe its own filter pose: each keyframe's pose and false, no tail, no closure
+  // through an offset.
   ASSERT_TRUE(a.count("ESDF") && b.count("ESDF"));
-  const std::string& filter_old = a.at("ESDF") + std::string(10, '\0');
+  common::BinaryWriter nodes;
+  nodes.boolean(true);
+  nodes.size(loaded->keyframes().size());
+  for (size_t k = 0; k < loaded->keyframes().size(); ++k) {
+    nodes.i32(static_cast<std::int32_t>(k));
+    nodes.boolean(false);
+  }
+  nodes.size(0);
+  nodes.size(loaded->keyframes().size());
+  for (size_t k = 0; k < loaded->keyframes().size(); ++k) nodes.u8(0);
+  const std::string& filter_old = a.at("ESDF") + std::string(9, '\0') + nodes.bytes();
   const std::string& filter_now = b.at("ESDF");
   ASSERT_GE(filter_now.size(), filter_old.size());
   const size_t lineages = filter_now.size() - filter_old.size();

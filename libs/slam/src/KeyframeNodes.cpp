@@ -27,7 +27,8 @@ Mat3 addedToRight(const Vec3& z, const Mat3& cov) { return rightToAdded(esdf::in
 
 }  // namespace
 
-KeyframeNodes::KeyframeNodes(esdf::Esdf& filter, bool reduced) : filter_(filter), reduced_(reduced) {}
+KeyframeNodes::KeyframeNodes(esdf::Esdf& filter, bool reduced, size_t own_poses_first)
+    : filter_(filter), reduced_(reduced), own_poses_first_(own_poses_first) {}
 
 KeyframeNodes::Hang KeyframeNodes::beyond(const Hang& h, const Vec3& z, const Mat3& cov) {
   Hang out;
@@ -51,7 +52,7 @@ bool KeyframeNodes::add(size_t from, const Vec3& z, const Mat3& omega) {
     filter_.augmentRelative(static_cast<int>(from), z, omega);
     return true;
   }
-  if (from + 1 == size() && tail_ + 1 < kKeyframesPerPose) {
+  if (from + 1 == size() && size() >= own_poses_first_ && tail_ + 1 < kKeyframesPerPose) {
     hangs_.push_back(beyond(hangs_.at(from), z, omega.inverse()));
     ++tail_;
     return false;

@@ -15,12 +15,13 @@ namespace {
 constexpr size_t kNone = std::numeric_limits<size_t>::max();
 }  // namespace
 
-Map::Map(std::unique_ptr<esdf::Esdf> filter, double index_cell_m, size_t scan_cache_bytes, std::string spill_dir, bool reduced_pose_graph)
+Map::Map(std::unique_ptr<esdf::Esdf> filter, double index_cell_m, size_t scan_cache_bytes, std::string spill_dir, bool reduced_pose_graph,
+         size_t own_poses_first)
     : scans_(scan_cache_bytes, spill_dir),
       edges_("pose graph edges", spill_dir),
       index_(index_cell_m),
       filter_(std::move(filter)),
-      nodes_(filter_ ? std::make_unique<KeyframeNodes>(*filter_, reduced_pose_graph) : nullptr),
+      nodes_(filter_ ? std::make_unique<KeyframeNodes>(*filter_, reduced_pose_graph, own_poses_first) : nullptr),
       odometry_("odometry readings", spill_dir) {}
 
 Map::~Map() = default;

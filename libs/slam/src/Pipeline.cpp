@@ -42,7 +42,7 @@ Pipeline::Pipeline(PipelineOptions options)
       reference_("reference poses", options_.map.scan_spill_dir),
       map_(makeFilter(options_), std::max(1.0, options_.loop_closure.search_radius_m),
            static_cast<size_t>(options_.map.scan_cache_mb * 1024 * 1024), options_.map.scan_spill_dir,
-           options_.estimator.reduced_pose_graph),
+           options_.estimator.reduced_pose_graph, static_cast<size_t>(options_.estimator.reduced_after_keyframes)),
       local_(options_),
       global_(options_, map_, stats_, observers_),
       images_(options_.loop_closure.image_max_offset_s),

@@ -41,8 +41,9 @@ class KeyframeNodes {
   static constexpr double kReserved = 0.1;
   static constexpr double kMaxOffsetScale = 1000;
 
-  // `reduced`: whether keyframes may hang from others' poses.
-  KeyframeNodes(esdf::Esdf& filter, bool reduced);
+  // `reduced`: whether keyframes may hang from others' poses; `own_poses_first`: the first this
+  // many keyframes are poses of their own even so (the map's memory budget spent on them first).
+  KeyframeNodes(esdf::Esdf& filter, bool reduced, size_t own_poses_first = 0);
 
   bool reduced() const { return reduced_; }
   size_t size() const { return reduced_ ? hangs_.size() : static_cast<size_t>(filter_.size()); }
@@ -57,8 +58,8 @@ class KeyframeNodes {
   // The first keyframe: the filter's first pose (initialised by the caller).
   void addFirst();
   // The next keyframe, linked to keyframe `from` by z with information `omega`. It hangs (into
-  // the tail) from `from`'s filter pose at from ⊕ z when `from` is the newest keyframe and the
-  // tail has room; else it becomes a pose of its own by ESDF prediction with augmentation, z
+  // the tail) from `from`'s filter pose at from ⊕ z when `from` is the newest keyframe, the
+  // first own_poses_first keyframes are in and the tail has room; else it becomes a pose of its own by ESDF prediction with augmentation, z
   // composed with `from`'s offset when that hangs. True: a pose of its own.
   bool add(size_t from, const esdf::Vec3& z, const esdf::Mat3& omega);
 
@@ -112,6 +113,7 @@ class KeyframeNodes {
 
   esdf::Esdf& filter_;
   bool reduced_;
+  size_t own_poses_first_;
   std::deque<Hang> hangs_;  // per keyframe (reduced only)
   size_t tail_ = 0;         // keyframes hung since the newest filter pose
   std::deque<std::uint8_t> uses_;  // per filter pose: closures through its group's offsets so far

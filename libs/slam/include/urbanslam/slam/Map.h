@@ -79,9 +79,9 @@ class Map {
   // `filter`: the estimator behind the poses (nullptr: dead reckoning, poses composed from the
   // constraints). `index_cell_m`: the spatial index's cell. `scan_cache_bytes`, `spill_dir`: the
   // scan store's memory bound and spill folder (io::ScanStore). `reduced_pose_graph`: keyframes
-  // may hang from the filter poses of others (KeyframeNodes.h).
+  // may hang from the filter poses of others once `own_poses_first` are in (KeyframeNodes.h).
   Map(std::unique_ptr<esdf::Esdf> filter, double index_cell_m, size_t scan_cache_bytes = io::ScanStore::kDefaultCacheBytes,
-      std::string spill_dir = {}, bool reduced_pose_graph = false);
+      std::string spill_dir = {}, bool reduced_pose_graph = false, size_t own_poses_first = 0);
   ~Map();
 
   const PerKeyframe<Keyframe>& keyframes() const { return keyframes_; }

@@ -171,10 +171,15 @@ struct EstimatorOptions {
   // gate's exact covariances start from until the next recovery. The run's last recovery goes
   // on until nothing moves past 1 mm and 1e-4 rad.
   int full_recovery_steps = 1;
-  // One keyframe in four is a pose of the filter, the others hang from it by local SLAM's
-  // constraints, their closures composed with the offsets (KeyframeNodes.h): a quarter of the
-  // filter, and of the whole-map factor's fill from passes over mapped streets.
-  bool reduced_pose_graph = false;
+  // Beyond the first reduced_after_keyframes keyframes, one in four is a pose of the filter, the
+  // others hang from it by local SLAM's constraints, their closures composed with the offsets
+  // (KeyframeNodes.h): a quarter of the filter from there on, and of the whole-map factor's fill
+  // from passes over mapped streets, for maps a little less stiff than with every keyframe a pose.
+  // The first keyframes are poses each, so that a map of up to that many (any indoor log, a
+  // city of tens of kilometres) is mapped as well as it can be and only a longer drive, whose
+  // factor would otherwise outgrow the memory, trades some of that for memory.
+  bool reduced_pose_graph = true;
+  int reduced_after_keyframes = 100000;
 };
 
 struct MapOptions {
