@@ -59,8 +59,9 @@ class KeyframeNodes {
   void addFirst();
   // The next keyframe, linked to keyframe `from` by z with information `omega`. It hangs (into
   // the tail) from `from`'s filter pose at from ⊕ z when `from` is the newest keyframe, the
-  // first own_poses_first keyframes are in and the tail has room; else it becomes a pose of its own by ESDF prediction with augmentation, z
-  // composed with `from`'s offset when that hangs. True: a pose of its own.
+  // first own_poses_first keyframes are in and the tail has room; else it becomes a pose of its
+  // own by ESDF prediction with augmentation, z composed with `from`'s offset when that hangs.
+  // True: a pose of its own.
   bool add(size_t from, const esdf::Vec3& z, const esdf::Mat3& omega);
 
   esdf::Vec3 mean(size_t k) const;
