@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -37,11 +38,17 @@ constexpr size_t kPer = slam::KeyframeNodes::kKeyframesPerPose;
 Vec3 step(size_t k) { return {1.0, 0.05 * std::sin(0.3 * static_cast<double>(k)), 0.04 * std::cos(0.2 * static_cast<double>(k))}; }
 Mat3 stepOmega() { return Vec3(1 / 0.01, 1 / 0.02, 1 / 1e-4).asDiagonal(); }
 
-// Keyframes 0..kChain-1 in `filter` through `nodes`, each from the one before.
-void chain(esdf::Esdf& filter, slam::KeyframeNodes& nodes) {
+// Keyframes 0..kChain-1 in `filter` through `nodes`, each from the one before: the first
+// `own_first` (at least one) poses of their own, then every kPer-th.
+void chain(esdf::Esdf& filter, slam::KeyframeNodes& nodes, size_t own_first = 1) {
   filter.initialise(Vec3::Zero(), Mat3::Identity() * 1e-9);
   nodes.addFirst();
-  for (size_t k = 1; k < kChain; ++k) EXPECT_EQ(nodes.add(k - 1, step(k), stepOmega()), k % kPer == 0) << k;
+  own_first = std::max<size_t>(own_first, 1);
+  for (size_t k = 1; k < kChain; ++k) {
+    const bool own = k < own_first || (k - (own_first - 1)) % kPer == 0;
+    EXPECT_EQ(nodes.add(k - 1, step(k), stepOmega()), own) << k;
+    EXPECT_EQ(nodes.hung(k), !own) << k;
+  }
 }
 
 // The same chain as poses 0..kChain-1 of a plain filter, each step's information times `share`.
@@ -104,13 +111,7 @@ TEST(KeyframeNodes, TheFirstKeyframesArePosesOfTheirOwn) {
   constexpr size_t kOwn = 12;
   esdf::Esdf reduced_filter, plain;
   slam::KeyframeNodes nodes(reduced_filter, true, kOwn);
-  reduced_filter.initialise(Vec3::Zero(), Mat3::Identity() * 1e-9);
-  nodes.addFirst();
-  for (size_t k = 1; k < kChain; ++k) {
-    const bool own = k < kOwn || (k - (kOwn - 1)) % kPer == 0;
-    EXPECT_EQ(nodes.add(k - 1, step(k), stepOmega()), own) << k;
-    EXPECT_EQ(nodes.hung(k), !own) << k;
-  }
+  chain(reduced_filter, nodes, kOwn);
   chain(plain);
   EXPECT_EQ(nodes.nodes(), static_cast<int>(kOwn + (kChain - kOwn) / kPer));
   reduced_filter.recover();

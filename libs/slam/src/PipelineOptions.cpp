@@ -167,7 +167,7 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
         "when the next recovery starts (the run's last goes on until nothing moves past 1 mm and 1e-4 rad)");
   s.add("reduced_pose_graph", o.estimator.reduced_pose_graph,
         "beyond reduced_after_keyframes, one keyframe in four is a filter pose, the three after it hang from it (their closures go in "
-        "composed with their offsets): a filter pose per four keyframes");
+        "composed with their offsets)");
   s.add("reduced_after_keyframes", o.estimator.reduced_after_keyframes, 0, 1000000000, "keyframes",
         "reduced_pose_graph: the first this many keyframes are filter poses each (0: one in four from the start)");
 
