@@ -98,6 +98,69 @@ TEST(LoopCloser, AliasedMinimumAlongACorridorIsRefused) {
   EXPECT_LT(std::abs(common::between(p.truth, right.measurement).phi), 2 * kDeg);
 }
 
+// The same aliased alignment, where a closure accepted a keyframe before predicts it: the
+// restarts, which would refuse it, are left out (they tested that minimum for the accepted
+// closure). Where the accepted closure predicts the reference pose instead, they run.
+TEST(LoopCloser, AnAlignmentThatContinuesAnAcceptedClosureSkipsTheRestarts) {
+  Pair p = intelPair(149, 464);
+  ASSERT_EQ(p.map->size(), 2u) << "rawlogs/intel.rawlog: scans or reference poses missing";
+  const common::Pose2 drifted{0.126, 0.130, -0.179};
+  slam::LoopClosureOptions o;
+  o.max_free_space_conflict = 1;
+  slam::LoopClosureOptions off = o;
+  off.ambiguity_offset_m = 0;
+  auto f0 = filterWith(p.map->keyframes()[0].pose, drifted);
+  const auto aliased = slam::LoopCloser(off).tryClose(*f0, *p.map, 0, 1, false);
+  ASSERT_TRUE(aliased.accepted) << slam::reasonName(aliased.reason);
+  ASSERT_GT(distance(p.truth, aliased.measurement), 1.0);
+
+  slam::LoopClosureRecord recent;
+  recent.from = 0;
+  recent.to = 1;
+  recent.accepted = true;
+  recent.measurement = aliased.measurement;
+  auto f1 = filterWith(p.map->keyframes()[0].pose, drifted);
+  const auto continued = slam::LoopCloser(o).tryClose(*f1, *p.map, 0, 1, false, nullptr, &recent);
+  EXPECT_TRUE(continued.accepted) << slam::reasonName(continued.reason);
+  EXPECT_TRUE(continued.restarts_skipped);
+  EXPECT_LT(distance(aliased.measurement, continued.measurement), 0.01);
+
+  recent.measurement = p.truth;
+  auto f2 = filterWith(p.map->keyframes()[0].pose, drifted);
+  const auto tested = slam::LoopCloser(o).tryClose(*f2, *p.map, 0, 1, false, nullptr, &recent);
+  EXPECT_FALSE(tested.accepted);
+  EXPECT_FALSE(tested.restarts_skipped);
+  EXPECT_EQ(tested.reason, slam::ClosureReason::Ambiguous);
+}
+
+// Keyframes a metre apart along x; a closure 10 -> 70 measured (60.1, 0.05, 1°). Carried to
+// 11 -> 71 it predicts (-1, 0, 0) ⊕ (60.1, 0.05, 1°) ⊕ (1, 0, 0) = (59.1 + cos 1°, 0.05 + sin 1°, 1°).
+// A measurement continues it within a quarter of ambiguity_offset_m (0.1875 m) and
+// confirm_tolerance_deg (3°), from a keyframe of the same earlier visit (closer than
+// min_keyframe_gap, 30 keyframes).
+TEST(LoopCloser, AClosureIsContinuedWithinTheRestartsSameMinimumFromTheSameVisit) {
+  slam::Map map(nullptr, 1.0);
+  for (size_t k = 0; k < 100; ++k)
+    map.addKeyframe({k, static_cast<double>(k), {static_cast<double>(k), 0, 0}, false, false, {}}, io::CompactScan());
+  slam::LoopClosureOptions o;
+  ASSERT_EQ(o.ambiguity_offset_m, 0.75);
+  ASSERT_EQ(o.confirm_tolerance_deg, 3.0);
+  ASSERT_EQ(o.min_keyframe_gap, 30);
+  const slam::LoopCloser closer(o);
+  slam::LoopClosureRecord c;
+  c.from = 10;
+  c.to = 70;
+  c.measurement = {60.1, 0.05, 1 * kDeg};
+  const common::Pose2 predicted{59.1 + std::cos(1 * kDeg), 0.05 + std::sin(1 * kDeg), 1 * kDeg};
+  EXPECT_TRUE(closer.continuesClosure(map, c, 11, 71, predicted));
+  EXPECT_TRUE(closer.continuesClosure(map, c, 11, 71, common::compose(predicted, {0.15, 0.1, 2.5 * kDeg})));
+  EXPECT_FALSE(closer.continuesClosure(map, c, 11, 71, common::compose(predicted, {0.15, 0.12, 0})));  // 0.192 m
+  EXPECT_FALSE(closer.continuesClosure(map, c, 11, 71, common::compose(predicted, {0, 0, 3.5 * kDeg})));
+  // The keyframe 29 after c's is of the same visit, 30 after of another: each measured where c puts it.
+  EXPECT_TRUE(closer.continuesClosure(map, c, 39, 71, common::compose({-29, 0, 0}, common::compose(c.measurement, {1, 0, 0}))));
+  EXPECT_FALSE(closer.continuesClosure(map, c, 40, 71, common::compose({-30, 0, 0}, common::compose(c.measurement, {1, 0, 0}))));
+}
+
 // MIT CSAIL scans 122 and 214: a run accepted this closure 2.4 m along a corridor (the
 // ground-truth relations around it disagree by 0.67 m, the corrected log by 2.4 m). It passes
 // the residual, overlap, constraint and ambiguity tests; at that pose a wall of each scan

@@ -149,6 +149,7 @@ void GlobalSlam::recoverRecent() {
 void GlobalSlam::reportClosure(const LoopClosureRecord& r) {
   ++(r.accepted ? stats_.closures_accepted : stats_.closures_rejected);
   if (r.accepted) added_.push_back(r);
+  if (r.accepted && (!last_accepted_ || r.to >= last_accepted_->to)) last_accepted_ = r;
   closures_.push_back(r);
   const LoopClosureEvent e{r.from, r.to, r.to_time, r.detector, r.score, r.accepted, reasonName(r.reason)};
   for (auto* o : observers_) o->onLoopClosure(e);
@@ -193,6 +194,12 @@ void GlobalSlam::reportExpired(LoopClosureRecord r) {
 bool GlobalSlam::waitsForJointGate(const LoopClosureRecord& r) const {
   if (!options_.loop_closure.joint_gate || r.accepted || r.reason != ClosureReason::Gating) return false;
   return r.mahalanobis2 <= map_.nodes()->jointGateThreshold();
+}
+
+const LoopClosureRecord* GlobalSlam::recentClosure(size_t current) const {
+  const size_t window = static_cast<size_t>(std::max(1, options_.loop_closure.confirm_window));
+  const LoopClosureRecord* c = last_accepted_ ? &*last_accepted_ : nullptr;
+  return c && !c->restarts_skipped && c->to < current && current - c->to <= window ? c : nullptr;
 }
 
 bool GlobalSlam::confirming() const {
@@ -332,7 +339,8 @@ void GlobalSlam::searchLoops(size_t current, SteadyTime handed_over) {
     // 7-9. Alignment and gating (the update itself waits for a confirmation).
     ++stats_.closures_tried;
     const Detection* detection = c.detection ? &*c.detection : nullptr;
-    if (admit(closer_.tryClose(*map_.nodes(), map_, c.keyframe, current, !confirm, detection), current) == Admission::Accepted) {
+    if (admit(closer_.tryClose(*map_.nodes(), map_, c.keyframe, current, !confirm, detection, recentClosure(current)), current) ==
+        Admission::Accepted) {
       accepted = true;
       break;  // one closure per keyframe; the next keyframe sees the corrected map
     }
@@ -409,7 +417,7 @@ void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double scor
     LoopClosureRecord r;
     std::optional<CameraPairView> view;
     if (scans) {
-      r = closer_.tryClose(f, map_, earlier, current, !confirm, &detection);
+      r = closer_.tryClose(f, map_, earlier, current, !confirm, &detection, recentClosure(current));
       if (camera) view = CameraPairView{earlier, current, *camera};
     } else {
       CameraMeasurement m = *camera;

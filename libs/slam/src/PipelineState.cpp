@@ -138,6 +138,7 @@ void writeRecord(BinaryWriter& w, const LoopClosureRecord& c) {
   w.f64(c.prior_sigma_m);
   w.boolean(c.bearing_only);
   w.u8(static_cast<std::uint8_t>(c.confirmed_by));
+  w.boolean(c.restarts_skipped);
 }
 
 LoopClosureRecord readRecord(BinaryReader& r, size_t keyframes, std::uint32_t format_version) {
@@ -175,6 +176,8 @@ LoopClosureRecord readRecord(BinaryReader& r, size_t keyframes, std::uint32_t fo
     if (confirmed > static_cast<std::uint8_t>(Confirmation::Jointly)) r.fail("loop closure confirmation " + std::to_string(confirmed));
     c.confirmed_by = static_cast<Confirmation>(confirmed);
   }
+  // Before version 12 no closure left the ambiguity restarts out.
+  if (format_version >= 12) c.restarts_skipped = r.boolean();
   return c;
 }
 
@@ -598,7 +601,12 @@ void GlobalSlam::readState(BinaryReader& r, std::uint32_t format_version) {
   pending_.clear();
   for (size_t i = 0, count = r.count(kRecordBytes); i < count; ++i) pending_.push_back(readRecord(r, n, format_version));
   closures_.clear();
-  for (size_t i = 0, count = r.count(kRecordBytes); i < count; ++i) closures_.push_back(readRecord(r, n, format_version));
+  last_accepted_.reset();
+  for (size_t i = 0, count = r.count(kRecordBytes); i < count; ++i) {
+    const LoopClosureRecord c = readRecord(r, n, format_version);
+    if (c.accepted && (!last_accepted_ || c.to >= last_accepted_->to)) last_accepted_ = c;
+    closures_.push_back(c);
+  }
   dirty_since_recovery_ = r.boolean();
   last_full_size_ = r.size();
   // The classifier's keyframe features are not saved: a function of each keyframe's scan,

@@ -110,6 +110,10 @@ class GlobalSlam {
   // A hypothesis that passed the gate waits for its confirmation (the candidate search then
   // looks near at every keyframe).
   bool confirming() const;
+  // The last accepted closure when it took the ambiguity restarts and is at most confirm_window
+  // keyframes (at least one) older than `current`: a closure that continues it leaves them out
+  // (LoopCloser::tryClose).
+  const LoopClosureRecord* recentClosure(size_t current) const;
   bool cameraConfirms(const LoopClosureRecord& r, const std::optional<CameraPairView>& given) const;
   void expirePending(size_t current);
   bool consistent(const LoopClosureRecord& a, const LoopClosureRecord& b) const;
@@ -147,6 +151,8 @@ class GlobalSlam {
   LoopClosureLog closures_;  // every hypothesis and its fate
   bool dirty_since_recovery_ = false;
   size_t last_full_size_ = 0;  // keyframes at the last full recovery
+  // The accepted closure of the newest keyframe (a resumed run reads it off the closures' log).
+  std::optional<LoopClosureRecord> last_accepted_;
   // The first closure since the last full recovery: its keyframe and when local SLAM handed
   // that over (not saved: a resumed run has no clock of the earlier one's).
   std::optional<std::pair<size_t, SteadyTime>> unrecovered_closure_;

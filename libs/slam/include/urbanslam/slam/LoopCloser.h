@@ -80,6 +80,9 @@ struct LoopClosureRecord {
   // estimate's (CameraClosure.h). Scan alignments and full camera poses measure all three.
   bool bearing_only = false;
   Confirmation confirmed_by = Confirmation::None;
+  // The ambiguity restarts were left out: the alignment continues a closure that took them
+  // (LoopCloser::tryClose).
+  bool restarts_skipped = false;
 };
 
 // A record as the map file holds it (the current format), for the records' spill file.
@@ -128,8 +131,17 @@ class LoopCloser {
   std::vector<Candidate> candidates(KeyframeNodes& filter, const Map& map, size_t current, bool confirming = false);
   // Alignment and gating of one candidate. With `commit`, a closure that passes is
   // added to the filter; without, it is only tested (accepted = passed) for later confirmation.
+  // `recent`: an accepted closure a few keyframes back that took the ambiguity restarts. An
+  // alignment that continues it (continuesClosure) leaves them out: they would test the
+  // uniqueness of the minimum that its restarts tested. So along a revisit every other closure
+  // takes them, each with its own scans.
   LoopClosureRecord tryClose(KeyframeNodes& filter, const Map& map, size_t earlier, size_t current, bool commit = true,
-                             const Detection* detection = nullptr);
+                             const Detection* detection = nullptr, const LoopClosureRecord* recent = nullptr);
+  // Whether `earlier` -> `current` measured as `z` continues the accepted closure `c`: `earlier` is
+  // of the same earlier visit (within min_keyframe_gap keyframes of c's), and c, carried along
+  // both visits by the estimate, puts `current` where z does, within what the ambiguity restarts
+  // count as the same minimum (a quarter of ambiguity_offset_m) and confirm_tolerance_deg.
+  bool continuesClosure(const Map& map, const LoopClosureRecord& c, size_t earlier, size_t current, const common::Pose2& z) const;
   // Gating (and with `commit` the update) of a relative-pose factor measured by another sensor
   // in place of a scan alignment. With `camera` (the images that measured it: CameraClosure.h),
   // first the scene's depth: a monocular pair fixes its scene up to the baseline, and at the
@@ -144,9 +156,9 @@ class LoopCloser {
     return candidates(nodes, map, current, confirming);
   }
   LoopClosureRecord tryClose(esdf::Esdf& filter, const Map& map, size_t earlier, size_t current, bool commit = true,
-                             const Detection* detection = nullptr) {
+                             const Detection* detection = nullptr, const LoopClosureRecord* recent = nullptr) {
     KeyframeNodes nodes(filter, false);
-    return tryClose(nodes, map, earlier, current, commit, detection);
+    return tryClose(nodes, map, earlier, current, commit, detection, recent);
   }
 
   // The checks of a closure that need no estimate, for two scans aligned from `guess` by

@@ -20,13 +20,13 @@
 namespace urbanslam::slam {
 
 constexpr const char* kMapFileName = "map.usmap";
-constexpr std::uint32_t kMapFormatVersion = 11;
+constexpr std::uint32_t kMapFormatVersion = 12;
 // Version 3 files (no separate maps), 4 (no heading corrections of local SLAM), 5 (no record of
 // which camera closures measured bearing and heading only), 6 (no record of what confirmed a
 // closure), 7 (every step's duration instead of their histograms), 8 (no record of the
-// filter's factors since its last factorisation), 9 (every keyframe a filter pose of its own)
-// and 10 (a reduced pose graph that hung keyframes at their closures: refused when it has one)
-// are read as well.
+// filter's factors since its last factorisation), 9 (every keyframe a filter pose of its own),
+// 10 (a reduced pose graph that hung keyframes at their closures: refused when it has one) and
+// 11 (no record of which closures left the ambiguity restarts out) are read as well.
 constexpr std::uint32_t kOldestMapFormatVersion = 3;
 
 // The map of the pipeline's current state written to `out` from its start, streamed (the
