@@ -149,7 +149,7 @@ void GlobalSlam::recoverRecent() {
 void GlobalSlam::reportClosure(const LoopClosureRecord& r) {
   ++(r.accepted ? stats_.closures_accepted : stats_.closures_rejected);
   if (r.accepted) added_.push_back(r);
-  if (r.accepted && (!last_accepted_ || r.to >= last_accepted_->to)) last_accepted_ = r;
+  keepIfNewestAccepted(r);
   closures_.push_back(r);
   const LoopClosureEvent e{r.from, r.to, r.to_time, r.detector, r.score, r.accepted, reasonName(r.reason)};
   for (auto* o : observers_) o->onLoopClosure(e);
@@ -162,10 +162,7 @@ bool GlobalSlam::consistent(const LoopClosureRecord& a, const LoopClosureRecord&
   // Two alignments onto the same earlier scan would repeat one aliasing (a corridor, a symmetric
   // room) rather than confirm it: the confirmation aligns with another scan of the earlier visit.
   if (a.from == b.from) return false;
-  const auto& kf = map_.keyframes();
-  const common::Pose2 predicted = common::compose(common::compose(common::between(kf[b.from].pose, kf[a.from].pose), a.measurement),
-                                                  common::between(kf[a.to].pose, kf[b.to].pose));
-  return agree(predicted, b.measurement);
+  return agree(carriedClosure(map_, a, b.from, b.to), b.measurement);
 }
 
 bool GlobalSlam::agree(const common::Pose2& a, const common::Pose2& b) const {
@@ -194,6 +191,10 @@ void GlobalSlam::reportExpired(LoopClosureRecord r) {
 bool GlobalSlam::waitsForJointGate(const LoopClosureRecord& r) const {
   if (!options_.loop_closure.joint_gate || r.accepted || r.reason != ClosureReason::Gating) return false;
   return r.mahalanobis2 <= map_.nodes()->jointGateThreshold();
+}
+
+void GlobalSlam::keepIfNewestAccepted(const LoopClosureRecord& r) {
+  if (r.accepted && (!last_accepted_ || r.to >= last_accepted_->to)) last_accepted_ = r;
 }
 
 const LoopClosureRecord* GlobalSlam::recentClosure(size_t current) const {
@@ -310,9 +311,7 @@ bool GlobalSlam::cameraConfirms(const LoopClosureRecord& r, const std::optional<
   if (!options_.loop_closure.camera_confirmation || r.bearing_only) return false;
   const std::optional<CameraPairView> view = given ? given : camera_measurer_ ? camera_measurer_(r.from, r.to) : std::nullopt;
   if (!view || !view->camera.metric.valid) return false;
-  const auto& kf = map_.keyframes();
-  const common::Pose2 scans = common::compose(common::compose(common::between(kf[view->earlier].pose, kf[r.from].pose), r.measurement),
-                                              common::between(kf[r.to].pose, kf[view->current].pose));
+  const common::Pose2 scans = carriedClosure(map_, r, view->earlier, view->current);
   const common::Pose2& m = view->camera.mount;
   return agree(common::compose(common::compose(m, view->camera.metric.pose), common::inverse(m)), scans);
 }

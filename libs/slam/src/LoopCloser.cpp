@@ -298,14 +298,17 @@ bool LoopCloser::freeSpaceConflict(const io::LaserScan& earlier_scan, const io::
   return true;
 }
 
+common::Pose2 carriedClosure(const Map& map, const LoopClosureRecord& c, size_t earlier, size_t current) {
+  const auto& kf = map.keyframes();
+  return common::compose(common::compose(common::between(kf[earlier].pose, kf[c.from].pose), c.measurement),
+                         common::between(kf[c.to].pose, kf[current].pose));
+}
+
 bool LoopCloser::continuesClosure(const Map& map, const LoopClosureRecord& c, size_t earlier, size_t current,
                                   const common::Pose2& z) const {
   // Another visit's scans were never aligned with the current ones: the restarts are theirs to pass.
   if ((earlier > c.from ? earlier - c.from : c.from - earlier) >= static_cast<size_t>(options_.min_keyframe_gap)) return false;
-  const auto& kf = map.keyframes();
-  const common::Pose2 predicted = common::compose(common::compose(common::between(kf[earlier].pose, kf[c.from].pose), c.measurement),
-                                                  common::between(kf[c.to].pose, kf[current].pose));
-  const common::Pose2 d = common::between(predicted, z);
+  const common::Pose2 d = common::between(carriedClosure(map, c, earlier, current), z);
   return std::hypot(d.x, d.y) <= 0.25 * options_.ambiguity_offset_m && std::abs(d.phi) <= options_.confirm_tolerance_deg * M_PI / 180;
 }
 

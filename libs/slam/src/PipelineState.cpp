@@ -604,7 +604,7 @@ void GlobalSlam::readState(BinaryReader& r, std::uint32_t format_version) {
   last_accepted_.reset();
   for (size_t i = 0, count = r.count(kRecordBytes); i < count; ++i) {
     const LoopClosureRecord c = readRecord(r, n, format_version);
-    if (c.accepted && (!last_accepted_ || c.to >= last_accepted_->to)) last_accepted_ = c;
+    keepIfNewestAccepted(c);
     closures_.push_back(c);
   }
   dirty_since_recovery_ = r.boolean();

@@ -114,6 +114,9 @@ class GlobalSlam {
   // keyframes (at least one) older than `current`: a closure that continues it leaves them out
   // (LoopCloser::tryClose).
   const LoopClosureRecord* recentClosure(size_t current) const;
+  // last_accepted_ becomes `r` when r is accepted and of the newest keyframe so far (as reported,
+  // and as a resumed run reads the closures' log).
+  void keepIfNewestAccepted(const LoopClosureRecord& r);
   bool cameraConfirms(const LoopClosureRecord& r, const std::optional<CameraPairView>& given) const;
   void expirePending(size_t current);
   bool consistent(const LoopClosureRecord& a, const LoopClosureRecord& b) const;

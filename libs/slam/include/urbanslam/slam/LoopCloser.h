@@ -85,6 +85,11 @@ struct LoopClosureRecord {
   bool restarts_skipped = false;
 };
 
+// The relative pose of keyframe `current` from `earlier` that the closure `c` implies, carried
+// along both visits by the map's estimate: between(earlier, c.from) ⊕ c.measurement ⊕
+// between(c.to, current). Confirmation, camera confirmation and continuation compare with it.
+common::Pose2 carriedClosure(const Map& map, const LoopClosureRecord& c, size_t earlier, size_t current);
+
 // A record as the map file holds it (the current format), for the records' spill file.
 // PipelineState.cpp.
 struct LoopClosureRecordCodec {
