@@ -267,6 +267,90 @@ TEST(Recovery, ConservativeCovarianceIsExactWithoutNewInformationAndAnUpperBound
 // Relative-pose covariance of (x_i, x_j) from their joint covariance, at the filter's means.
 Mat3 relative(const Esdf& f, int i, int j, const Mat6& joint) { return betweenCovariance(f.mean(i), f.mean(j), joint); }
 
+// The innovation gate's exact test refactorises a map that only gained closures and poses since
+// the last factorisation: pose 7's conservative marginal before that factorisation (first), its
+// exact marginal at it (second), and its conservative marginal after more closures (later).
+struct GateFactorisation {
+  explicit GateFactorisation(double keep_marginals_min_work) : f(options(keep_marginals_min_work)) {
+    std::mt19937 rng(35);
+    buildGraph(f, rng, 50, 6);
+    f.recover();  // factor of 50 poses
+    for (int k = 50; k < 65; ++k) f.augmentRelative(k - 1, Vec3(1, 0, 0.05), kOdoInfo);
+    // Closures at more factored poses than the exact covariance updates the old factor for
+    // (ExactUpdates.cpp): its next query refactorises.
+    for (int i : {4, 12, 20, 28}) f.observeRelative(i, 64 - i / 4, between(f.mean(i), f.mean(64 - i / 4)), kLoopInfo);
+    first = f.jointCovariance(7, 7, CovarianceMode::Conservative).topLeftCorner<3, 3>();
+    const long long before = f.factorisations();
+    exact_at_second = f.jointCovariance(7, 58, CovarianceMode::Exact);  // the gate's factorisation, at 65 poses
+    refactorised = f.factorisations() == before + 1;
+    second = exact_at_second.topLeftCorner<3, 3>();
+    // Closures after it, into the new chain.
+    for (int k = 65; k < 75; ++k) f.augmentRelative(k - 1, Vec3(1, 0, 0.05), kOdoInfo);
+    f.observeRelative(8, 72, between(f.mean(8), f.mean(72)), kLoopInfo);
+    later = f.jointCovariance(7, 7, CovarianceMode::Conservative).topLeftCorner<3, 3>();
+  }
+  static EsdfOptions options(double keep_marginals_min_work) {
+    EsdfOptions o = LinearGraph::options();
+    o.keep_marginals_min_work = keep_marginals_min_work;
+    return o;
+  }
+  Esdf f;
+  Mat3 first, second, later;
+  Mat6 exact_at_second;
+  bool refactorised = false;
+};
+
+TEST(Recovery, AFactorisationThatOnlyAddsInformationKeepsDearMarginalsAsUpperBounds) {
+  // Kept however cheap (the case of a city of 10^6 keyframes, where they take minutes): the new
+  // information can only shrink them, so they still bound the covariance from above. The poses
+  // factored since are solved along their paths, exactly.
+  GateFactorisation g(0);
+  Esdf& f = g.f;
+  ASSERT_TRUE(g.refactorised);
+  EXPECT_LT((g.later - g.first).cwiseAbs().maxCoeff(), 1e-12 * g.first.norm()) << "the first factorisation's marginal is kept";
+  EXPECT_GT((g.first - g.second).norm(), 1e-3 * g.second.norm()) << "the closures should have shrunk pose 7's marginal";
+  // A pose factored by the second factorisation only: its marginal there, from its path solve.
+  const Mat3 solved = f.jointCovariance(58, 58, CovarianceMode::Conservative).topLeftCorner<3, 3>();
+  EXPECT_LT((solved - g.exact_at_second.bottomRightCorner<3, 3>()).cwiseAbs().maxCoeff(), 1e-9 * solved.norm());
+  // Every kind of pair stays an upper bound of the exact covariance (the last queries: an exact
+  // one refactorises).
+  const std::vector<std::pair<int, int>> pairs{{7, 7}, {7, 58}, {7, 73}, {58, 74}, {2, 30}, {60, 60}};
+  const auto bounded = conservativeThenExact(f, pairs);
+  for (size_t k = 0; k < bounded.size(); ++k) {
+    const auto& [c, e] = bounded[k];
+    EXPECT_GT(minEigen<6>(c - e), -1e-9 * e.norm()) << k;
+  }
+}
+
+TEST(Recovery, AFactorisationOfASmallMapComputesItsMarginalsAgain) {
+  // With the default threshold a 65-pose map's sparse inverse is cheap: the marginals are those
+  // of the new factorisation, tighter.
+  GateFactorisation g(EsdfOptions{}.keep_marginals_min_work);
+  ASSERT_TRUE(g.refactorised);
+  EXPECT_LT((g.later - g.second).cwiseAbs().maxCoeff(), 1e-9 * g.second.norm());
+}
+
+TEST(Recovery, ARelinearisedFactorisationComputesTheMarginalsAgain) {
+  // Relinearising changes Lambda, not only adds to it: the marginals of the factorisation before
+  // bound nothing, and the conservative covariance is exact again, without new information.
+  std::mt19937 rng(36);
+  Esdf f;  // relinearises
+  buildGraph(f, rng, 60, 8);
+  f.recover();
+  const Mat3 before = f.jointCovariance(5, 5, CovarianceMode::Conservative).topLeftCorner<3, 3>();
+  // A closure that moves the map by decimetres, then a recovery as global SLAM runs it.
+  f.observeRelative(5, 45, between(f.mean(5), f.mean(45)) + Vec3(0.4, -0.3, 0.1), kLoopInfo);
+  f.recover();
+  f.relinearise();
+  f.recover(0);
+  const auto pairs = conservativeThenExact(f, {{5, 5}, {5, 45}, {20, 59}});
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const auto& [c, e] = pairs[k];
+    EXPECT_LT((c - e).cwiseAbs().maxCoeff() / e.cwiseAbs().maxCoeff(), 1e-9) << k;
+  }
+  EXPECT_GT((before - pairs[0].second.topLeftCorner<3, 3>()).norm(), 1e-3 * before.norm()) << "the closure should change pose 5's marginal";
+}
+
 TEST(Recovery, ConservativeCovarianceAfterAClosureIsReachedThroughIt) {
   // Driving back along an earlier visit: after a closure from the factored map into the
   // dead-reckoned chain, a pose near the closure's earlier end is known relative to the newest

@@ -297,6 +297,10 @@ bool Esdf::factorCurrent() const {
 
 void Esdf::ensureFactor() {
   if (factorCurrent()) return;
+  // Lambda only gained information since the last factorisation (factors added, none changed):
+  // the marginals of that one's poses still bound the new ones from above (kept when dear to
+  // compute again; see factoredMarginal).
+  const bool keep = full_factor_.valid() && explained_stamp_ == values_stamp_ && marginals_work_ >= options_.keep_marginals_min_work;
   full_factor_.factorize(state_, 0, size());
   ++factorisations_;
   full_factor_values_ = values_stamp_;
@@ -315,7 +319,7 @@ void Esdf::ensureFactor() {
   chain_valid_ = true;
   base_columns_.resize(0, 0);
   root_columns_.clear();
-  factored_marginals_.clear();
+  clearFactoredMarginals(keep);
   anchor_base_ = -1;  // the anchor is looked for again in the new chain
   anchor_paths_from_ = -1;
 }
@@ -509,11 +513,7 @@ Mat6 Esdf::conservativeJoint(int i, int j, Mat3* relative) {
   auto chainPhi = [&](int p) -> const Mat3& { return chain_phi_[static_cast<size_t>(p - m)]; };
   auto marginal = [&](int p) -> Mat3 {
     if (p >= m) return chainedCovariance(p, p);
-    // Every factored pose's at once, from the factor's sparse inverse, on the first one asked:
-    // while the vehicle drives along an earlier visit its keyframes are candidates one after
-    // another, and a column solve each would pass over the whole map each time.
-    if (factored_marginals_.empty()) factored_marginals_ = full_factor_.inverseDiagonalBlocks();
-    return factored_marginals_[static_cast<size_t>(p)];
+    return factoredMarginal(p);
   };
   auto cross = [&](int a, int b) -> Mat3 {  // Sigma(a, b) for a < b
     if (b < m) return SparseCholesky::covarianceBetween(full_factor_.pathSolve(a), full_factor_.pathSolve(b));
@@ -553,6 +553,42 @@ Mat6 Esdf::conservativeJoint(int i, int j, Mat3* relative) {
                                    joint(path->phi * sa * path->phi.transpose() + path->cov, sbb, path->phi * sa * to_b.transpose()));
   if (spread(t) < spread(*relative)) *relative = t;
   return s;
+}
+
+Mat3 Esdf::factoredMarginal(int p) {
+  // While the vehicle drives along an earlier visit its keyframes are candidates one after
+  // another: every factored pose's marginal at once, from the factor's sparse inverse, for about
+  // the cost of one more factorisation. A factorisation that only added information since the
+  // one the sparse inverse came from (the innovation gate's, between the full recoveries) keeps
+  // it when a new one would be dear (EsdfOptions::keep_marginals_min_work): Lambda grew by
+  // positive terms, so its marginals bound the new ones from above, as the conservative
+  // covariance asks, if more loosely. On a map of 10^6 keyframes, where the fill of every pass
+  // of a street makes a sparse inverse cost minutes, most factorisations are the gate's. The poses it does not
+  // cover (factored since, near the vehicle) come from path solves, each costing its path in the
+  // factor, until their work reaches a new sparse inverse's: never more than twice the cheaper.
+  if (static_cast<size_t>(p) < factored_marginals_.size()) return factored_marginals_[static_cast<size_t>(p)];
+  if (const auto it = path_marginals_.find(p); it != path_marginals_.end()) return it->second;
+  if (inverse_work_ < 0) inverse_work_ = full_factor_.inverseWork();
+  if (factored_marginals_.empty() || path_marginal_work_ >= inverse_work_) {
+    factored_marginals_ = full_factor_.inverseDiagonalBlocks();
+    marginals_work_ = inverse_work_;
+    path_marginals_.clear();
+    return factored_marginals_[static_cast<size_t>(p)];
+  }
+  const PathSolution y = full_factor_.pathSolve(p);
+  path_marginal_work_ += y.work;
+  const Mat3 s = SparseCholesky::covarianceBetween(y, y);
+  return path_marginals_[p] = 0.5 * (s + s.transpose());
+}
+
+void Esdf::clearFactoredMarginals(bool keep_inverse) {
+  if (!keep_inverse) {
+    factored_marginals_.clear();
+    marginals_work_ = 0;
+  }
+  path_marginals_.clear();
+  path_marginal_work_ = 0;
+  inverse_work_ = -1;
 }
 
 const Esdf::ChainAnchor& Esdf::chainAnchor() {

@@ -55,6 +55,7 @@ PathSolution pathSolve(const SupernodalFactorView& l, const FactorIndex& index, 
     const int nc = columns(s), nr = l.row_begin[s + 1] - l.row_begin[s];
     const ConstBlock ls(l.values + l.value_begin[s], nr, nc, Eigen::OuterStride<>(nr));
     Rows3 x(&out.values[3 * at(out.begin[k])], nc, 3);
+    out.work += 3.0 * static_cast<double>(nc) * (0.5 * nc + (nr - nc));
     // (A unit-diagonal LDL' factor holds D where L's diagonal would be: its columns divide by 1.)
     if (!l.unit_diagonal_ldl) ls.topRows(nc).triangularView<Eigen::Lower>().solveInPlace(x);
     if (nr == nc) continue;

@@ -332,6 +332,11 @@ const FactorIndex& SparseCholesky::index(const SupernodalFactorView& v) const {
   return *impl_->index;
 }
 
+double SparseCholesky::inverseWork() const {
+  if (!impl_->factor) throw std::logic_error("inverseWork without a factor");
+  return esdf::inverseWork(view());
+}
+
 PathSolution SparseCholesky::pathSolve(int pose) const {
   if (!impl_->factor) throw std::logic_error("pathSolve without a factor");
   const SupernodalFactorView v = view();

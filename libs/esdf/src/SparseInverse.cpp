@@ -44,6 +44,15 @@ FactorIndex::FactorIndex(const SupernodalFactorView& l)
   for (int k = 0; k < l.columns; ++k) row_of[static_cast<size_t>(l.perm ? l.perm[k] : k)] = k;
 }
 
+double inverseWork(const SupernodalFactorView& l) {
+  double work = 0;
+  for (int s = 0; s < l.supernodes; ++s) {
+    const double nc = l.first_column[s + 1] - l.first_column[s], nb = l.row_begin[s + 1] - l.row_begin[s] - nc;
+    work += nb * nb * nc + 2 * nb * nc * nc + nc * nc * nc / 3;
+  }
+  return work;
+}
+
 std::vector<Mat3> inverseDiagonalBlocks(const SupernodalFactorView& l, const FactorIndex& index) {
   const int n = l.columns;
   if (n % 3 != 0) throw std::invalid_argument("inverseDiagonalBlocks: the size is not three per pose");

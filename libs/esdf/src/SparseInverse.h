@@ -41,5 +41,8 @@ struct FactorIndex {
 
 // The 3x3 diagonal blocks of A^-1 for A of size 3 * poses (rows 3p .. 3p + 2 are pose p).
 std::vector<Mat3> inverseDiagonalBlocks(const SupernodalFactorView& l, const FactorIndex& index);
+// Its multiply-adds: per supernode of nc columns over nb rows below them, Z_RS = -Z_RR W (nb² nc),
+// W = L_RS L_SS^-1 and W' Z_RS (nb nc² each), L_SS^-1 (nc³ / 3).
+double inverseWork(const SupernodalFactorView& l);
 
 }  // namespace urbanslam::esdf

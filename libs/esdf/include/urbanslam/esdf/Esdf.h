@@ -71,6 +71,12 @@ struct EsdfOptions {
 
   FillReducingOrdering ordering = FillReducingOrdering::Amd;
 
+  // A factorisation that only added information to the one the factored poses' marginals came
+  // from keeps them (upper bounds, CovarianceMode::Conservative) when computing them again would
+  // take at least this many multiply-adds (a sparse inverse: 10^10 is seconds, 10^6 keyframes of
+  // a city take 2.5·10^11); below, they are computed again, tighter.
+  double keep_marginals_min_work = 1e10;
+
   // A relative-pose factor keeps the heading branch it was linearised on when added (the one
   // nearest the estimate then): its heading error is never re-wrapped. Re-wrapping at each
   // relinearisation lets a stale estimate flip an earlier closure onto the other branch, and
@@ -355,7 +361,20 @@ class Esdf {
   static constexpr size_t kMaxLineages = 8;  // beyond, refactorising is cheaper than their column solves
   // Sigma(:, r) of the last full factorisation for a lineage's root r.
   const Eigen::MatrixXd& rootColumns(int r);
-  std::vector<Mat3> factored_marginals_;  // Sigma(p, p) of the factored poses (empty: not yet computed)
+  // Sigma(p, p) of the factored poses from a sparse inverse, of this factorisation or of an
+  // earlier one with less information (factoredMarginal); empty: not yet computed.
+  std::vector<Mat3> factored_marginals_;
+  // Poses beyond those: each from its path solve, while their work stays below a new sparse
+  // inverse's.
+  std::unordered_map<int, Mat3> path_marginals_;
+  double path_marginal_work_ = 0;
+  double inverse_work_ = -1;   // the sparse inverse's of the current factor (-1: not counted yet)
+  double marginals_work_ = 0;  // what the sparse inverse of factored_marginals_ took
+  // Sigma(p, p) of factored pose p from the last factorisation.
+  Mat3 factoredMarginal(int p);
+  // After a factorisation (`keep_inverse`: it only added information to the one the sparse
+  // inverse came from) or a load.
+  void clearFactoredMarginals(bool keep_inverse = false);
   ChainAnchor anchor_;
   size_t anchor_factors_ = 0;                        // factors_.size() when anchor_ was looked for ...
   int anchor_base_ = -1;                             // ... and chain_base_ then

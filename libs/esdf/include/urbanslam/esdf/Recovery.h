@@ -40,6 +40,7 @@ struct PathSolution {
   std::vector<int> supernodes;  // ascending
   std::vector<int> begin;       // each supernode's first row in values (one more at the end)
   std::vector<double> values;   // three per row: the pose's three columns
+  double work = 0;              // multiply-adds the solve took (its supernodes' entries, three columns)
 };
 
 class SparseCholesky {
@@ -65,6 +66,9 @@ class SparseCholesky {
   // The 3x3 diagonal blocks of Lambda_sub^-1, one per pose of the range: the marginal
   // covariances, all at once for about the cost of one more factorisation (SparseInverse.h).
   std::vector<Mat3> inverseDiagonalBlocks() const;
+  // The multiply-adds inverseDiagonalBlocks takes on this factor (its supernodes' products), to
+  // weigh it against path solves (PathSolution::work) of the poses actually asked for.
+  double inverseWork() const;
   bool supernodal() const;
   // Covariance blocks among a few poses of the range (indices from first()) at the cost of their
   // paths in the factor, not of column solves over all of it (PathSolve.h): pathSolve once per
