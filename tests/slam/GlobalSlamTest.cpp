@@ -444,3 +444,52 @@ TEST(GlobalSlam, TheLastRecoveryReachesTheOptimumWhateverTheStepsBefore) {
     EXPECT_LT(worst_rad, 1e-7);
   }
 }
+
+// A full recovery after a closure waits until the keyframes since the previous one have paid for
+// its work at [estimator] full_recovery_work_per_keyframe each (the whole map's factorisation and
+// sparse inverse, counted on the factor the previous one left): on a map whose factor fills
+// faster than it grows, its cost per keyframe stays bounded. A straight drive closed every ten
+// keyframes on the keyframe twenty back (the true relative pose); with no growth rule each
+// closure would bring one.
+TEST(GlobalSlam, AFullRecoveryWaitsUntilTheKeyframesSinceThePreviousHavePaidForIt) {
+  struct Recoveries : slam::PipelineObserver {
+    slam::Map* map = nullptr;
+    std::vector<std::pair<size_t, double>> at;  // keyframes and the recovery's factor's work
+    void onPosesUpdated(const slam::PosesUpdatedEvent& e) override {
+      if (e.keyframe != static_cast<size_t>(-1)) at.emplace_back(map->size(), map->filter()->recoveryWork());
+    }
+  };
+  const auto run = [](double work_per_keyframe) {
+    auto r = std::make_unique<::Run>();
+    Recoveries rec;
+    rec.map = &r->map;
+    r->observers.push_back(&rec);
+    r->options.estimator.full_recovery_min_growth = 0;
+    r->options.estimator.full_recovery_work_per_keyframe = work_per_keyframe;
+    r->global = std::make_unique<slam::GlobalSlam>(r->options, r->map, r->stats, r->observers);
+    slam::KeyframeConstraint c;
+    c.z = {1.0, 0, 0};
+    c.cov = Eigen::Vector3d(0.01, 0.01, 1e-6).asDiagonal();
+    const Eigen::Matrix3d closure_info = Eigen::Vector3d(1e4, 1e4, 1e6).asDiagonal();
+    for (size_t k = 0; k < 400; ++k) {
+      r->global->addKeyframe({k, static_cast<double>(k), {}, false, false, {}}, io::CompactScan(), c);
+      if (k >= 30 && k % 10 == 0) r->global->addPlaceFix(k - 20, k, common::Pose2{20, 0, 0}, closure_info, 1.0, slam::Proposer::Place);
+    }
+    EXPECT_EQ(r->stats.closures_accepted, 37u);
+    return rec.at;
+  };
+  const auto every = run(0);
+  EXPECT_EQ(every.size(), 37u);  // after every closure
+  ASSERT_GE(every.size(), 2u);
+  // A budget at which the map's work needs about 40 keyframes by the end of the drive.
+  const double budget = every.back().second / 40;
+  const auto paid = run(budget);
+  ASSERT_GE(paid.size(), 3u);
+  EXPECT_LT(paid.size(), every.size());
+  for (size_t i = 1; i < paid.size(); ++i) {
+    const double since = static_cast<double>(paid[i].first - paid[i - 1].first);
+    EXPECT_GE(since * budget, paid[i - 1].second) << "recovery " << i << " at " << paid[i].first;
+    EXPECT_LT(since * budget, paid[i - 1].second + 10 * budget)
+        << "recovery " << i << " came later than the next closure after it was paid";
+  }
+}

@@ -581,6 +581,13 @@ Mat3 Esdf::factoredMarginal(int p) {
   return path_marginals_[p] = 0.5 * (s + s.transpose());
 }
 
+double Esdf::recoveryWork() {
+  if (!full_factor_.valid()) return 0;
+  if (recovery_work_.first != factorisations_)
+    recovery_work_ = {factorisations_, full_factor_.factorisationWork() + full_factor_.inverseWork()};
+  return recovery_work_.second;
+}
+
 void Esdf::clearFactoredMarginals(bool keep_inverse) {
   if (!keep_inverse) {
     factored_marginals_.clear();

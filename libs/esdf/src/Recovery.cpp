@@ -337,6 +337,11 @@ double SparseCholesky::inverseWork() const {
   return esdf::inverseWork(view());
 }
 
+double SparseCholesky::factorisationWork() const {
+  if (!impl_->factor) throw std::logic_error("factorisationWork without a factor");
+  return esdf::factorisationWork(view());
+}
+
 PathSolution SparseCholesky::pathSolve(int pose) const {
   if (!impl_->factor) throw std::logic_error("pathSolve without a factor");
   const SupernodalFactorView v = view();

@@ -53,6 +53,15 @@ double inverseWork(const SupernodalFactorView& l) {
   return work;
 }
 
+double factorisationWork(const SupernodalFactorView& l) {
+  double work = 0;
+  for (int s = 0; s < l.supernodes; ++s) {
+    const double nc = l.first_column[s + 1] - l.first_column[s], nb = l.row_begin[s + 1] - l.row_begin[s] - nc;
+    work += nc * nc * nc / 3 + nb * nc * nc + nb * nb * nc / 2;
+  }
+  return work;
+}
+
 std::vector<Mat3> inverseDiagonalBlocks(const SupernodalFactorView& l, const FactorIndex& index) {
   const int n = l.columns;
   if (n % 3 != 0) throw std::invalid_argument("inverseDiagonalBlocks: the size is not three per pose");

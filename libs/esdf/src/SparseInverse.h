@@ -44,5 +44,8 @@ std::vector<Mat3> inverseDiagonalBlocks(const SupernodalFactorView& l, const Fac
 // Its multiply-adds: per supernode of nc columns over nb rows below them, Z_RS = -Z_RR W (nb² nc),
 // W = L_RS L_SS^-1 and W' Z_RS (nb nc² each), L_SS^-1 (nc³ / 3).
 double inverseWork(const SupernodalFactorView& l);
+// A numeric factorisation's: per supernode nc³ / 3 (its diagonal block), nb nc² (the rows below)
+// and nb² nc / 2 (the update of the ancestors it reaches).
+double factorisationWork(const SupernodalFactorView& l);
 
 }  // namespace urbanslam::esdf

@@ -105,10 +105,14 @@ void GlobalSlam::closureAdded(size_t current, SteadyTime handed_over) {
   // A full recovery costs O(n) and more (a factorisation of the whole map): after a closure
   // only once the map has grown by a fraction of what it was at the last one, which spreads its
   // cost over that many keyframes, so that the cost per keyframe grows only as a factorisation's
-  // cost per pose does. Between them the closure's information is in the filter, and the recent
-  // poses (where the next candidates and closures are) are recovered.
-  const double growth = options_.estimator.full_recovery_min_growth;
-  if (static_cast<double>(map_.size() - last_full_size_) >= growth * static_cast<double>(last_full_size_)) {
+  // cost per pose does; and only once those keyframes have paid for its work at
+  // full_recovery_work_per_keyframe each, which bounds that cost where the factor fills faster
+  // than the map grows (every pass of a city's streets linked to the earlier ones). Between
+  // them the closure's information is in the filter, and the recent poses (where the next
+  // candidates and closures are) are recovered.
+  const double growth = options_.estimator.full_recovery_min_growth, work = options_.estimator.full_recovery_work_per_keyframe;
+  const double since = static_cast<double>(map_.size() - last_full_size_);
+  if (since >= growth * static_cast<double>(last_full_size_) && (work <= 0 || since * work >= map_.filter()->recoveryWork())) {
     recoverAll(false);
     added_.clear();
     return;

@@ -162,6 +162,9 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("global_thread", o.estimator.global_thread, "global SLAM on a thread of its own: local SLAM never waits (same results)");
   s.add("full_recovery_min_growth", o.estimator.full_recovery_min_growth, 0.0, 10.0, "",
         "full recovery after a closure once the map grew by this fraction since the last (0: every closure)");
+  s.add("full_recovery_work_per_keyframe", o.estimator.full_recovery_work_per_keyframe, 0.0, 1e12, "multiply-adds",
+        "... and once the keyframes since the last, at this much each, have paid for its work (a factorisation of the whole map and its "
+        "sparse inverse): a full recovery's cost per keyframe bounded (0: the growth alone)");
   s.add("full_recovery_steps", o.estimator.full_recovery_steps, 1, 100, "",
         "Gauss-Newton steps of a full recovery after a closure, each a factorisation of the whole map; what they move is relinearised "
         "when the next recovery starts (the run's last goes on until nothing moves past 1 mm and 1e-4 rad)");

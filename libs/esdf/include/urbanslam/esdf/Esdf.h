@@ -192,6 +192,10 @@ class Esdf {
   const InformationState& state() const { return state_; }
   size_t factorCount() const { return factors_.size(); }
   long long factorNonZeros() const { return full_factor_.factorNonZeros(); }
+  // What a full recovery will cost, in multiply-adds, estimated from the last factor: a
+  // factorisation and the sparse inverse the candidates' covariances then take (0 without one;
+  // counted once per factorisation).
+  double recoveryWork();
   size_t memoryBytes() const;
   // Factorisations of the whole map by this object (recoveries, exact covariances): what grows
   // with the map. A count of this process's work, not saved with the filter's state.
@@ -370,6 +374,7 @@ class Esdf {
   double path_marginal_work_ = 0;
   double inverse_work_ = -1;   // the sparse inverse's of the current factor (-1: not counted yet)
   double marginals_work_ = 0;  // what the sparse inverse of factored_marginals_ took
+  std::pair<long long, double> recovery_work_{-1, 0};  // recoveryWork() at factorisations_
   // Sigma(p, p) of factored pose p from the last factorisation.
   Mat3 factoredMarginal(int p);
   // After a factorisation (`keep_inverse`: it only added information to the one the sparse

@@ -69,6 +69,9 @@ class SparseCholesky {
   // The multiply-adds inverseDiagonalBlocks takes on this factor (its supernodes' products), to
   // weigh it against path solves (PathSolution::work) of the poses actually asked for.
   double inverseWork() const;
+  // The multiply-adds of a numeric factorisation of this factor's pattern (per supernode: its
+  // diagonal block's Cholesky, the solve below it, the update of its ancestors).
+  double factorisationWork() const;
   bool supernodal() const;
   // Covariance blocks among a few poses of the range (indices from first()) at the cost of their
   // paths in the factor, not of column solves over all of it (PathSolve.h): pathSolve once per

@@ -165,6 +165,11 @@ struct EstimatorOptions {
   // A full recovery after a loop closure only once the map has grown by this fraction since the
   // last one (0: after every closure): its cost spread over that many keyframes.
   double full_recovery_min_growth = 0.01;
+  // ... and once the keyframes since the last one, at this many multiply-adds each, have paid for
+  // its work (a factorisation of the whole map and its sparse inverse, Esdf::recoveryWork): a
+  // map whose factor fills with every pass of a street (10^6 keyframes of a city) recovers less
+  // often, and a full recovery's cost per keyframe stays bounded (0: the growth alone).
+  double full_recovery_work_per_keyframe = 5e6;
   // Gauss-Newton steps of such a recovery, each a factorisation of the whole map. The factors a
   // step moves are relinearised at the start of the next recovery, not at the end of this one:
   // the factor the last step leaves is then the current information's, which the innovation
