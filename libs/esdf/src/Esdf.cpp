@@ -319,7 +319,7 @@ void Esdf::ensureFactor() {
   chain_valid_ = true;
   base_columns_.resize(0, 0);
   root_columns_.clear();
-  clearFactoredMarginals(keep);
+  newFactor(keep);
   anchor_base_ = -1;  // the anchor is looked for again in the new chain
   anchor_paths_from_ = -1;
 }
@@ -563,15 +563,15 @@ Mat3 Esdf::factoredMarginal(int p) {
   // it when a new one would be dear (EsdfOptions::keep_marginals_min_work): Lambda grew by
   // positive terms, so its marginals bound the new ones from above, as the conservative
   // covariance asks, if more loosely. On a map of 10^6 keyframes, where the fill of every pass
-  // of a street makes a sparse inverse cost minutes, most factorisations are the gate's. The poses it does not
-  // cover (factored since, near the vehicle) come from path solves, each costing its path in the
-  // factor, until their work reaches a new sparse inverse's: never more than twice the cheaper.
+  // of a street makes a sparse inverse cost minutes, most factorisations are the gate's. The
+  // poses it does not cover (factored since, near the vehicle) come from path solves, each
+  // costing its path in the factor, until their work reaches a new sparse inverse's: never more
+  // than twice the cheaper.
   if (static_cast<size_t>(p) < factored_marginals_.size()) return factored_marginals_[static_cast<size_t>(p)];
   if (const auto it = path_marginals_.find(p); it != path_marginals_.end()) return it->second;
-  if (inverse_work_ < 0) inverse_work_ = full_factor_.inverseWork();
-  if (factored_marginals_.empty() || path_marginal_work_ >= inverse_work_) {
+  if (factored_marginals_.empty() || path_marginal_work_ >= inverseWork()) {
     factored_marginals_ = full_factor_.inverseDiagonalBlocks();
-    marginals_work_ = inverse_work_;
+    marginals_work_ = inverseWork();
     path_marginals_.clear();
     return factored_marginals_[static_cast<size_t>(p)];
   }
@@ -581,21 +581,25 @@ Mat3 Esdf::factoredMarginal(int p) {
   return path_marginals_[p] = 0.5 * (s + s.transpose());
 }
 
-double Esdf::recoveryWork() {
-  if (!full_factor_.valid()) return 0;
-  if (recovery_work_.first != factorisations_)
-    recovery_work_ = {factorisations_, full_factor_.factorisationWork() + full_factor_.inverseWork()};
-  return recovery_work_.second;
+double Esdf::inverseWork() {
+  if (inverse_work_ < 0) inverse_work_ = full_factor_.inverseWork();
+  return inverse_work_;
 }
 
-void Esdf::clearFactoredMarginals(bool keep_inverse) {
-  if (!keep_inverse) {
+double Esdf::recoveryWork() {
+  if (!full_factor_.valid()) return 0;
+  if (factorisation_work_ < 0) factorisation_work_ = full_factor_.factorisationWork();
+  return factorisation_work_ + inverseWork();
+}
+
+void Esdf::newFactor(bool keep_marginals) {
+  if (!keep_marginals) {
     factored_marginals_.clear();
     marginals_work_ = 0;
   }
   path_marginals_.clear();
   path_marginal_work_ = 0;
-  inverse_work_ = -1;
+  inverse_work_ = factorisation_work_ = -1;
 }
 
 const Esdf::ChainAnchor& Esdf::chainAnchor() {

@@ -193,7 +193,7 @@ void Esdf::readState(common::BinaryReader& r, bool with_updates, bool with_linea
   }
   chain_valid_ = r.boolean();
   base_columns_ = r.dense();
-  clearFactoredMarginals();
+  newFactor();
   anchor_base_ = -1;
   anchor_paths_from_ = -1;
   factors_of_pose_.clear();

@@ -372,14 +372,16 @@ class Esdf {
   // inverse's.
   std::unordered_map<int, Mat3> path_marginals_;
   double path_marginal_work_ = 0;
-  double inverse_work_ = -1;   // the sparse inverse's of the current factor (-1: not counted yet)
   double marginals_work_ = 0;  // what the sparse inverse of factored_marginals_ took
-  std::pair<long long, double> recovery_work_{-1, 0};  // recoveryWork() at factorisations_
+  // The current factor's sparse inverse and numeric factorisation in multiply-adds, counted when
+  // first needed (-1: not yet).
+  double inverse_work_ = -1, factorisation_work_ = -1;
+  double inverseWork();
   // Sigma(p, p) of factored pose p from the last factorisation.
   Mat3 factoredMarginal(int p);
-  // After a factorisation (`keep_inverse`: it only added information to the one the sparse
-  // inverse came from) or a load.
-  void clearFactoredMarginals(bool keep_inverse = false);
+  // A new factor (a factorisation or a load): what was computed from the last one dropped, but
+  // with `keep_marginals` (only information added since) factored_marginals_.
+  void newFactor(bool keep_marginals = false);
   ChainAnchor anchor_;
   size_t anchor_factors_ = 0;                        // factors_.size() when anchor_ was looked for ...
   int anchor_base_ = -1;                             // ... and chain_base_ then
