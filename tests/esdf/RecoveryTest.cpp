@@ -169,6 +169,45 @@ TEST(Recovery, PathSolvesGiveTheDenseInverseBetweenAnyTwoPoses) {
   EXPECT_THROW(chol.pathSolve(20), std::out_of_range);
 }
 
+// AMD's factor against METIS's: a factorisation that AMD's ordering makes dear is ordered by
+// nested dissection when that takes fewer operations (our own count of the numeric
+// factorisation, not CHOLMOD's estimate the choice uses), and the factor solves the same system.
+// A city's streets (a planar graph) favour nested dissection; a chain with a few closures, AMD.
+TEST(Recovery, ADearFactorisationIsOrderedByNestedDissectionWhereThatIsCheaper) {
+  for (const bool city : {true, false}) {
+    LinearGraph g(36, city ? 1 : 3000, city ? 0 : 6);
+    if (city) streets(g.f, 6000);
+    const InformationState& s = g.f.state();
+    SparseCholesky amd(FillReducingOrdering::Amd), metis(FillReducingOrdering::Metis);
+    amd.factorize(s, 0, g.f.size());
+    metis.factorize(s, 0, g.f.size());
+    ASSERT_FALSE(amd.nestedDissection());
+    ASSERT_TRUE(metis.nestedDissection());
+    const double wa = amd.factorisationWork(), wm = metis.factorisationWork();
+    ASSERT_EQ(wm < wa, city) << "AMD " << wa << ", METIS " << wm << " multiply-adds";
+
+    SparseCholesky chosen(FillReducingOrdering::Amd, 1.0), never(FillReducingOrdering::Amd, 1e30);
+    chosen.factorize(s, 0, g.f.size());
+    never.factorize(s, 0, g.f.size());
+    EXPECT_EQ(chosen.nestedDissection(), city);
+    EXPECT_EQ(chosen.factorisationWork(), std::min(wa, wm));
+    EXPECT_EQ(chosen.factorNonZeros(), city ? metis.factorNonZeros() : amd.factorNonZeros());
+    EXPECT_FALSE(never.nestedDissection());
+    EXPECT_EQ(never.factorisationWork(), wa);
+
+    std::mt19937 rng(10);
+    Eigen::MatrixXd b(3 * g.f.size(), 2);
+    for (int i = 0; i < b.size(); ++i) b(i) = test::gauss(rng, 1.0);
+    const Eigen::MatrixXd x = chosen.solve(b), x_amd = amd.solve(b);
+    EXPECT_LT((x - x_amd).cwiseAbs().maxCoeff() / x_amd.cwiseAbs().maxCoeff(), 1e-9);
+    // A saved matrix factorised again chooses the same ordering: the same factor, bit for bit.
+    SparseCholesky again(FillReducingOrdering::Amd, 1.0);
+    again.factorize(chosen.matrix());
+    EXPECT_EQ(again.nestedDissection(), city);
+    EXPECT_EQ((again.solve(b) - x).cwiseAbs().maxCoeff(), 0.0);
+  }
+}
+
 TEST(Recovery, EnvelopeCholeskySolvesEveryWindowLikeDenseLlt) {
   // Windows with links leaving them (ignored), short in-window loops and, for first = 0, a link
   // from the newest to the oldest pose (the dense worst case of the envelope).

@@ -12,7 +12,7 @@ namespace urbanslam::esdf {
 
 Esdf::Esdf(EsdfOptions options)
     : options_(options),
-      full_factor_(options.ordering),
+      full_factor_(options.ordering, options.nested_dissection_min_flops),
       joint_gate_threshold_(chi2Quantile(options.chi2_gate_probability, 6)),
       single_gate_threshold_(chi2Quantile(options.chi2_gate_probability, 3)) {}
 Esdf::~Esdf() = default;

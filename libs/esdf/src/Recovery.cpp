@@ -78,6 +78,8 @@ struct SparseCholesky::Impl {
   cholmod_common common;
   cholmod_factor* factor = nullptr;
   FillReducingOrdering ordering;
+  double nested_dissection_min_flops;
+  bool nested_dissection = false;  // the current factor's ordering
   // Pattern of the last analysed matrix: the symbolic factor is reused when it is unchanged.
   std::vector<int> last_p, last_i;
   // Its values at the last factorisation, read only to save the filter (matrix()): written to an
@@ -91,7 +93,7 @@ struct SparseCholesky::Impl {
   std::unique_ptr<FactorIndex> index;
   std::vector<int> path_workspace;  // pathSolve's, one entry per supernode
 
-  explicit Impl(FillReducingOrdering o) : ordering(o) {
+  Impl(FillReducingOrdering o, double nd_min_flops) : ordering(o), nested_dissection_min_flops(nd_min_flops) {
     cholmod_start(&common);
     switch (o) {
       case FillReducingOrdering::Amd:
@@ -116,9 +118,34 @@ struct SparseCholesky::Impl {
     if (factor) cholmod_free_factor(&factor, &common);
     cholmod_finish(&common);
   }
+
+  // The symbolic factor of `a` with the configured ordering; with AMD on a pattern whose
+  // factorisation it makes dear, METIS's ordering too, the one with fewer operations kept (both
+  // deterministic: a saved matrix factorised again chooses the same).
+  cholmod_factor* analyze(cholmod_sparse* a) {
+    cholmod_factor* f = cholmod_analyze(a, &common);
+    if (!f) throw std::runtime_error("CHOLMOD analyze failed (status " + std::to_string(common.status) + ")");
+    nested_dissection = f->ordering == CHOLMOD_METIS;
+    if (ordering != FillReducingOrdering::Amd || nested_dissection_min_flops <= 0 || common.fl < nested_dissection_min_flops) return f;
+    const double amd_flops = common.fl, amd_lnz = common.lnz;
+    common.method[0].ordering = CHOLMOD_METIS;
+    cholmod_factor* nd = cholmod_analyze(a, &common);
+    common.method[0].ordering = CHOLMOD_AMD;
+    if (nd && common.status == CHOLMOD_OK && nd->ordering == CHOLMOD_METIS && common.fl < amd_flops) {
+      cholmod_free_factor(&f, &common);
+      nested_dissection = true;
+      return nd;
+    }
+    if (nd) cholmod_free_factor(&nd, &common);
+    common.status = CHOLMOD_OK;
+    common.fl = amd_flops;
+    common.lnz = amd_lnz;
+    return f;
+  }
 };
 
-SparseCholesky::SparseCholesky(FillReducingOrdering ordering) : impl_(std::make_unique<Impl>(ordering)) {}
+SparseCholesky::SparseCholesky(FillReducingOrdering ordering, double nested_dissection_min_flops)
+    : impl_(std::make_unique<Impl>(ordering, nested_dissection_min_flops)) {}
 SparseCholesky::~SparseCholesky() = default;
 
 bool SparseCholesky::valid() const { return impl_->factor != nullptr; }
@@ -198,8 +225,7 @@ void SparseCholesky::factorizeLower(std::vector<int> colptr, std::vector<int> ro
     std::vector<int>().swap(rowind);
   } else {
     if (impl_->factor) cholmod_free_factor(&impl_->factor, cm);
-    impl_->factor = cholmod_analyze(&a, cm);
-    if (!impl_->factor) throw std::runtime_error("CHOLMOD analyze failed (status " + std::to_string(cm->status) + ")");
+    impl_->factor = impl_->analyze(&a);
     impl_->last_p = std::move(colptr);
     impl_->last_i = std::move(rowind);
   }
@@ -279,6 +305,8 @@ Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& b) const {
 }
 
 bool SparseCholesky::supernodal() const { return impl_->factor && impl_->factor->is_super; }
+
+bool SparseCholesky::nestedDissection() const { return impl_->factor && impl_->nested_dissection; }
 
 SupernodalFactorView SparseCholesky::view() const {
   if (!impl_->factor) throw std::logic_error("no factor to read");

@@ -2,7 +2,7 @@
 // State and covariance recovery for the information filter: a CHOLMOD (SuiteSparse) sparse
 // Cholesky factorisation of Lambda, or of the principal sub-block of a range of poses, with a
 // fill-reducing ordering (AMD by default; METIS nested dissection pays off on very large
-// grid-like graphs). The symbolic analysis is reused while the block structure is unchanged,
+// grid-like graphs, such as a city's streets driven many times). The symbolic analysis is reused while the block structure is unchanged,
 // which is the case between relinearisation passes.
 #include <Eigen/Core>
 #include <cstdint>
@@ -45,7 +45,12 @@ struct PathSolution {
 
 class SparseCholesky {
  public:
-  explicit SparseCholesky(FillReducingOrdering ordering = FillReducingOrdering::Amd);
+  // With AMD, `nested_dissection_min_flops` > 0: a pattern whose AMD factorisation would take at
+  // least that many floating-point operations (CHOLMOD's count from the analysis) is ordered by
+  // METIS too, and the ordering with fewer operations is used. On a city driven many times the
+  // factor of the whole map is where memory peaks, and nested dissection's is the smaller; on
+  // small and chain-like graphs AMD's is as good and METIS's analysis is the dearer.
+  explicit SparseCholesky(FillReducingOrdering ordering = FillReducingOrdering::Amd, double nested_dissection_min_flops = 0);
   ~SparseCholesky();
   SparseCholesky(const SparseCholesky&) = delete;
   SparseCholesky& operator=(const SparseCholesky&) = delete;
@@ -73,6 +78,8 @@ class SparseCholesky {
   // diagonal block's Cholesky, the solve below it, the update of its ancestors).
   double factorisationWork() const;
   bool supernodal() const;
+  // The factor's ordering is METIS's nested dissection (chosen over AMD, or asked for).
+  bool nestedDissection() const;
   // Covariance blocks among a few poses of the range (indices from first()) at the cost of their
   // paths in the factor, not of column solves over all of it (PathSolve.h): pathSolve once per
   // pose, then covarianceBetween(a, b) = Sigma(a, b) for any two of them.
