@@ -5,8 +5,11 @@ GENERATOR = $(shell command -v ninja >/dev/null 2>&1 && echo "-G Ninja")
 CMAKE_ARGS ?=
 
 # Every Debian 12 package the project needs (build, tests, GUI, benchmarks and their peers).
+# libopenblas0-serial becomes the system's BLAS (Debian's alternatives rank it above ATLAS):
+# CHOLMOD's supernodal factorisations of a large map run in half to two thirds of the time, on
+# one thread.
 DEB_PACKAGES = cmake g++ make ninja-build ccache pkg-config \
-  libmrpt-dev mrpt-common mrpt-apps libopencv-dev libeigen3-dev libsuitesparse-dev \
+  libmrpt-dev mrpt-common mrpt-apps libopencv-dev libeigen3-dev libsuitesparse-dev libopenblas0-serial \
   libwxgtk3.2-dev libgtest-dev libbenchmark-dev zlib1g-dev libzip-dev libceres-dev \
   xvfb xauth opencv-doc plasma-workspace-wallpapers
 
