@@ -1,9 +1,10 @@
 #pragma once
 // State and covariance recovery for the information filter: a CHOLMOD (SuiteSparse) sparse
 // Cholesky factorisation of Lambda, or of the principal sub-block of a range of poses, with a
-// fill-reducing ordering (AMD by default; METIS nested dissection pays off on very large
-// grid-like graphs, such as a city's streets driven many times). The symbolic analysis is reused while the block structure is unchanged,
-// which is the case between relinearisation passes.
+// fill-reducing ordering (AMD by default; METIS's nested dissection as well where AMD's factor
+// would be dear: it pays off on very large grid-like graphs, such as a city's streets driven many
+// times). The symbolic analysis is reused while the block structure is unchanged, which is the
+// case between relinearisation passes.
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
