@@ -71,9 +71,18 @@ const char* confirmationName(Confirmation c) {
   return "";
 }
 
+namespace {
+
+MovingReturnsOptions movingReturnsOptions(const LoopClosureOptions& options) {
+  MovingReturnsOptions o;
+  o.neighbours = options.moving_returns_neighbours;
+  return o;
+}
+
+}  // namespace
+
 LoopCloser::LoopCloser(const LoopClosureOptions& options)
-    : options_(options),
-      chi2_2dof_(esdf::chi2Quantile(options.mahalanobis_probability, 2)) {}
+    : options_(options), chi2_2dof_(esdf::chi2Quantile(options.mahalanobis_probability, 2)), moving_(movingReturnsOptions(options)) {}
 
 void LoopCloser::setScorer(CandidateScorer scorer) { scorer_ = std::move(scorer); }
 
@@ -298,6 +307,10 @@ bool LoopCloser::freeSpaceConflict(const io::LaserScan& earlier_scan, const io::
   return true;
 }
 
+io::LaserScan LoopCloser::staticScan(KeyframeNodes& filter, const Map& map, size_t k, size_t current) {
+  return moving_.scanWithout(map, k, current, [&](size_t j) { return esdf::toPose(filter.mean(j)); });
+}
+
 common::Pose2 carriedClosure(const Map& map, const LoopClosureRecord& c, size_t earlier, size_t current) {
   const auto& kf = map.keyframes();
   return common::compose(common::compose(common::between(kf[earlier].pose, kf[c.from].pose), c.measurement),
@@ -343,8 +356,15 @@ LoopClosureRecord LoopCloser::tryClose(KeyframeNodes& filter, const Map& map, si
   }
   // (Trying PL-ICP first on an uncertain guess was measured worse: it lands in wrong local
   // minima that pass the residual test — ATE 2.96 m vs 0.26 m on Intel.)
-  // The map keeps its scans compact (and maybe on disk): expanded once for this candidate.
-  const io::LaserScan earlier_scan = map.scan(earlier), current_scan = map.scan(current);
+  // The map keeps its scans compact (and maybe on disk): expanded once for this candidate, the
+  // returns of what moved hidden (the current keyframe's once for all its candidates).
+  const io::LaserScan earlier_scan = staticScan(filter, map, earlier, current);
+  if (current_scan_for_ != current || current_scan_map_ != &map) {
+    current_scan_ = staticScan(filter, map, current, current);
+    current_scan_for_ = current;
+    current_scan_map_ = &map;
+  }
+  const io::LaserScan& current_scan = current_scan_;
   const common::Pose2 guess = esdf::toPose(esdf::between(xi, xk));
   // Where the innovation gate admits a measurement: the relative pose's own uncertainty (the
   // alignment's, centimetres, is left out), at the filter's own quantile.

@@ -128,6 +128,9 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
   s.add("submap_check_path_m", o.loop_closure.submap_check_path_m, 0.0, 1000.0, "m",
         "a closure beyond appearance_min_sigma_m is measured by aligning the two visits' keyframes within this much path as two submaps, "
         "and refused when another alignment of them is nearly as good; 0: off");
+  s.add("moving_returns_neighbours", o.loop_closure.moving_returns_neighbours, 0, 100, "keyframes",
+        "the two scans are aligned without the returns that the keyframes up to this many places before and after each saw through "
+        "(traffic, people); 0: off");
   s.add("free_space_no_return_m", o.loop_closure.free_space_no_return_m, 0.0, 1000.0, "m",
         "free-space test: a beam without a return (or beyond max_range_m) saw free space this far; 0: says nothing");
   s.add("free_space_margin_m", o.loop_closure.free_space_margin_m, 0.0, 10.0, "m",

@@ -23,6 +23,7 @@
 #include "urbanslam/slam/CameraClosure.h"
 #include "urbanslam/slam/KeyframeGrid.h"
 #include "urbanslam/slam/KeyframeNodes.h"
+#include "urbanslam/slam/MovingReturns.h"
 #include "urbanslam/slam/PipelineOptions.h"
 #include "urbanslam/slam/Proposer.h"
 
@@ -191,6 +192,14 @@ class LoopCloser {
   size_t cached_for_ = static_cast<size_t>(-1);
   std::unordered_map<size_t, Eigen::Matrix3d> cached_;  // relative covariances for cached_for_
   std::optional<bool> narrow_view_;                     // the laser covers well under the full circle (read once)
+  size_t current_scan_for_ = static_cast<size_t>(-1);
+  const Map* current_scan_map_ = nullptr;
+  io::LaserScan current_scan_;  // the current keyframe's scan, its moving returns hidden (staticScan)
+
+  MovingReturns moving_;  // the judges' free space, kept between attempts
+  // Keyframe k's scan without the returns that moved (MovingReturns.h), judged by keyframes up
+  // to `current` placed by the estimate.
+  io::LaserScan staticScan(KeyframeNodes& filter, const Map& map, size_t k, size_t current);
 
   // Two scans aligned by verifyAlignment's first step, kept for its ambiguity restarts (which
   // tryClose runs only when the gate does not refuse the closure anyway).

@@ -124,6 +124,10 @@ struct LoopClosureOptions {
   // visits' path submaps (their keyframes within this much path, PathSubmaps.h) nearly as good as
   // the one from the closure, which becomes its measurement (0: off).
   double submap_check_path_m = 30;
+  // The two scans are aligned and tested without the returns of things that moved (traffic,
+  // people), judged by the keyframes up to this many places before and after each in the log
+  // (MovingReturns.h; the current keyframe's by those before it). 0: off.
+  int moving_returns_neighbours = 5;
   double free_space_margin_m = 0.3;   // a point conflicts this far (+5 % of the range) inside free space
   double free_space_no_return_m = 0;  // a beam without a return saw free space this far (0: unknown)
   // A closure measured by the camera alone (no scans) is refused when the scene its two images
