@@ -5,6 +5,7 @@
 #include <functional>
 #include <random>
 
+#include "CastScan.h"
 #include "urbanslam/io/MapOutputs.h"
 #include "urbanslam/slam/MovingPoints.h"
 
@@ -12,55 +13,16 @@ using namespace urbanslam;
 
 namespace {
 
-struct Segment {
-  double x1, y1, x2, y2;
-  bool moving;
-};
+using test::Segment;
 
 // A room 20 m x 16 m, and a 1 m box that stands in it for the first scans only (or always).
 std::vector<Segment> world(bool with_box) {
   std::vector<Segment> w = {{-10, -8, 10, -8, false}, {10, -8, 10, 8, false}, {10, 8, -10, 8, false}, {-10, 8, -10, -8, false}};
-  if (with_box) {
-    const double x0 = 3, x1 = 4, y0 = -0.5, y1 = 0.5;
-    for (const Segment& s :
-         std::vector<Segment>{{x0, y0, x1, y0, true}, {x1, y0, x1, y1, true}, {x1, y1, x0, y1, true}, {x0, y1, x0, y0, true}})
-      w.push_back(s);
-  }
+  if (with_box) test::addBox(w, 3, -0.5, 4, 0.5, true);
   return w;
 }
 
-// A front 180° scan at half a degree from a sensor 0.5 m ahead of the vehicle, cast against the
-// segments with 1 cm range noise; `hits_box` says per beam whether it ended on the box.
-io::LaserScan castScan(const common::Pose2& vehicle, const std::vector<Segment>& w, std::mt19937& rng, std::vector<bool>& hits_box) {
-  io::LaserScan s;
-  s.angle_min_rad = -M_PI / 2;
-  s.angle_increment_rad = M_PI / 360;
-  s.max_range_m = 40;
-  s.sensor_pose = {0.5, 0, 0};
-  const common::Pose2 sensor = common::compose(vehicle, s.sensor_pose);
-  std::normal_distribution<double> noise(0, 0.01);
-  hits_box.clear();
-  for (int i = 0; i <= 360; ++i) {
-    const double a = sensor.phi + s.bearing(static_cast<size_t>(i));
-    const double dx = std::cos(a), dy = std::sin(a);
-    double best = HUGE_VAL;
-    bool box = false;
-    for (const Segment& g : w) {
-      // sensor + t d = g1 + u (g2 - g1)
-      const double ex = g.x2 - g.x1, ey = g.y2 - g.y1;
-      const double den = dx * ey - dy * ex;
-      if (std::abs(den) < 1e-12) continue;
-      const double t = ((g.x1 - sensor.x) * ey - (g.y1 - sensor.y) * ex) / den;
-      const double u = ((g.x1 - sensor.x) * dy - (g.y1 - sensor.y) * dx) / den;
-      if (t > 0 && u >= 0 && u <= 1 && t < best) best = t, box = g.moving;
-    }
-    s.ranges.push_back(static_cast<float>(best + noise(rng)));
-    s.valid.push_back(1);
-    hits_box.push_back(box);
-  }
-  return s;
-}
-
+// The scans: from a sensor 0.5 m ahead of the vehicle, 40 m range (the room's walls are nearer).
 struct Drive {
   std::vector<io::LaserScan> scans;
   std::vector<common::Pose2> poses;
@@ -94,7 +56,7 @@ Drive drive(const std::function<bool(size_t)>& box_at, int laps = 1) {
   }
   std::vector<bool> hits;
   for (size_t i = 0; i < d.poses.size(); ++i) {
-    d.scans.push_back(castScan(d.poses[i], world(box_at(i)), rng, hits));
+    d.scans.push_back(test::castScan(d.poses[i], world(box_at(i)), 0.5, 40, rng, &hits));
     for (size_t b = 0; b < hits.size(); ++b)
       if (d.scans.back().valid[b]) d.box_point.push_back(hits[b]);
   }

@@ -7,6 +7,7 @@
 #include <random>
 #include <vector>
 
+#include "CastScan.h"
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/esdf/PoseOps.h"
 #include "urbanslam/slam/LoopCloser.h"
@@ -17,10 +18,7 @@ using namespace urbanslam;
 
 namespace {
 
-struct Segment {
-  double x1, y1, x2, y2;
-  bool car;
-};
+using test::Segment;
 
 // A street along x between facades at y = -8 and y = 8, each building stepping a metre back
 // from or forward to the one before (every 13 m on one side, 11 m on the other), lamp posts 25 m
@@ -44,45 +42,7 @@ std::vector<Segment> street() {
 }
 
 // A car's outline (4.5 m x 1.8 m) with its rear at x_rear, in the lane centred at y.
-void addCar(std::vector<Segment>& w, double x_rear, double y) {
-  const double x0 = x_rear, x1 = x_rear + 4.5, y0 = y - 0.9, y1 = y + 0.9;
-  for (const Segment& s :
-       std::vector<Segment>{{x0, y0, x1, y0, true}, {x1, y0, x1, y1, true}, {x1, y1, x0, y1, true}, {x0, y1, x0, y0, true}})
-    w.push_back(s);
-}
-
-// A front 180° scan at half a degree from a sensor 1.5 m ahead of the vehicle, cast against the
-// segments with 1 cm range noise; `on_car` says per beam whether it ended on a car.
-io::LaserScan castScan(const common::Pose2& vehicle, const std::vector<Segment>& w, std::mt19937& rng,
-                       std::vector<bool>* on_car = nullptr) {
-  io::LaserScan s;
-  s.angle_min_rad = -M_PI / 2;
-  s.angle_increment_rad = M_PI / 360;
-  s.max_range_m = 80;
-  s.sensor_pose = {1.5, 0, 0};
-  const common::Pose2 sensor = common::compose(vehicle, s.sensor_pose);
-  std::normal_distribution<double> noise(0, 0.01);
-  if (on_car) on_car->clear();
-  for (int i = 0; i <= 360; ++i) {
-    const double a = sensor.phi + s.bearing(static_cast<size_t>(i));
-    const double dx = std::cos(a), dy = std::sin(a);
-    double best = HUGE_VAL;
-    bool car = false;
-    for (const Segment& g : w) {
-      const double ex = g.x2 - g.x1, ey = g.y2 - g.y1;
-      const double den = dx * ey - dy * ex;
-      if (std::abs(den) < 1e-12) continue;
-      const double t = ((g.x1 - sensor.x) * ey - (g.y1 - sensor.y) * ex) / den;
-      const double u = ((g.x1 - sensor.x) * dy - (g.y1 - sensor.y) * dx) / den;
-      if (t > 0 && u >= 0 && u <= 1 && t < best) best = t, car = g.car;
-    }
-    const bool hit = best < s.max_range_m;
-    s.ranges.push_back(hit ? static_cast<float>(best + noise(rng)) : static_cast<float>(s.max_range_m));
-    s.valid.push_back(hit ? 1 : 0);
-    if (on_car) on_car->push_back(hit && car);
-  }
-  return s;
-}
+void addCar(std::vector<Segment>& w, double x_rear, double y) { test::addBox(w, x_rear, y - 0.9, x_rear + 4.5, y + 0.9, true); }
 
 // A car driving along the street: where its rear is at time 0 and its speed along x (negative:
 // the other way), in the lane centred at y.
@@ -104,7 +64,7 @@ Pass drive(double x_start, int keyframes, const std::vector<Car>& cars, std::mt1
     for (const Car& c : cars) addCar(w, c.rear_x + c.speed * 0.1 * i, c.lane_y);
     p.poses.push_back({x_start + i, -2, 0});
     p.on_car.emplace_back();
-    p.scans.push_back(castScan(p.poses.back(), w, rng, &p.on_car.back()));
+    p.scans.push_back(test::castScan(p.poses.back(), w, 1.5, 80, rng, &p.on_car.back()));
   }
   return p;
 }
@@ -119,7 +79,7 @@ struct Hidden {
 };
 Hidden judge(const Pass& p, size_t i, const std::vector<size_t>& by, const slam::MovingReturnsOptions& o = {}) {
   std::vector<alignment::BeamFreeSpace> free;
-  for (size_t j : by) free.push_back(slam::freeSpace(p.scans[j], o));
+  for (size_t j : by) free.push_back(slam::scanFreeSpace(p.scans[j], o.margin_m, o.margin_fraction));
   std::vector<slam::ScanJudge> judges;
   for (size_t n = 0; n < by.size(); ++n) judges.push_back({&free[n], common::between(p.poses[i], p.poses[by[n]])});
   io::LaserScan s = p.scans[i];

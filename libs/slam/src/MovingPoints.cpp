@@ -2,14 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
-#include <list>
-#include <unordered_map>
+#include <utility>
 
 #include "urbanslam/alignment/BeamFreeSpace.h"
-#include "urbanslam/alignment/ScanModel.h"
 #include "urbanslam/common/ParallelJobs.h"
 #include "urbanslam/common/Timing.h"
+#include "urbanslam/slam/FreeSpaceCache.h"
 #include "urbanslam/slam/KeyframeGrid.h"
 
 namespace urbanslam::slam {
@@ -19,40 +17,6 @@ namespace {
 // Keyframes a thread takes at a time, and the threads (each holding its cache of free space).
 constexpr size_t kRunKeyframes = 256;
 constexpr size_t kMaxWorkers = 2;
-
-// The free space of the scans judged with recently, least recently used dropped: consecutive
-// keyframes mostly share their judges.
-class FreeSpaceCache {
- public:
-  FreeSpaceCache(const std::vector<io::PosedScan>& scans, const MovingPointsOptions& o, size_t capacity)
-      : scans_(scans), options_(o), capacity_(capacity) {
-    model_.max_range_m = std::numeric_limits<double>::infinity();  // every return the scan kept
-    model_.min_range_m = 0;
-  }
-  const alignment::BeamFreeSpace& get(size_t i) {
-    if (const auto it = index_.find(i); it != index_.end()) {
-      order_.splice(order_.begin(), order_, it->second);
-      return it->second->second;
-    }
-    if (order_.size() >= capacity_) {
-      index_.erase(order_.back().first);
-      order_.pop_back();
-    }
-    const alignment::PointSet points = alignment::pointSetFromScan(scans_[i].get(buffer_), model_, true);
-    order_.emplace_front(i, alignment::BeamFreeSpace(points, options_.margin_m, options_.margin_fraction));
-    index_[i] = order_.begin();
-    return order_.front().second;
-  }
-
- private:
-  const std::vector<io::PosedScan>& scans_;
-  MovingPointsOptions options_;
-  size_t capacity_;
-  alignment::ScanModelOptions model_;
-  io::LaserScan buffer_;
-  std::list<std::pair<size_t, alignment::BeamFreeSpace>> order_;
-  std::unordered_map<size_t, std::list<std::pair<size_t, alignment::BeamFreeSpace>>::iterator> index_;
-};
 
 }  // namespace
 
@@ -67,6 +31,7 @@ MovingPointsResult findMovingPoints(const std::vector<io::PosedScan>& scans, con
   // each with its own cache of free space; every point's verdict is the same whichever thread
   // gives it, and the runs' verdicts are joined in order.
   struct Worker {
+    explicit Worker(FreeSpaceCache c) : cache(std::move(c)) {}
     FreeSpaceCache cache;
     io::LaserScan buffer;
     std::vector<Eigen::Vector2d> world;
@@ -78,7 +43,7 @@ MovingPointsResult findMovingPoints(const std::vector<io::PosedScan>& scans, con
   const size_t n_workers = common::workerCount(runs, kMaxWorkers);
   std::vector<Worker> workers;
   workers.reserve(n_workers);
-  while (workers.size() < n_workers) workers.push_back({FreeSpaceCache(scans, o, std::max<size_t>(64, 8 * views))});
+  while (workers.size() < n_workers) workers.emplace_back(FreeSpaceCache(o.margin_m, o.margin_fraction, std::max<size_t>(64, 8 * views)));
   std::vector<io::PointMask> kept(runs);  // per run, a bit per point (10^6 keyframes hold 10^8 points)
   common::runJobs(runs, workers.size(), [&](size_t w, size_t run) {
     Worker& k = workers[w];
@@ -107,7 +72,8 @@ MovingPointsResult findMovingPoints(const std::vector<io::PosedScan>& scans, con
       k.votes.assign(k.world.size(), 0);
       for (size_t j : k.judges) {
         k.state.assign(k.world.size(), alignment::BeamFreeSpace::kUnseen);
-        k.cache.get(j).classify(k.world, scans[j].pose, k.state);
+        k.cache.get(j, [&](io::LaserScan& buffer) -> const io::LaserScan& { return scans[j].get(buffer); })
+            .classify(k.world, scans[j].pose, k.state);
         for (size_t p = 0; p < k.world.size(); ++p) k.votes[p] += k.state[p] == alignment::BeamFreeSpace::kSeenThrough ? 1 : 0;
       }
       for (int v : k.votes) kept[run].push(v < o.min_views);

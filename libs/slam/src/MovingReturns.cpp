@@ -2,35 +2,19 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
-#include "urbanslam/alignment/BeamFreeSpace.h"
-#include "urbanslam/alignment/ScanModel.h"
 #include "urbanslam/slam/Map.h"
 
 namespace urbanslam::slam {
-
-alignment::BeamFreeSpace freeSpace(const io::LaserScan& judge, const MovingReturnsOptions& o) {
-  alignment::ScanModelOptions model;  // every return the judge kept
-  model.max_range_m = std::numeric_limits<double>::infinity();
-  model.min_range_m = 0;
-  return alignment::BeamFreeSpace(alignment::pointSetFromScan(judge, model, true), o.margin_m, o.margin_fraction);
-}
 
 size_t hideMovingReturns(io::LaserScan& scan, const std::vector<ScanJudge>& judges, const MovingReturnsOptions& o) {
   if (judges.size() < static_cast<size_t>(std::max(1, o.min_views))) return 0;
   // The returns in the vehicle frame, each with its beam.
   std::vector<Eigen::Vector2d> points;
+  for (const io::Point2& q : io::scanToPoints(scan, true)) points.emplace_back(q.x, q.y);
   std::vector<size_t> beams;
-  const common::Pose2& s = scan.sensor_pose;
-  const double c = std::cos(s.phi), sn = std::sin(s.phi);
-  for (size_t b = 0; b < scan.size(); ++b) {
-    if (!scan.valid[b]) continue;
-    const double r = scan.ranges[b], a = scan.bearing(b);
-    const double x = r * std::cos(a), y = r * std::sin(a);
-    points.emplace_back(s.x + c * x - sn * y, s.y + sn * x + c * y);
-    beams.push_back(b);
-  }
+  for (size_t b = 0; b < scan.size(); ++b)
+    if (scan.valid[b]) beams.push_back(b);
   std::vector<int> votes(points.size(), 0);
   std::vector<char> state;
   for (const ScanJudge& j : judges) {
@@ -60,48 +44,36 @@ size_t hideMovingReturns(io::LaserScan& scan, const std::vector<ScanJudge>& judg
 }
 
 MovingReturns::MovingReturns(const MovingReturnsOptions& options, size_t cached_keyframes)
-    // Room for every judge of one scan at least: the judges' free space is referred to until
-    // the scan is judged.
-    : options_(options), capacity_(std::max(cached_keyframes, 2 * static_cast<size_t>(std::max(0, options.neighbours)) + 1)) {}
-
-const alignment::BeamFreeSpace& MovingReturns::judge(const Map& map, size_t j) {
-  if (const auto it = index_.find(j); it != index_.end()) {
-    order_.splice(order_.begin(), order_, it->second);
-    return it->second->second;
-  }
-  if (order_.size() >= capacity_) {
-    index_.erase(order_.back().first);
-    order_.pop_back();
-  }
-  order_.emplace_front(j, freeSpace(map.scan(j), options_));
-  index_[j] = order_.begin();
-  return order_.front().second;
-}
+    // Room for every judge of one scan at least.
+    : options_(options),
+      judges_(options.margin_m, options.margin_fraction,
+              std::max(cached_keyframes, 2 * static_cast<size_t>(std::max(0, options.neighbours)) + 1)) {}
 
 io::LaserScan MovingReturns::scanWithout(const Map& map, size_t k, size_t newest, const std::function<common::Pose2(size_t)>& pose) {
   io::LaserScan scan = map.scan(k);
   if (options_.neighbours <= 0 || scan.size() == 0) return scan;
   if (map_ != &map) {  // another map's keyframe j is another scan
-    order_.clear();
-    index_.clear();
+    judges_.clear();
     map_ = &map;
   }
   const auto& keyframes = map.keyframes();
   const common::Pose2 here = pose(k);
-  std::vector<size_t> js;
-  std::vector<common::Pose2> placed;
+  // (Every judge's free space stays in the cache until the scan is judged: it holds more than
+  // one scan's judges.)
+  std::vector<ScanJudge> judges;
   const auto take = [&](size_t j) {
     if (!keyframes[j].hasScan()) return;
     const common::Pose2 rel = common::between(here, pose(j));
     if (!(std::hypot(rel.x, rel.y) <= options_.reach_m)) return;
-    js.push_back(j);
-    placed.push_back(rel);
+    const auto scan_of = [&](io::LaserScan& buffer) -> const io::LaserScan& {
+      map.scanInto(j, buffer);
+      return buffer;
+    };
+    judges.push_back({&judges_.get(j, scan_of), rel});
   };
   const size_t n = static_cast<size_t>(options_.neighbours);
   for (size_t j = k > n ? k - n : 0; j < k; ++j) take(j);
   for (size_t j = k + 1; j <= std::min({k + n, newest, keyframes.size() - 1}); ++j) take(j);
-  std::vector<ScanJudge> judges;
-  for (size_t i = 0; i < js.size(); ++i) judges.push_back({&judge(map, js[i]), placed[i]});
   hideMovingReturns(scan, judges, options_);
   return scan;
 }

@@ -12,13 +12,12 @@
 // seen through by the scans after it, an oncoming one by the scans before it too.
 #include <cstddef>
 #include <functional>
-#include <list>
-#include <unordered_map>
 #include <vector>
 
 #include "urbanslam/alignment/BeamFreeSpace.h"
 #include "urbanslam/common/Pose2.h"
 #include "urbanslam/io/LaserScan.h"
+#include "urbanslam/slam/FreeSpaceCache.h"
 
 namespace urbanslam::slam {
 
@@ -35,14 +34,12 @@ struct MovingReturnsOptions {
   double min_width_m = 1.0;       // hidden only in runs of returns at least this wide (a vehicle)
 };
 
-// A scan that judges another: the space its beams passed through (freeSpace), and its vehicle
-// pose in the judged scan's vehicle frame.
+// A scan that judges another: the space its beams passed through (scanFreeSpace with the
+// options' margins, FreeSpaceCache.h), and its vehicle pose in the judged scan's vehicle frame.
 struct ScanJudge {
   const alignment::BeamFreeSpace* free = nullptr;
   common::Pose2 pose;
 };
-// The free space of a judge's scan, in its vehicle frame, with the options' margins.
-alignment::BeamFreeSpace freeSpace(const io::LaserScan& judge, const MovingReturnsOptions& options);
 
 // Marks invalid the returns of `scan` that at least min_views of the judges saw through, in
 // runs of beams (none missing, or one at a time) whose ends lie min_width_m apart or more;
@@ -61,13 +58,9 @@ class MovingReturns {
   io::LaserScan scanWithout(const Map& map, size_t k, size_t newest, const std::function<common::Pose2(size_t)>& pose);
 
  private:
-  const alignment::BeamFreeSpace& judge(const Map& map, size_t j);
-
   MovingReturnsOptions options_;
-  size_t capacity_;
-  const Map* map_ = nullptr;
-  std::list<std::pair<size_t, alignment::BeamFreeSpace>> order_;  // most recently used first
-  std::unordered_map<size_t, std::list<std::pair<size_t, alignment::BeamFreeSpace>>::iterator> index_;
+  const Map* map_ = nullptr;  // the map whose keyframes `judges_` holds
+  FreeSpaceCache judges_;
 };
 
 }  // namespace urbanslam::slam
