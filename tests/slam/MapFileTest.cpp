@@ -2,6 +2,7 @@
 // of this version is refused with one error naming it.
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <fstream>
 #include <iterator>
 #include <memory>
@@ -236,13 +237,31 @@ TEST(MapFile, AVersion3FileIsReadAsAMapWithoutSeparateMaps) {
     as_it_was = filter_now.substr(0, i) + filter_now.substr(i + lineages) == filter_old;
   EXPECT_TRUE(as_it_was) << "section ESDF differs beyond the chain's lineages, the factors since the factorisation and the keyframe nodes";
   ASSERT_TRUE(a.count("LOCL") && b.count("LOCL"));
-  const std::string& local_old = a.at("LOCL");
+  // Version 13 follows each point of the submap's point sets with the position of the sensor that
+  // saw it, which a version 3 file has not: read as the set's origin, written as zeros. The sets
+  // follow the motion integrator's 251 bytes (libs/slam/README.md, LOCL).
+  const std::string& local_v3 = a.at("LOCL");
+  std::string local_old = local_v3.substr(0, 251);
+  {
+    size_t at = 251;
+    const auto count = [&]() {
+      std::uint64_t v = 0;
+      for (int i = 7; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(local_v3.at(at + i));
+      local_old += local_v3.substr(at, 8);
+      at += 8;
+      return v;
+    };
+    for (std::uint64_t set = 0, sets = count(); set < sets; ++set) {
+      for (std::uint64_t p = 0, points = count(); p < points; ++p, at += 68) local_old += local_v3.substr(at, 68) + std::string(16, '\0');
+    }
+    local_old += local_v3.substr(at);
+  }
   const std::string& local_now = b.at("LOCL");
   ASSERT_EQ(local_now.size(), local_old.size() + 24);
   bool inserted = false;  // 24 zero bytes somewhere, the rest as it was
   for (size_t i = 0; i + 24 <= local_now.size() && !inserted; ++i)
     inserted = local_now.compare(i, 24, std::string(24, '\0')) == 0 && local_now.substr(0, i) + local_now.substr(i + 24) == local_old;
-  EXPECT_TRUE(inserted) << "section LOCL differs beyond the heading corrections";
+  EXPECT_TRUE(inserted) << "section LOCL differs beyond the heading corrections and the sensor positions";
   ASSERT_TRUE(b.count("SEPM"));
   EXPECT_EQ(b.at("SEPM"), std::string(8, '\0'));  // a count of 0
   // The durations read into histograms: one per step, and they stay as they are once written so.

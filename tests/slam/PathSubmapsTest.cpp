@@ -17,8 +17,10 @@ using alignment::test::World;
 namespace {
 
 // A street along x, facades 8 m either side of the centre line, one building design repeated
-// every 12 m on each side (a recessed door per building, a tree in front of every other one on
-// the south side). With `cross_street`, a cross street at x in [-10, 2) breaks the repetition
+// every 12 m on each side (a recessed door per building; trees, one per building on the south
+// side and two on the north: the sides of the trees that face the street are what views from the
+// two lanes both see that fixes where along the street they are, a door's two sides being seen
+// from one end each). With `cross_street`, a cross street at x in [-10, 2) breaks the repetition
 // and a building stands at its end.
 World street(bool cross_street) {
   World w;
@@ -34,6 +36,8 @@ World street(bool cross_street) {
     w.push_back({{x + 5, -8}, {x + 5, -9}});
     w.push_back({{x + 5, -9}, {x + 12, -9}});
     alignment::test::addPolygon(w, x + 3, -6.5, 0.4, 8);
+    alignment::test::addPolygon(w, x + 2, 6.5, 0.4, 8);
+    alignment::test::addPolygon(w, x + 8, 6.5, 0.4, 8);
   }
   if (cross_street) alignment::test::addBox(w, -14, 24, 4, 30);
   return w;

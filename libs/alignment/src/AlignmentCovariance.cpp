@@ -21,8 +21,14 @@ struct Pair {
   Eigen::Vector2d dm;  // d m / d phi
 };
 
-std::vector<Pair> associations(const IndexedReference& reference, const PointSet& moving, const Pose2& transform, double gate) {
+// The pairs at `transform` within the association gate; with the reference's normals, not those
+// whose sensors see the line from opposite sides (as point-to-line ICP pairs them).
+std::vector<Pair> associations(const IndexedReference& reference, const std::vector<LineNormal>& normals, const PointSet& moving,
+                               const Pose2& transform, const CovarianceOptions& options) {
   const NearestNeighbours& index = reference.index();
+  const PointSet& ref = reference.points();
+  const double tolerance = options.seen_side_tolerance_deg * M_PI / 180;
+  const double gate = options.association_gate_m;
   const Rigid2 T = Rigid2::fromPose(transform);
   const double c = std::cos(transform.phi), s = std::sin(transform.phi);
   std::vector<Pair> out;
@@ -32,6 +38,7 @@ std::vector<Pair> associations(const IndexedReference& reference, const PointSet
     int j = 0;
     double d2 = 0;
     if (!index.nearestWithin(m, gate * gate, &j, &d2)) continue;
+    if (!normals.empty() && !seenFromSameSide(normals[j], ref[j], T * moving[i].origin, tolerance)) continue;
     out.push_back({static_cast<int>(i), j, m, Eigen::Vector2d(-s * b.x() - c * b.y(), c * b.x() - s * b.y())});
   }
   return out;
@@ -61,10 +68,10 @@ double sweepSpacing(const PointSet& ref, int j) {
 
 Eigen::Matrix3d lineVarianceCovariance(const IndexedReference& indexed, const PointSet& moving, const Pose2& transform,
                                        const CovarianceOptions& options) {
-  const auto pairs = associations(indexed, moving, transform, options.association_gate_m);
+  const auto& normals = indexed.normals(options.normals);
+  const auto pairs = associations(indexed, normals, moving, transform, options);
   if (pairs.size() < 3) return largeCovariance(options);
   const PointSet& reference = indexed.points();
-  const auto& normals = indexed.normals(options.normals);
   const Rigid2 T = Rigid2::fromPose(transform);
   Eigen::Matrix3d info = Eigen::Matrix3d::Zero();
   double chi2 = 0;
@@ -100,11 +107,11 @@ Eigen::Matrix3d lineVarianceCovariance(const IndexedReference& indexed, const Po
 
 Eigen::Matrix3d hessianCovariance(const IndexedReference& indexed, const PointSet& moving, const Pose2& transform,
                                   const CovarianceOptions& options) {
-  const auto pairs = associations(indexed, moving, transform, options.association_gate_m);
-  if (pairs.size() < 3) return largeCovariance(options);
-  const PointSet& reference = indexed.points();
   const std::vector<LineNormal> none;
   const auto& normals = options.hessian_point_to_line ? indexed.normals(options.normals) : none;
+  const auto pairs = associations(indexed, normals, moving, transform, options);
+  if (pairs.size() < 3) return largeCovariance(options);
+  const PointSet& reference = indexed.points();
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
   double sse = 0;
   int n = 0;
@@ -184,9 +191,9 @@ double translationConstraintRatio(const PointSet& reference, const PointSet& mov
 
 double translationConstraintRatio(const IndexedReference& reference, const PointSet& moving, const Pose2& transform,
                                   const CovarianceOptions& options) {
-  const auto pairs = associations(reference, moving, transform, options.association_gate_m);
-  if (pairs.size() < 3) return 0.0;
   const auto& normals = reference.normals(options.normals);
+  const auto pairs = associations(reference, normals, moving, transform, options);
+  if (pairs.size() < 3) return 0.0;
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
   for (const auto& pr : pairs) {
     if (normals[pr.ref].valid) {

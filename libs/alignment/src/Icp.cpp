@@ -51,9 +51,10 @@ RegistrationResult icpWithIndex(const PointSet& reference, const NearestNeighbou
     return result;
   }
   const bool point_to_line = !normals.empty();
+  const double seen_side_tolerance = options.seen_side_tolerance_deg * M_PI / 180;
   const double gate_final = std::max(1e-6, options.gate_final_m);
   double gate = std::max(gate_final, options.gate_initial_m);
-  Pose2 pose = guess;
+  Pose2 pose = guess, before_last = guess;
   bool settled = false;
 
   std::vector<Eigen::Vector2d> src, dst;
@@ -83,6 +84,7 @@ RegistrationResult icpWithIndex(const PointSet& reference, const NearestNeighbou
       int j = 0;
       double d2 = 0;
       if (!index.nearestWithin(m, g * g, &j, &d2)) continue;
+      if (point_to_line && !seenFromSameSide(normals[j], reference[j], T * q.origin, seen_side_tolerance)) continue;
       double e = std::sqrt(d2);
       if (point_to_line && normals[j].valid) e = std::abs(normals[j].n.dot(m - reference[j].p));
       src.push_back(q.p);
@@ -140,13 +142,19 @@ RegistrationResult icpWithIndex(const PointSet& reference, const NearestNeighbou
     }
     const double dt = std::hypot(next.x - pose.x, next.y - pose.y);
     const double dphi = std::abs(common::wrapToPi(next.phi - pose.phi));
+    // Two sets of pairs that each lead to the other's pose (a pair that counts at one pose and
+    // not at the other: the nearest neighbour changes, or a sensor crosses a line's side) make
+    // the estimate alternate between the two for ever: at this gate, that is as settled as it gets.
+    const bool alternating = it > 2 && std::hypot(next.x - before_last.x, next.y - before_last.y) < options.tolerance_m &&
+                             std::abs(common::wrapToPi(next.phi - before_last.phi)) < options.tolerance_rad;
+    before_last = pose;
     pose = next;
     if (gate <= gate_final * (1 + 1e-9)) {
-      if (dt < options.tolerance_m && dphi < options.tolerance_rad) {
+      if ((dt < options.tolerance_m && dphi < options.tolerance_rad) || alternating) {
         settled = true;
         break;
       }
-    } else if (dt < 0.05 * gate && dphi < 0.01 * gate) {
+    } else if ((dt < 0.05 * gate && dphi < 0.01 * gate) || alternating) {
       if (gate <= options.abandon_gate_factor * gate_final &&
           static_cast<double>(src.size()) < options.abandon_below_fraction * static_cast<double>(moving.size())) {
         std::ostringstream os;

@@ -99,4 +99,13 @@ std::vector<LineNormal> computeLineNormals(const PointSet& points, const LineNor
   return out;
 }
 
+bool seenFromSameSide(const LineNormal& normal, const ScanPoint& ref, const Eigen::Vector2d& other_sensor, double grazing_rad) {
+  if (!normal.valid || grazing_rad < 0) return true;
+  const Eigen::Vector2d to_own = ref.origin - ref.p, to_other = other_sensor - ref.p;
+  const double own = normal.n.dot(to_own), other = normal.n.dot(to_other);
+  if ((own >= 0) == (other >= 0)) return true;
+  const double s = std::sin(grazing_rad);
+  return std::abs(own) <= s * to_own.norm() || std::abs(other) <= s * to_other.norm();
+}
+
 }  // namespace urbanslam::alignment

@@ -17,6 +17,7 @@ PointSet transformed(const PointSet& points, const common::Pose2& pose) {
   PointSet out(points);
   for (auto& q : out) {
     q.p = T * q.p;
+    q.origin = T * q.origin;
     q.cov = T.R * q.cov * T.R.transpose();
   }
   return out;

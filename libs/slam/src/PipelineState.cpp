@@ -268,17 +268,20 @@ void writePointSet(BinaryWriter& w, const alignment::PointSet& points) {
     w.f64(p.range_m);
     w.f64(p.bearing_rad);
     w.i32(p.beam);
+    w.matrix(Eigen::Vector2d(p.origin));
   }
 }
 
-alignment::PointSet readPointSet(BinaryReader& r) {
-  alignment::PointSet points(r.count((2 + 4 + 2) * 8 + 4));
+// Before version 13 a point set held no sensor positions: they are then the set's origin.
+alignment::PointSet readPointSet(BinaryReader& r, bool with_origins) {
+  alignment::PointSet points(r.count((2 + 4 + 2) * 8 + 4 + (with_origins ? 2 * 8 : 0)));
   for (auto& p : points) {
     p.p = r.matrix<2, 1>();
     p.cov = r.matrix<2, 2>();
     p.range_m = r.f64();
     p.bearing_rad = r.f64();
     p.beam = r.i32();
+    if (with_origins) p.origin = r.matrix<2, 1>();
   }
   return points;
 }
@@ -492,13 +495,13 @@ void LocalSubmap::writeState(BinaryWriter& w) const {
   w.f64(heading_corrections_.matches());
 }
 
-void LocalSubmap::readState(BinaryReader& r, bool with_heading_corrections) {
+void LocalSubmap::readState(BinaryReader& r, bool with_heading_corrections, bool with_origins) {
   const size_t n = r.count(8);
   if (n > capacity_) r.fail("a local submap of " + std::to_string(n) + " keyframes where it holds " + std::to_string(capacity_));
   sets_.clear();
   beams_.clear();
   for (size_t i = 0; i < n; ++i) {
-    sets_.push_back(readPointSet(r));
+    sets_.push_back(readPointSet(r, with_origins));
     beams_.emplace_back(sets_.back(), matcher_.free_margin_m, matcher_.free_margin_fraction);
   }
   generation_ = r.size();
@@ -525,9 +528,9 @@ void LocalSlam::writeState(BinaryWriter& w) const {
   w.f64(last_anchor_time_);
 }
 
-void LocalSlam::readState(BinaryReader& r, bool with_heading_corrections) {
+void LocalSlam::readState(BinaryReader& r, bool with_heading_corrections, bool with_origins) {
   motion_.readState(r);
-  submap_.readState(r, with_heading_corrections);
+  submap_.readState(r, with_heading_corrections, with_origins);
   have_scan_keyframe_ = r.boolean();
   local_poses_.resize(r.count(24));
   for (auto& p : local_poses_) p = readPose(r);
@@ -716,7 +719,7 @@ void Pipeline::readState(BinaryReader& r, std::uint32_t format_version, bool con
   }
   {
     BinaryReader s = r.section(kLocalTag);
-    local_.readState(s, format_version >= 5);
+    local_.readState(s, format_version >= 5, format_version >= 13);
     submap_corrections_.readState(s);
     s.expectEnd();
   }

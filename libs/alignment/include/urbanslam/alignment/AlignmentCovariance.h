@@ -34,6 +34,9 @@ struct CovarianceOptions {
   CovarianceMethod method = CovarianceMethod::LineVariance;
   double association_gate_m = 0.3;  // pairs farther apart at the final transform are ignored
   LineNormalOptions normals;
+  // With normals, no pair whose sensors see its line from opposite sides, each more steeply than
+  // this, as point-to-line ICP pairs them (IcpOptions); < 0: every pair.
+  double seen_side_tolerance_deg = 10;
   bool scale_by_residuals = true;  // line variance: inflate by chi^2/dof when it exceeds 1
   double max_std_m = 100.0;        // weak prior bounding free directions
   double max_std_rad = 3.14159;

@@ -41,6 +41,10 @@ struct IcpOptions {
   double abandon_below_fraction = 0;
   double abandon_gate_factor = 5;
   LineNormalOptions normals;  // point-to-line only
+  // Point-to-line: a moving point is not paired with a reference line when the two sensors see
+  // that line from opposite sides, each more steeply than this (LineNormals.h,
+  // seenFromSameSide); < 0: it always is.
+  double seen_side_tolerance_deg = 10;
 };
 
 class NearestNeighbours;

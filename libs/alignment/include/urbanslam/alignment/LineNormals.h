@@ -33,4 +33,13 @@ struct LineNormal {
 
 std::vector<LineNormal> computeLineNormals(const PointSet& points, const LineNormalOptions& options);
 
+// A surface is seen from its front only. A point seen from `other_sensor` can be on the line of
+// reference point `ref` (its `normal`) unless the two sensors are on opposite sides of that line,
+// each seeing it more steeply than `grazing_rad` (seen nearly edge-on, a normal tilted by noise
+// may put a sensor just behind it). Two views from opposite sides would otherwise pair the faces
+// that each sees of the same things (a facade's pillars, the two halves of a post), which lie
+// apart: two views of a street from its two ends then slide along it by a pillar's width. A point
+// without a normal, or a negative tolerance: true.
+bool seenFromSameSide(const LineNormal& normal, const ScanPoint& ref, const Eigen::Vector2d& other_sensor, double grazing_rad);
+
 }  // namespace urbanslam::alignment

@@ -17,6 +17,7 @@ struct ScanPoint {
   double range_m = 0;                             // original range (eq. 3.1)
   double bearing_rad = 0;                         // original bearing
   int beam = 0;                                   // index of the beam in the original sweep
+  Eigen::Vector2d origin = Eigen::Vector2d::Zero();  // where it was seen from (the sensor), same frame as p
 };
 
 // Points in increasing beam order (the order of the sweep). A concatenation of several scans
@@ -33,7 +34,8 @@ struct Rigid2 {
   Eigen::Vector2d operator*(const Eigen::Vector2d& p) const { return R * p + t; }
 };
 
-// The points (and their covariances, rotated) expressed in the frame in which `pose` is the
+// The points (their covariances rotated, the sensor positions they were seen from moved with
+// them) expressed in the frame in which `pose` is the
 // frame of the set: p' = R(phi) p + t.
 PointSet transformed(const PointSet& points, const common::Pose2& pose);
 

@@ -42,7 +42,7 @@ class LocalSubmap {
   // both at the next match, as a cache miss would (the same inputs give the same reference).
   // with_heading_corrections: false for maps written before they were kept.
   void writeState(common::BinaryWriter& w) const;
-  void readState(common::BinaryReader& r, bool with_heading_corrections = true);
+  void readState(common::BinaryReader& r, bool with_heading_corrections = true, bool with_origins = true);
 
  private:
   const alignment::MatchReference* reference(const std::vector<common::Pose2>& poses) const;
