@@ -17,16 +17,7 @@ namespace uc = urbanslam::common;
 namespace {
 
 // A street along x, 16 m between its facades; a pillar 1 m wide every 4 m on either side.
-ua::test::World streetOfPillars() {
-  ua::test::World w;
-  w.push_back({{-60, -7}, {80, -7}});
-  w.push_back({{-60, 9}, {80, 9}});
-  for (double x = -60; x <= 80; x += 4) {
-    ua::test::addBox(w, x, -7, x + 1, -6.2);
-    ua::test::addBox(w, x, 8.2, x + 1, 9);
-  }
-  return w;
-}
+ua::test::World streetOfPillars() { return ua::test::pillaredStreetWorld(-7, 9, -60, 80); }
 
 }  // namespace
 

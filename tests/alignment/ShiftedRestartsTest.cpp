@@ -16,16 +16,7 @@ namespace uc = urbanslam::common;
 namespace {
 
 // A street 10 m wide whose facades repeat every 4 m: pillars of 1 m along both walls.
-ua::test::World repeatedStreet() {
-  ua::test::World w;
-  w.push_back({{-60, -5}, {60, -5}});
-  w.push_back({{-60, 5}, {60, 5}});
-  for (double x = -60; x <= 60; x += 4) {
-    ua::test::addBox(w, x, -5, x + 1, -4.2);
-    ua::test::addBox(w, x, 4.2, x + 1, 5);
-  }
-  return w;
-}
+ua::test::World repeatedStreet() { return ua::test::pillaredStreetWorld(-5, 5, -60, 60); }
 
 // The rule, run to the end: PL-ICP from the result shifted along x and y, by the first shift,
 // twice, four times that...; another minimum is a converged restart that ends away from the

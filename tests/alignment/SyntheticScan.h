@@ -54,6 +54,20 @@ inline World corridorWorld() {
   return w;
 }
 
+// A street along x from x0 to x1 between facades at y = south and y = north, a pillar 1 m wide
+// and 0.8 m deep every 4 m along both: a facade of one repeated design, whose pillars' sides each
+// view sees from one end of the street only.
+inline World pillaredStreetWorld(double south, double north, double x0, double x1) {
+  World w;
+  w.push_back({{x0, south}, {x1, south}});
+  w.push_back({{x0, north}, {x1, north}});
+  for (double x = x0; x <= x1; x += 4) {
+    addBox(w, x, south, x + 1, south + 0.8);
+    addBox(w, x, north - 0.8, x + 1, north);
+  }
+  return w;
+}
+
 struct ScanSpec {
   int beams = 361;
   double fov_rad = M_PI;

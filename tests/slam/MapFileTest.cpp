@@ -2,7 +2,6 @@
 // of this version is refused with one error naming it.
 #include <gtest/gtest.h>
 
-#include <cstdint>
 #include <fstream>
 #include <iterator>
 #include <memory>
@@ -13,6 +12,7 @@
 #include "urbanslam/common/BinaryStream.h"
 #include "urbanslam/common/Error.h"
 #include "urbanslam/slam/MapFile.h"
+#include "urbanslam/slam/MotionIntegrator.h"
 #include "urbanslam/slam/Pipeline.h"
 
 using namespace urbanslam;
@@ -237,24 +237,29 @@ TEST(MapFile, AVersion3FileIsReadAsAMapWithoutSeparateMaps) {
     as_it_was = filter_now.substr(0, i) + filter_now.substr(i + lineages) == filter_old;
   EXPECT_TRUE(as_it_was) << "section ESDF differs beyond the chain's lineages, the factors since the factorisation and the keyframe nodes";
   ASSERT_TRUE(a.count("LOCL") && b.count("LOCL"));
-  // Version 13 follows each point of the submap's point sets with the position of the sensor that
-  // saw it, which a version 3 file has not: read as the set's origin, written as zeros. The sets
-  // follow the motion integrator's 251 bytes (libs/slam/README.md, LOCL).
+  // Version 13 follows each point of the submap's point sets (after the motion integrator's
+  // state: libs/slam/README.md, LOCL) with the position of the sensor that saw it, which a
+  // version 3 file has not: read as the set's origin, written as zeros.
   const std::string& local_v3 = a.at("LOCL");
-  std::string local_old = local_v3.substr(0, 251);
+  std::string local_old;
   {
-    size_t at = 251;
-    const auto count = [&]() {
-      std::uint64_t v = 0;
-      for (int i = 7; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(local_v3.at(at + i));
-      local_old += local_v3.substr(at, 8);
-      at += 8;
-      return v;
+    common::BinaryReader r(local_v3.data(), local_v3.size(), "LOCL");
+    size_t copied = 0;  // local_v3's bytes up to where r has read, copied into local_old
+    const auto copy = [&] {
+      const size_t at = local_v3.size() - r.remaining();
+      local_old += local_v3.substr(copied, at - copied);
+      copied = at;
     };
-    for (std::uint64_t set = 0, sets = count(); set < sets; ++set) {
-      for (std::uint64_t p = 0, points = count(); p < points; ++p, at += 68) local_old += local_v3.substr(at, 68) + std::string(16, '\0');
+    slam::MotionIntegrator(slam::MotionOptions{}, slam::VehicleOptions{}).readState(r);
+    std::string point((2 + 4 + 2) * 8 + 4, '\0');  // position, covariance, range, bearing, beam
+    for (size_t set = 0, sets = r.size(); set < sets; ++set) {
+      for (size_t p = 0, points = r.size(); p < points; ++p) {
+        r.raw(point.data(), point.size());
+        copy();
+        local_old += std::string(16, '\0');
+      }
     }
-    local_old += local_v3.substr(at);
+    local_old += local_v3.substr(copied);
   }
   const std::string& local_now = b.at("LOCL");
   ASSERT_EQ(local_now.size(), local_old.size() + 24);
