@@ -95,6 +95,8 @@ std::array<double, 9> GlobalSlam::addKeyframeFrom(size_t from, Keyframe kf, io::
 }
 
 void GlobalSlam::finish() {
+  const auto now = std::chrono::steady_clock::now();
+  for (size_t k = map_.size() > searchLag() ? map_.size() - searchLag() : 0; k < map_.size(); ++k) searchLoopsEvery(k, now);
   for (LoopClosureRecord r : pending_) reportExpired(r);  // hypotheses still waiting for a confirmation
   pending_.clear();
   if (dirty_since_recovery_) recoverAll(true);
@@ -320,7 +322,13 @@ bool GlobalSlam::cameraConfirms(const LoopClosureRecord& r, const std::optional<
   return agree(common::compose(common::compose(m, view->camera.metric.pose), common::inverse(m)), scans);
 }
 
-void GlobalSlam::closeLoops(size_t current, SteadyTime handed_over) {
+size_t GlobalSlam::searchLag() const { return static_cast<size_t>(std::max(0, options_.loop_closure.moving_returns_neighbours)); }
+
+void GlobalSlam::closeLoops(size_t newest, SteadyTime handed_over) {
+  if (newest >= searchLag()) searchLoopsEvery(newest - searchLag(), handed_over);
+}
+
+void GlobalSlam::searchLoopsEvery(size_t current, SteadyTime handed_over) {
   if (map_.filter() && options_.loop_closure.enabled && current % static_cast<size_t>(options_.loop_closure.every_n_keyframes) == 0)
     searchLoops(current, handed_over);
 }

@@ -220,7 +220,8 @@ void Pipeline::addKeyframe(io::LaserScan scan, const std::optional<CameraMeasure
   map_.addAnchor({timestamp, k, common::Pose2{}, local_.motion().odometryPose()});
   local_.keyframeAdded(scan, c.z);
   // 4. Global SLAM, in order: the keyframe into the filter as a delayed pose, then loop closures
-  //    against earlier keyframes.
+  //    against earlier keyframes of the keyframe a few before it (GlobalSlam::searchLag: its
+  //    scan judged by the keyframes on both sides).
   // The observers get the keyframe's scan as the map keeps it: the expanded copy local SLAM used
   // goes along rather than being expanded again there.
   //    Then the submap's keyframes as global SLAM sees them, for local SLAM to take later.

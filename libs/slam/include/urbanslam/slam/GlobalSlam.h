@@ -53,9 +53,16 @@ class GlobalSlam {
   // The same with the constraint from keyframe `from` (the first keyframe of a session joined to
   // the map: Pipeline::appendSession).
   std::array<double, 9> addKeyframeFrom(size_t from, Keyframe kf, io::CompactScan scan, const KeyframeConstraint& constraint);
-  // Loop closures of keyframe `current` with earlier ones, when [loop_closure] asks for it now.
-  // `handed_over`: when local SLAM handed the keyframe over, for the correction's latency.
-  void closeLoops(size_t current, SteadyTime handed_over);
+  // Keyframe `newest` is in the map: loop closures of the keyframe searchLag() before it with
+  // earlier ones, when [loop_closure] asks for it then. `handed_over`: when local SLAM handed
+  // `newest` over, for the correction's latency.
+  void closeLoops(size_t newest, SteadyTime handed_over);
+  // How many keyframes a keyframe's loop closures wait for: its scan's moving returns are judged
+  // by the keyframes after it as well as before ([loop_closure] moving_returns_neighbours), or
+  // the car ahead of it, which only later scans see through, pulls its alignments along the
+  // street. A saved map keeps its last searchLag() keyframes unsearched, so that a continued run
+  // searches them as one run over both logs does; finish() searches them.
+  size_t searchLag() const;
   // Whether a camera closure between the two keyframes may measure the full pose: where the
   // estimate knows their relative position within [loop_closure] appearance_min_sigma_m (largest
   // sigma), so that a copy of a facade design tens of metres along the street cannot pass the
@@ -77,7 +84,8 @@ class GlobalSlam {
   // How closures the scans measured are confirmed by the camera ([loop_closure]
   // camera_confirmation); without it, only by a second closure.
   void setCameraMeasurer(CameraPairMeasurer measurer) { camera_measurer_ = std::move(measurer); }
-  // End of input: hypotheses still awaiting confirmation are dropped, the last poses recovered.
+  // End of input: the last keyframes' loop closures sought, hypotheses still awaiting
+  // confirmation dropped, the last poses recovered.
   void finish();
 
   const LoopClosureLog& closureLog() const { return closures_; }
@@ -129,7 +137,9 @@ class GlobalSlam {
   // than the gate (the window could not take up its correction).
   void closureAdded(size_t current, SteadyTime handed_over);
   bool missesAddedClosure() const;
-  // Candidates, alignment, gating and confirmation for keyframe `current`.
+  // Candidates, alignment, gating and confirmation for keyframe `current` (every
+  // [loop_closure] every_n_keyframes).
+  void searchLoopsEvery(size_t current, SteadyTime handed_over);
   void searchLoops(size_t current, SteadyTime handed_over);
   // The newest filter poses recovered ([estimator] recent_window), the newest keyframes' poses
   // pulled.

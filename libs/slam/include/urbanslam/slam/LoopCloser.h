@@ -194,12 +194,14 @@ class LoopCloser {
   std::optional<bool> narrow_view_;                     // the laser covers well under the full circle (read once)
   size_t current_scan_for_ = static_cast<size_t>(-1);
   const Map* current_scan_map_ = nullptr;
+  size_t current_scan_judged_to_ = 0;  // the map's size when current_scan_ was judged
   io::LaserScan current_scan_;  // the current keyframe's scan, its moving returns hidden (staticScan)
 
   MovingReturns moving_;  // the judges' free space, kept between attempts
-  // Keyframe k's scan without the returns that moved (MovingReturns.h), judged by keyframes up
-  // to `current` placed by the estimate.
-  io::LaserScan staticScan(KeyframeNodes& filter, const Map& map, size_t k, size_t current);
+  // Keyframe k's scan without the returns that moved (MovingReturns.h), judged by the keyframes
+  // around it that the map holds, placed by the estimate (global SLAM seeks a keyframe's
+  // closures once the ones after it are in: GlobalSlam::searchLag).
+  io::LaserScan staticScan(KeyframeNodes& filter, const Map& map, size_t k);
 
   // Two scans aligned by verifyAlignment's first step, kept for its ambiguity restarts (which
   // tryClose runs only when the gate does not refuse the closure anyway).

@@ -126,7 +126,8 @@ struct LoopClosureOptions {
   double submap_check_path_m = 30;
   // The two scans are aligned and tested without the returns of things that moved (traffic,
   // people), judged by the keyframes up to this many places before and after each in the log
-  // (MovingReturns.h; the current keyframe's by those before it). 0: off.
+  // (MovingReturns.h; a keyframe's closures are sought once the keyframes after it are in the
+  // map). 0: off.
   int moving_returns_neighbours = 5;
   double free_space_margin_m = 0.3;   // a point conflicts this far (+5 % of the range) inside free space
   double free_space_no_return_m = 0;  // a beam without a return saw free space this far (0: unknown)
