@@ -95,8 +95,7 @@ std::array<double, 9> GlobalSlam::addKeyframeFrom(size_t from, Keyframe kf, io::
 }
 
 void GlobalSlam::finish() {
-  const auto now = std::chrono::steady_clock::now();
-  for (size_t k = map_.size() > searchLag() ? map_.size() - searchLag() : 0; k < map_.size(); ++k) searchLoopsEvery(k, now);
+  closePendingLoops(std::chrono::steady_clock::now());
   for (LoopClosureRecord r : pending_) reportExpired(r);  // hypotheses still waiting for a confirmation
   pending_.clear();
   if (dirty_since_recovery_) recoverAll(true);
@@ -325,7 +324,11 @@ bool GlobalSlam::cameraConfirms(const LoopClosureRecord& r, const std::optional<
 size_t GlobalSlam::searchLag() const { return static_cast<size_t>(std::max(0, options_.loop_closure.moving_returns_neighbours)); }
 
 void GlobalSlam::closeLoops(size_t newest, SteadyTime handed_over) {
-  if (newest >= searchLag()) searchLoopsEvery(newest - searchLag(), handed_over);
+  for (; next_search_ + searchLag() <= newest; ++next_search_) searchLoopsEvery(next_search_, handed_over);
+}
+
+void GlobalSlam::closePendingLoops(SteadyTime handed_over) {
+  for (; next_search_ < map_.size(); ++next_search_) searchLoopsEvery(next_search_, handed_over);
 }
 
 void GlobalSlam::searchLoopsEvery(size_t current, SteadyTime handed_over) {

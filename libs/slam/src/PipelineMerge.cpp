@@ -19,6 +19,9 @@ void Pipeline::appendSession(const Pipeline& session, const SessionJoin& join) {
   const Map& other = session.map_;
   const size_t n0 = map_.size();
   if (other.empty()) return;
+  // This map's last keyframes, still waiting for their search, are searched as at the end of
+  // its input: the session's keyframes that follow them were not driven after them.
+  global_.closePendingLoops(std::chrono::steady_clock::now());
 
   // This map's keyframe nearest to `p` within `radius_m` among its own (not the session's), with
   // a scan when `scan` says so; none: n0.

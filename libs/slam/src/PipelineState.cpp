@@ -612,6 +612,8 @@ void GlobalSlam::readState(BinaryReader& r, std::uint32_t format_version) {
   }
   dirty_since_recovery_ = r.boolean();
   last_full_size_ = r.size();
+  // A map is saved before the end of its input: its last keyframes' closures were still to seek.
+  next_search_ = n > searchLag() ? n - searchLag() : 0;
   // The classifier's keyframe features are not saved: a function of each keyframe's scan,
   // computed when first needed (laserDetector()).
 }

@@ -53,10 +53,13 @@ class GlobalSlam {
   // The same with the constraint from keyframe `from` (the first keyframe of a session joined to
   // the map: Pipeline::appendSession).
   std::array<double, 9> addKeyframeFrom(size_t from, Keyframe kf, io::CompactScan scan, const KeyframeConstraint& constraint);
-  // Keyframe `newest` is in the map: loop closures of the keyframe searchLag() before it with
-  // earlier ones, when [loop_closure] asks for it then. `handed_over`: when local SLAM handed
-  // `newest` over, for the correction's latency.
+  // Keyframe `newest` is in the map: loop closures of the keyframes up to searchLag() before it
+  // with earlier ones, each when [loop_closure] asks for it then. `handed_over`: when local SLAM
+  // handed `newest` over, for the correction's latency.
   void closeLoops(size_t newest, SteadyTime handed_over);
+  // The keyframes still waiting for their search searched now, judged by the keyframes the map
+  // holds: at the end of the input, and before another session's keyframes follow this map's.
+  void closePendingLoops(SteadyTime handed_over);
   // How many keyframes a keyframe's loop closures wait for: its scan's moving returns are judged
   // by the keyframes after it as well as before ([loop_closure] moving_returns_neighbours), or
   // the car ahead of it, which only later scans see through, pulls its alignments along the
@@ -169,6 +172,9 @@ class GlobalSlam {
   // The first closure since the last full recovery: its keyframe and when local SLAM handed
   // that over (not saved: a resumed run has no clock of the earlier one's).
   std::optional<std::pair<size_t, SteadyTime>> unrecovered_closure_;
+  // The first keyframe whose loop closures have not been sought (a map read back: its last
+  // searchLag() keyframes).
+  size_t next_search_ = 0;
   // The closures accepted since the last closureAdded (not saved: a checkpoint falls between steps).
   std::vector<LoopClosureRecord> added_;
 };
