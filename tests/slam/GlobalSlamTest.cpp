@@ -497,38 +497,3 @@ TEST(GlobalSlam, AFullRecoveryWaitsUntilTheKeyframesSinceThePreviousHavePaidForI
         << "recovery " << i << " came later than the next closure after it was paid";
   }
 }
-
-// A keyframe's scan is judged for what moved by the keyframes before and after it
-// (MovingReturns.h): its loop closures are sought once moving_returns_neighbours keyframes
-// after it are in the map, each keyframe's once, and the last ones at the end of the input.
-TEST(GlobalSlam, AKeyframesLoopsAreSoughtOnceTheKeyframesAfterItAreInTheMap) {
-  struct SearchLog : slam::PipelineObserver {
-    const slam::Map* map = nullptr;
-    std::vector<std::pair<size_t, size_t>> searches;  // keyframe searched, keyframes in the map then
-    void onCandidates(const slam::CandidatesEvent& e) override { searches.emplace_back(e.keyframe, map->size()); }
-  };
-  for (int neighbours : {5, 0}) {
-    ::Run r;
-    SearchLog log;
-    log.map = &r.map;
-    r.observers = {&log};
-    r.options.loop_closure.moving_returns_neighbours = neighbours;
-    r.global = std::make_unique<slam::GlobalSlam>(r.options, r.map, r.stats, r.observers);
-    slam::KeyframeConstraint c;
-    c.z = {1.0, 0, 0};
-    c.cov = Eigen::Vector3d(1e-4, 1e-4, 1e-6).asDiagonal();
-    const size_t n = 20, lag = static_cast<size_t>(neighbours);
-    for (size_t k = 0; k < n; ++k) {
-      r.global->addKeyframe({k, static_cast<double>(k), {}, false, false, {}}, io::CompactScan(), c);
-      r.global->closeLoops(k, std::chrono::steady_clock::now());
-    }
-    ASSERT_EQ(log.searches.size(), n - lag) << neighbours;
-    for (size_t i = 0; i < log.searches.size(); ++i) {
-      EXPECT_EQ(log.searches[i].first, i);
-      EXPECT_EQ(log.searches[i].second, i + lag + 1);
-    }
-    r.global->finish();
-    ASSERT_EQ(log.searches.size(), n) << neighbours;
-    for (size_t i = n - lag; i < n; ++i) EXPECT_EQ(log.searches[i], std::make_pair(i, n));
-  }
-}

@@ -10,9 +10,12 @@
 #include "CastScan.h"
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/esdf/PoseOps.h"
+#include "urbanslam/slam/GlobalSlam.h"
 #include "urbanslam/slam/LoopCloser.h"
 #include "urbanslam/slam/Map.h"
 #include "urbanslam/slam/MovingReturns.h"
+#include "urbanslam/slam/Observer.h"
+#include "urbanslam/slam/PipelineOptions.h"
 
 using namespace urbanslam;
 
@@ -265,4 +268,67 @@ TEST(MovingReturns, TheCurrentKeyframesCarAheadIsJudgedByTheKeyframesAfterIt) {
   const common::Pose2 e = common::between(truth, both_sides.measurement);
   EXPECT_LT(std::hypot(e.x, e.y), 0.1);
   EXPECT_LT(std::abs(e.phi), 0.5 * M_PI / 180);
+}
+
+// A car that moved (driving ahead, or coming the other way) leaves returns of the earlier scans
+// where the current scan sees through; one that stands does not (the current scan sees it where
+// they saw it).
+TEST(MovingReturns, AScanThatSeesThroughWhereTheScansBeforeItSawSomethingIsFlagged) {
+  std::mt19937 rng(9);
+  const auto flagged = [&](double car_speed, double lane) {
+    const Pass p = drive(0, 6, 14, car_speed, lane, rng), none;
+    const std::unique_ptr<slam::Map> map = twoVisits(p, none);
+    return slam::seesThroughEarlier(*map, 5, 5, [&](size_t j) { return map->keyframes()[j].pose; }, {});
+  };
+  EXPECT_TRUE(flagged(8, -2));  // ahead, slower than the vehicle
+  EXPECT_TRUE(flagged(-8, 2));  // coming the other way
+  EXPECT_FALSE(flagged(0, 2));  // parked
+}
+
+// Global SLAM seeks a flagged keyframe's closures once moving_returns_neighbours keyframes
+// follow it (the keyframes after it waiting with it, in order), any other's at once, and the
+// ones still waiting at the end of the input.
+TEST(MovingReturns, AKeyframeWhoseScanMayHoldACarAheadWaitsForTheKeyframesAfterIt) {
+  struct SearchLog : slam::PipelineObserver {
+    const slam::Map* map = nullptr;
+    std::vector<std::pair<size_t, size_t>> searches;  // keyframe searched, keyframes in the map then
+    void onCandidates(const slam::CandidatesEvent& e) override { searches.emplace_back(e.keyframe, map->size()); }
+  };
+  std::mt19937 rng(10);
+  for (const double car_speed : {8.0, 0.0}) {
+    const Pass p = drive(0, 12, 14, car_speed, -2, rng);
+    slam::PipelineOptions options;
+    slam::PipelineStats stats;
+    SearchLog log;
+    std::vector<slam::PipelineObserver*> observers{&log};
+    slam::Map map(std::make_unique<esdf::Esdf>(), 2.0);
+    log.map = &map;
+    slam::GlobalSlam global(options, map, stats, observers);
+    slam::KeyframeConstraint c;
+    c.cov = Eigen::Vector3d(1e-4, 1e-4, 1e-6).asDiagonal();
+    for (size_t k = 0; k < p.scans.size(); ++k) {
+      c.z = k == 0 ? common::Pose2{} : common::between(p.poses[k - 1], p.poses[k]);
+      global.addKeyframe({k, 0.1 * static_cast<double>(k), {}, true, false, {}}, io::CompactScan(p.scans[k]), c);
+      global.closeLoops(k, std::chrono::steady_clock::now());
+    }
+    global.finish();
+    const size_t n = p.scans.size(), lag = static_cast<size_t>(options.loop_closure.moving_returns_neighbours);
+    ASSERT_EQ(log.searches.size(), n) << car_speed;
+    size_t waited = 0;
+    for (size_t i = 0; i < n; ++i) {
+      EXPECT_EQ(log.searches[i].first, i);  // in order, each once
+      if (log.searches[i].second > i + 1) {
+        ++waited;
+        // A keyframe waits for the keyframes after it (at most lag of them; the end of the input).
+        EXPECT_LE(log.searches[i].second, std::min(n, i + lag + 1)) << i;
+      }
+      if (i + lag < n && slam::seesThroughEarlier(map, i, lag, [&](size_t j) { return p.poses[j]; }, {}))
+        EXPECT_EQ(log.searches[i].second, i + lag + 1) << i;
+    }
+    if (car_speed > 0) {
+      EXPECT_GT(waited, n / 2);  // the car ahead is in every scan
+    } else {
+      EXPECT_EQ(waited, 0u);  // a parked car: every keyframe searched at once
+    }
+  }
 }

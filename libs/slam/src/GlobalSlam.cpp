@@ -8,6 +8,7 @@
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/esdf/PoseOps.h"
 #include "urbanslam/laser_loop/LoopDetector.h"
+#include "urbanslam/slam/MovingReturns.h"
 
 namespace urbanslam::slam {
 
@@ -324,11 +325,23 @@ bool GlobalSlam::cameraConfirms(const LoopClosureRecord& r, const std::optional<
 size_t GlobalSlam::searchLag() const { return static_cast<size_t>(std::max(0, options_.loop_closure.moving_returns_neighbours)); }
 
 void GlobalSlam::closeLoops(size_t newest, SteadyTime handed_over) {
-  for (; next_search_ + searchLag() <= newest; ++next_search_) searchLoopsEvery(next_search_, handed_over);
+  if (map_.filter() && searchLag() > 0) {
+    MovingReturnsOptions o;  // the loop closer's judges' margins and widths
+    const auto pose = [&](size_t j) { return esdf::toPose(map_.nodes()->mean(j)); };
+    if (seesThroughEarlier(map_, newest, searchLag(), pose, o)) waiting_.push_back(newest);
+  }
+  while (next_search_ <= newest) {
+    if (!waiting_.empty() && waiting_.front() == next_search_) {
+      if (next_search_ + searchLag() > newest) break;
+      waiting_.pop_front();
+    }
+    searchLoopsEvery(next_search_++, handed_over);
+  }
 }
 
 void GlobalSlam::closePendingLoops(SteadyTime handed_over) {
   for (; next_search_ < map_.size(); ++next_search_) searchLoopsEvery(next_search_, handed_over);
+  waiting_.clear();
 }
 
 void GlobalSlam::searchLoopsEvery(size_t current, SteadyTime handed_over) {

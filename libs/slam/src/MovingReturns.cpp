@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "urbanslam/slam/FreeSpaceCache.h"
 #include "urbanslam/slam/Map.h"
 
 namespace urbanslam::slam {
@@ -41,6 +42,24 @@ size_t hideMovingReturns(io::LaserScan& scan, const std::vector<ScanJudge>& judg
   close();
   for (size_t b : hide) scan.valid[b] = 0;
   return hide.size();
+}
+
+bool seesThroughEarlier(const Map& map, size_t k, size_t before, const std::function<common::Pose2(size_t)>& pose,
+                        const MovingReturnsOptions& options) {
+  if (before == 0 || !map.keyframes()[k].hasScan()) return false;
+  const io::LaserScan current = map.scan(k);
+  if (current.size() == 0) return false;
+  MovingReturnsOptions one = options;
+  one.min_views = 1;  // the one judge: the current scan
+  const alignment::BeamFreeSpace free = scanFreeSpace(current, one.margin_m, one.margin_fraction);
+  const common::Pose2 here = pose(k);
+  for (size_t j = k > before ? k - before : 0; j < k; ++j) {
+    if (!map.keyframes()[j].hasScan()) continue;
+    io::LaserScan earlier = map.scan(j);
+    if (earlier.size() == 0) continue;
+    if (hideMovingReturns(earlier, {{&free, common::between(pose(j), here)}}, one) > 0) return true;
+  }
+  return false;
 }
 
 MovingReturns::MovingReturns(const MovingReturnsOptions& options, size_t cached_keyframes)

@@ -595,6 +595,9 @@ void GlobalSlam::writeState(BinaryWriter& w) const {
   closures_.forEach([&](const LoopClosureRecord& c) { writeRecord(w, c); });
   w.boolean(dirty_since_recovery_);
   w.size(last_full_size_);
+  w.size(next_search_);
+  w.size(waiting_.size());
+  for (size_t k : waiting_) w.size(k);
 }
 
 void GlobalSlam::readState(BinaryReader& r, std::uint32_t format_version) {
@@ -612,8 +615,18 @@ void GlobalSlam::readState(BinaryReader& r, std::uint32_t format_version) {
   }
   dirty_since_recovery_ = r.boolean();
   last_full_size_ = r.size();
-  // A map is saved before the end of its input: its last keyframes' closures were still to seek.
-  next_search_ = n > searchLag() ? n - searchLag() : 0;
+  waiting_.clear();
+  if (format_version >= 14) {
+    next_search_ = r.size();
+    for (size_t i = 0, count = r.count(8); i < count; ++i) waiting_.push_back(r.size());
+    if (next_search_ > n || std::any_of(waiting_.begin(), waiting_.end(), [&](size_t k) { return k < next_search_ || k >= n; }))
+      throw common::InputError("global SLAM's keyframes awaiting their loop search are not in the map");
+  } else {
+    // Saved before its input ended, by a build that sought every keyframe's closures
+    // searchLag() keyframes after it: its last ones still wait.
+    next_search_ = n > searchLag() ? n - searchLag() : 0;
+    for (size_t k = next_search_; k < n; ++k) waiting_.push_back(k);
+  }
   // The classifier's keyframe features are not saved: a function of each keyframe's scan,
   // computed when first needed (laserDetector()).
 }

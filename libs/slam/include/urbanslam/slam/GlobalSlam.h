@@ -53,18 +53,21 @@ class GlobalSlam {
   // The same with the constraint from keyframe `from` (the first keyframe of a session joined to
   // the map: Pipeline::appendSession).
   std::array<double, 9> addKeyframeFrom(size_t from, Keyframe kf, io::CompactScan scan, const KeyframeConstraint& constraint);
-  // Keyframe `newest` is in the map: loop closures of the keyframes up to searchLag() before it
-  // with earlier ones, each when [loop_closure] asks for it then. `handed_over`: when local SLAM
-  // handed `newest` over, for the correction's latency.
+  // Keyframe `newest` is in the map: loop closures with earlier keyframes of every keyframe up to
+  // `newest` not yet searched, in order, each when [loop_closure] asks for it then; one whose
+  // scan may hold something moving ahead (seesThroughEarlier) stops the search until
+  // searchLag() keyframes follow it. `handed_over`: when local SLAM handed `newest` over, for
+  // the correction's latency.
   void closeLoops(size_t newest, SteadyTime handed_over);
   // The keyframes still waiting for their search searched now, judged by the keyframes the map
   // holds: at the end of the input, and before another session's keyframes follow this map's.
   void closePendingLoops(SteadyTime handed_over);
-  // How many keyframes a keyframe's loop closures wait for: its scan's moving returns are judged
-  // by the keyframes after it as well as before ([loop_closure] moving_returns_neighbours), or
-  // the car ahead of it, which only later scans see through, pulls its alignments along the
-  // street. A saved map keeps its last searchLag() keyframes unsearched, so that a continued run
-  // searches them as one run over both logs does; finish() searches them.
+  // How many keyframes a keyframe's loop closures wait for when its scan sees through where the
+  // keyframes before it saw something ([loop_closure] moving_returns_neighbours): the car ahead
+  // that moved there, which only later scans see through, would pull its alignments along the
+  // street. Any other keyframe is searched at once (closures that land late cost where local
+  // SLAM takes the corrected submap). A saved map keeps the keyframes still waiting, so that a
+  // continued run searches them as one run over both logs does; finish() searches them.
   size_t searchLag() const;
   // Whether a camera closure between the two keyframes may measure the full pose: where the
   // estimate knows their relative position within [loop_closure] appearance_min_sigma_m (largest
@@ -172,9 +175,10 @@ class GlobalSlam {
   // The first closure since the last full recovery: its keyframe and when local SLAM handed
   // that over (not saved: a resumed run has no clock of the earlier one's).
   std::optional<std::pair<size_t, SteadyTime>> unrecovered_closure_;
-  // The first keyframe whose loop closures have not been sought (a map read back: its last
-  // searchLag() keyframes).
+  // The first keyframe whose loop closures have not been sought, and the keyframes from there on
+  // that wait for searchLag() keyframes after them (seesThroughEarlier), oldest first.
   size_t next_search_ = 0;
+  std::deque<size_t> waiting_;
   // The closures accepted since the last closureAdded (not saved: a checkpoint falls between steps).
   std::vector<LoopClosureRecord> added_;
 };

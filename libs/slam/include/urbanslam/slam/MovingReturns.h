@@ -46,6 +46,12 @@ struct ScanJudge {
 // returns how many.
 size_t hideMovingReturns(io::LaserScan& scan, const std::vector<ScanJudge>& judges, const MovingReturnsOptions& options);
 
+// Whether keyframe k's scan sees through a run of returns (min_width_m or more) of one of the
+// `before` keyframes before it, each placed by `pose`: something there moved (a car ahead that
+// drove on) and may still be in k's view, where only the keyframes after k see through it.
+bool seesThroughEarlier(const Map& map, size_t k, size_t before, const std::function<common::Pose2(size_t)>& pose,
+                        const MovingReturnsOptions& options);
+
 // A map's keyframe scans without their moving returns. The judges' free space is kept for the
 // keyframes used lately (a keyframe's scan never changes): consecutive closure attempts judge
 // neighbouring keyframes, which share most of their judges.
