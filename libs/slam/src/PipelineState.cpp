@@ -622,8 +622,9 @@ void GlobalSlam::readState(BinaryReader& r, std::uint32_t format_version) {
     if (next_search_ > n || std::any_of(waiting_.begin(), waiting_.end(), [&](size_t k) { return k < next_search_ || k >= n; }))
       throw common::InputError("global SLAM's keyframes awaiting their loop search are not in the map");
   } else {
-    // Saved before its input ended, by a build that sought every keyframe's closures
-    // searchLag() keyframes after it: its last ones still wait.
+    // No cursor before version 14: the last searchLag() keyframes are taken as waiting, as a
+    // build that made every keyframe wait left them. A map from a build that searched each
+    // keyframe at once has them searched a second time when it is continued.
     next_search_ = n > searchLag() ? n - searchLag() : 0;
     for (size_t k = next_search_; k < n; ++k) waiting_.push_back(k);
   }
