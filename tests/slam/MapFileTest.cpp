@@ -211,9 +211,9 @@ TEST(MapFile, AVersion3FileIsReadAsAMapWithoutSeparateMaps) {
     ASSERT_TRUE(a.count(tag) && b.count(tag)) << tag;
     EXPECT_TRUE(a.at(tag) == b.at(tag)) << "section " << tag << " differs";
   }
-  // Global SLAM's section as it was, then the loop search's cursor: a map saved before its
-  // input ended, by a build that sought each keyframe's closures moving_returns_neighbours (5)
-  // keyframes after it, has its last ones (here all three) waiting.
+  // Global SLAM's section as it was, then the loop search's cursor: a map saved by a build
+  // that searched each keyframe's closures when it was added has every keyframe searched and
+  // none waiting.
   ASSERT_TRUE(a.count("GLOB") && b.count("GLOB"));
   const std::string& glob_old = a.at("GLOB");
   const std::string& glob_now = b.at("GLOB");
@@ -222,10 +222,9 @@ TEST(MapFile, AVersion3FileIsReadAsAMapWithoutSeparateMaps) {
   const std::string cursor = glob_now.substr(glob_old.size());
   common::BinaryReader r(cursor.data(), cursor.size(), "cursor");
   const size_t n = loaded->keyframes().size();
-  ASSERT_LT(n, 5u);
+  ASSERT_GT(n, 0u);
+  EXPECT_EQ(r.size(), n);
   EXPECT_EQ(r.size(), 0u);
-  ASSERT_EQ(r.size(), n);
-  for (size_t k = 0; k < n; ++k) EXPECT_EQ(r.size(), k);
   // The filter as it was, with its chain's lineages (each pose's root and lineage, 8 bytes) and
   // then no record of factors since its factorisation (a count of 0 and false: it refactorises at
   // its next exact covariance) and the keyframe nodes of a reduced pose graph (the default) with

@@ -622,11 +622,10 @@ void GlobalSlam::readState(BinaryReader& r, std::uint32_t format_version) {
     if (next_search_ > n || std::any_of(waiting_.begin(), waiting_.end(), [&](size_t k) { return k < next_search_ || k >= n; }))
       throw common::InputError("global SLAM's keyframes awaiting their loop search are not in the map");
   } else {
-    // No cursor before version 14: the last searchLag() keyframes are taken as waiting, as a
-    // build that made every keyframe wait left them. A map from a build that searched each
-    // keyframe at once has them searched a second time when it is continued.
-    next_search_ = n > searchLag() ? n - searchLag() : 0;
-    for (size_t k = next_search_; k < n; ++k) waiting_.push_back(k);
+    // No cursor before version 14: every build that wrote one searched each keyframe's loop
+    // closures when it was added, so every keyframe is taken as searched (searching one again
+    // could add a closure on a pair already closed, its information counted twice).
+    next_search_ = n;
   }
   // The classifier's keyframe features are not saved: a function of each keyframe's scan,
   // computed when first needed (laserDetector()).
