@@ -17,7 +17,10 @@
 #   fixes               fixes found (place search or classifier + alignment), of them by the classifier
 #   support             the session's scans supporting the join (fixes and their confirmations)
 #   err_m, err_deg      for a join, the error of its transform against the truth (the simulator's
-#                       poses at both sessions' first keyframes)
+#                       poses at both sessions' first keyframes): the prior the session hangs from
+#                       when it joins (its fix nearest to the session's start)
+#   placed_m            for a join, the farthest any of the session's keyframes lies in the merged
+#                       map (pose_graph.g2o, optimised jointly) from its true place in the map's frame
 #   merge_s             wall time of `urbanslam merge`
 # Environment: SAME="3 4 5" (route seeds through city 1), OTHER="2 3" (city seeds), ROUTE_KM.
 set -euo pipefail
@@ -33,7 +36,7 @@ session() {  # name city_seed route_seed
   [ -f "$OUT/$1/stats.json" ] || "$U" run --quiet --simulate "$OUT/$1.ini" --out "$OUT/$1"
 }
 session map 1 1
-printf "%-8s %4s %8s %-6s %8s %8s %7s %6s %7s %7s\n" session city shared_m joined searches fixes support err_m err_deg merge_s
+printf "%-8s %4s %8s %-6s %8s %8s %7s %6s %7s %8s %7s\n" session city shared_m joined searches fixes support err_m err_deg placed_m merge_s
 rows() {  # name city
   local rc=0 start end
   start=$(date +%s.%N)
@@ -68,17 +71,29 @@ if city == "1":
         near = (c for dx in (-1, 0, 1) for dy in (-1, 0, 1) for c in cells[(int(p[1] // 6) + dx, int(p[2] // 6) + dy)])
         if any(math.hypot(c[1] - p[1], c[2] - p[2]) < 6 and abs(math.atan2(math.sin(c[3] - p[3]), math.cos(c[3] - p[3]))) < math.radians(30) for c in near):
             shared += math.hypot(p[1] - q[i - 1][1], p[2] - q[i - 1][2])
-err_m = err_deg = "-"
+err_m = err_deg = placed_m = "-"
 if s.get("joined"):
     (_, ax, ay, ap), (_, bx, by, bp) = m[0], q[0]
+    # The session's keyframes are the merged map's from its first_keyframe on, in their order.
+    merged = {}
+    for l in open(f"{out}/merged-{name}/pose_graph.g2o"):
+        f = l.split()
+        if f and f[0] == "VERTEX_SE2": merged[int(f[1])] = (float(f[2]), float(f[3]))
+    c0, s0 = math.cos(ap), math.sin(ap)
+    far = 0.0
+    for k, p in enumerate(q):
+        e = merged[s["first_keyframe"] + k]
+        tx, ty = c0 * (p[1] - ax) + s0 * (p[2] - ay), -s0 * (p[1] - ax) + c0 * (p[2] - ay)
+        far = max(far, math.hypot(e[0] - tx, e[1] - ty))
+    placed_m = "%.2f" % far
     # truth of the session's frame in the map's: inverse(A0) * B0
     c, sn = math.cos(ap), math.sin(ap)
     tx, ty, tp = c * (bx - ax) + sn * (by - ay), -sn * (bx - ax) + c * (by - ay), bp - ap
     t = s["transform"]
     err_m = "%.2f" % math.hypot(t["x"] - tx, t["y"] - ty)
     err_deg = "%.2f" % abs(math.degrees(math.atan2(math.sin(t["phi"] - tp), math.cos(t["phi"] - tp))))
-print("%-8s %4s %8.0f %-6s %8d %8s %7d %6s %7s %7.1f" % (name, city, shared, "yes" if s.get("joined") else "no", s.get("place_searches", 0),
-      "%d/%d" % (s.get("fixes", 0), s.get("fixes_laser", 0)), s.get("scans_agreeing", 0), err_m, err_deg, merge_s))
+print("%-8s %4s %8.0f %-6s %8d %8s %7d %6s %7s %8s %7.1f" % (name, city, shared, "yes" if s.get("joined") else "no", s.get("place_searches", 0),
+      "%d/%d" % (s.get("fixes", 0), s.get("fixes_laser", 0)), s.get("scans_agreeing", 0), err_m, err_deg, placed_m, merge_s))
 PY
 }
 for r in ${SAME-3 4 5}; do session "route$r" 1 "$r"; rows "route$r" 1; done
