@@ -250,6 +250,12 @@ GlobalSlam::Admission GlobalSlam::admitJointly(LoopClosureRecord r, size_t curre
 GlobalSlam::Admission GlobalSlam::admit(LoopClosureRecord r, size_t current, MeasuredBy measured,
                                         const std::optional<CameraPairView>& view) {
   const size_t window = static_cast<size_t>(options_.loop_closure.confirm_window);
+  if (contradicts_join_ && (r.reason == ClosureReason::None || r.reason == ClosureReason::Gating) && contradicts_join_(r)) {
+    r.accepted = false;
+    r.reason = ClosureReason::Join;
+    reportClosure(r);
+    return Admission::Rejected;
+  }
   if (window > 0 && waitsForJointGate(r)) return admitJointly(std::move(r), current);
   if (!r.accepted) {
     reportClosure(r);

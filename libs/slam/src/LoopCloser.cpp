@@ -53,6 +53,8 @@ const char* reasonName(ClosureReason reason) {
       return "submaps";
     case ClosureReason::SceneDepth:
       return "scene_depth";
+    case ClosureReason::Join:
+      return "join";
   }
   return "";
 }

@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "urbanslam/common/Error.h"
+#include "urbanslam/esdf/PoseOps.h"
 #include "urbanslam/slam/Pipeline.h"
 
 namespace urbanslam::slam {
@@ -46,6 +47,28 @@ void Pipeline::appendSession(const Pipeline& session, const SessionJoin& join) {
     if (!e.loop_closure && e.from < e.to && e.to < chain.size() && (!chain[e.to] || e.from > chain[e.to]->from)) chain[e.to] = e;
   });
 
+  // The session's first keyframe hangs from the map by the join's transform with the join's
+  // drift allowance over the session's path to the anchor fix (tens of metres for a fix kilometres
+  // into a drive), and the fixes tie the session down only when their keyframes are appended.
+  // Before that, a closure of the session's keyframes with this map must put the keyframe where
+  // one of the join's fixes does, as two fixes must agree to join (agreesWithJoin): a look-alike
+  // place of the map inside the allowance would otherwise take the whole session there.
+  size_t first_fix = other.size();
+  for (size_t i : join.agreeing) first_fix = std::min(first_fix, join.fixes[i].keyframe);
+  std::vector<double> path_m(other.size(), 0.0);
+  for (size_t k = 1; k < other.size(); ++k) {
+    const common::Pose2 &a = other.keyframes()[k - 1].pose, &b = other.keyframes()[k].pose;
+    path_m[k] = path_m[k - 1] + std::hypot(b.x - a.x, b.y - a.y);
+  }
+  global_.setJoinCheck([&, n0, first_fix](const LoopClosureRecord& r) {
+    if (r.from >= n0 || r.to < n0 || r.to >= n0 + first_fix) return false;
+    const common::Pose2 claimed = common::compose(esdf::toPose(map_.nodes()->mean(r.from)), r.measurement);
+    return !agreesWithJoin(join, r.to - n0, other.keyframes()[r.to - n0].pose, path_m, claimed);
+  });
+  struct ClearedAtExit {  // also when a bad session throws below: the check refers to this call's locals
+    GlobalSlam& global;
+    ~ClearedAtExit() { global.setJoinCheck({}); }
+  } cleared{global_};
   const auto now = std::chrono::steady_clock::now();
   for (const Keyframe& k : other.keyframes()) {
     KeyframeConstraint c;
@@ -83,6 +106,7 @@ void Pipeline::appendSession(const Pipeline& session, const SessionJoin& join) {
     // Loop closures as a run finds them: against this map and the session's earlier keyframes.
     global_.closeLoops(n0 + k.index, now);
   }
+  global_.setJoinCheck({});  // the fixes are in
   map_.appendTrajectory(other, n0);
   session.reference_.forEach([&](const io::StampedPose& p) { reference_.push_back(p); });
 

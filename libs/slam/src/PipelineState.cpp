@@ -156,7 +156,7 @@ LoopClosureRecord readRecord(BinaryReader& r, size_t keyframes, std::uint32_t fo
   c.score = r.f64();
   c.accepted = r.boolean();
   const std::uint8_t reason = r.u8();
-  if (reason > static_cast<std::uint8_t>(ClosureReason::SceneDepth)) r.fail("loop closure reason " + std::to_string(reason));
+  if (reason > static_cast<std::uint8_t>(ClosureReason::Join)) r.fail("loop closure reason " + std::to_string(reason));
   c.reason = static_cast<ClosureReason>(reason);
   c.measurement = readPose(r);
   c.information = r.matrix<3, 3>();

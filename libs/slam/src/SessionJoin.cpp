@@ -352,8 +352,22 @@ void SessionJoiner::decide(const Map& session) {
   for (size_t j : out.agreeing)
     if (path_[out.fixes[j].keyframe] < path_[out.fixes[anchor].keyframe]) anchor = j;
   out.transform = out.fixes[anchor].transform;
+  out.options = o;
   const double sxy = o.agree_m + o.agree_per_m * path_[out.fixes[anchor].keyframe], sphi = o.agree_deg * kDeg;
   out.transform_cov = Eigen::Vector3d(sxy * sxy, sxy * sxy, sphi * sphi).asDiagonal();
+}
+
+bool agreesWithJoin(const SessionJoin& join, size_t keyframe, const common::Pose2& pose, const std::vector<double>& path_m,
+                    const common::Pose2& claimed) {
+  const SessionJoinOptions& o = join.options;
+  const auto path = [&](size_t k) { return k < path_m.size() ? path_m[k] : 0.0; };
+  return std::any_of(join.agreeing.begin(), join.agreeing.end(), [&](size_t i) {
+    const SessionFix& f = join.fixes[i];
+    const common::Pose2 joined = common::compose(f.transform, pose);
+    return std::hypot(claimed.x - joined.x, claimed.y - joined.y) <=
+               o.agree_m + o.agree_per_m * std::abs(path(keyframe) - path(f.keyframe)) &&
+           std::abs(common::wrapToPi(claimed.phi - joined.phi)) <= o.agree_deg * kDeg;
+  });
 }
 
 SessionJoin findSessionJoin(const Map& map, const PipelineOptions& map_options, const Map& session, const SessionJoinOptions& options,

@@ -62,6 +62,10 @@ class GlobalSlam {
   // The keyframes still waiting for their search searched now, judged by the keyframes the map
   // holds: at the end of the input, and before another session's keyframes follow this map's.
   void closePendingLoops(SteadyTime handed_over);
+  // While a merged session hangs from its join only (Pipeline::appendSession): a closure this
+  // says puts the session's keyframe elsewhere than the join does is refused (reason Join).
+  // Empty: none.
+  void setJoinCheck(std::function<bool(const LoopClosureRecord&)> contradicts_join) { contradicts_join_ = std::move(contradicts_join); }
   // How many keyframes a keyframe's loop closures wait for when its scan sees through where the
   // keyframes before it saw something ([loop_closure] moving_returns_neighbours): the car ahead
   // that moved there, which only later scans see through, would pull its alignments along the
@@ -181,6 +185,7 @@ class GlobalSlam {
   std::deque<size_t> waiting_;
   // The closures accepted since the last closureAdded (not saved: a checkpoint falls between steps).
   std::vector<LoopClosureRecord> added_;
+  std::function<bool(const LoopClosureRecord&)> contradicts_join_;  // setJoinCheck
 };
 
 }  // namespace urbanslam::slam

@@ -50,6 +50,7 @@ enum class ClosureReason {
   NoOverlap,            // nowhere the gate admits could the scans share min_matched_fraction (not aligned)
   Submaps,              // the two visits' path submaps have another alignment nearly as good (a repeated street)
   SceneDepth,           // camera alone: at the estimated distance the shared scene would lie beyond max_scene_depth_m
+  Join,                 // a merged session's keyframe put where none of its join's fixes puts it, before they tie it
 };
 // Its name in loop_closures.csv and in observer events ("" for None).
 const char* reasonName(ClosureReason reason);

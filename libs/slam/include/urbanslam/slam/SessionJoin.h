@@ -102,7 +102,16 @@ struct SessionJoin {
   size_t agreeing_scans = 0;       // the session's scans that support them (their own and their confirmations)
   size_t contradicting_scans = 0;  // the session's scans checked against them that did not land where they say
   size_t rival = 0;                // the session's scans of the largest set of fixes that disagrees with the join
+  SessionJoinOptions options;      // what it was judged by
 };
+
+// Whether `claimed`, a place in the map for the session's keyframe `keyframe` (a closure's), is
+// where one of the join's agreeing fixes puts it, as two fixes must agree: within agree_m plus
+// agree_per_m times the session's path between the keyframe and that fix (its drift), and
+// agree_deg (SessionJoinOptions). `pose`: the keyframe's pose in the session's frame; `path_m`:
+// the session's path length at each of its keyframes.
+bool agreesWithJoin(const SessionJoin& join, size_t keyframe, const common::Pose2& pose, const std::vector<double>& path_m,
+                    const common::Pose2& claimed);
 
 // The search kept up to date while the session grows (a run that joins a map as it goes):
 // update() probes the keyframes added since the last call.
