@@ -8,10 +8,12 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Dense>
 
+#include "CameraAhead.h"
 #include "ConstantScan.h"
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/slam/GlobalSlam.h"
@@ -248,17 +250,8 @@ TEST(GlobalSlam, TwoClosuresJustBeyondTheGateGoInWhenTheyAgreeAndPassItJointly) 
     driveStraight(*r, Eigen::Vector3d(0.09, 0.09, 1e-6).asDiagonal());
     // Keyframes 150 -> 200 and 151 -> 201: 50 m along x, 2.1 m uncertain (sigma); each measured
     // `shift` metres longer.
-    for (const auto& [earlier, shift] : {std::make_pair(size_t{150}, shift1_m), std::make_pair(size_t{151}, shift2_m)}) {
-      slam::CameraMeasurement m;
-      m.mount = common::Pose2{0.0, 0.0, 0.0};
-      m.relative.valid = true;
-      m.relative.cov = Eigen::Vector2d(1e-4, 1e-4).asDiagonal();
-      m.relative.depth_per_baseline = 0.5;  // a scene 20-25 m away, within max_scene_depth_m
-      m.metric.valid = true;
-      m.metric.pose = common::Pose2{50.0 + shift, 0.0, 0.0};
-      m.metric.cov = Eigen::Vector3d(1e-4, 1e-4, 1e-6).asDiagonal();
-      r->global->proposeImageClosure(earlier, earlier + 50, 1.0, m, std::chrono::steady_clock::now());
-    }
+    for (const auto& [earlier, shift] : {std::make_pair(size_t{150}, shift1_m), std::make_pair(size_t{151}, shift2_m)})
+      r->global->proposeImageClosure(earlier, earlier + 50, 1.0, test::cameraAhead(50.0 + shift), std::chrono::steady_clock::now());
     r->global->finish();
     return r->global->closures();
   };
@@ -281,6 +274,47 @@ TEST(GlobalSlam, TwoClosuresJustBeyondTheGateGoInWhenTheyAgreeAndPassItJointly) 
   EXPECT_EQ(count(run(11.0, 11.0, true), false, slam::ClosureReason::Gating), 2);   // d^2 27: beyond the pair's quantile too
 }
 
+// Keyframes 0..205 with each step 1 m uncertain (sigma): keyframe 200 is 7 m uncertain relative
+// to keyframe 150, as a merged session hanging loosely from a map. Two agreeing closures from 150
+// and 151 measure it `measured_m` ahead; the join check refuses any that is not within 1 m of
+// 50 m. Returns the closures, and keyframe 200's estimate relative to 150 along x at the end.
+std::pair<std::vector<slam::LoopClosureRecord>, double> closuresWithJoinCheck(double measured_m, bool check, int confirm_window) {
+  ::Run r;
+  r.options.loop_closure.appearance_min_sigma_m = 100;  // the camera's full pose is taken however uncertain the estimate
+  r.options.loop_closure.confirm_window = confirm_window;
+  driveStraight(r, Eigen::Vector3d(1.0, 1.0, 1e-6).asDiagonal());
+  if (check) r.global->setJoinCheck([](const slam::LoopClosureRecord& c) { return std::abs(c.measurement.x - 50.0) > 1.0; });
+  for (size_t earlier : {size_t{150}, size_t{151}})
+    r.global->proposeImageClosure(earlier, earlier + 50, 1.0, test::cameraAhead(measured_m), std::chrono::steady_clock::now());
+  r.global->finish();
+  return {r.global->closures(), r.map.nodes()->mean(200)(0) - r.map.nodes()->mean(150)(0)};
+}
+
+TEST(GlobalSlam, RefusesTheClosuresTheJoinCheckSaysContradictTheJoin) {
+  // 10 m off: inside the filter's gate (d^2 = 100 / 50 = 2), so without the check the look-alike
+  // place goes in.
+  const auto unchecked = closuresWithJoinCheck(60.0, false, 3).first;
+  EXPECT_TRUE(std::any_of(unchecked.begin(), unchecked.end(), [](const slam::LoopClosureRecord& c) { return c.accepted; }));
+  const auto refused = closuresWithJoinCheck(60.0, true, 3).first;
+  ASSERT_EQ(refused.size(), 2u);
+  for (const auto& c : refused) {
+    EXPECT_FALSE(c.accepted);
+    EXPECT_EQ(c.reason, slam::ClosureReason::Join);
+    EXPECT_STREQ(slam::reasonName(c.reason), "join");
+  }
+  const auto agreeing = closuresWithJoinCheck(50.3, true, 3).first;
+  ASSERT_EQ(agreeing.size(), 2u);
+  for (const auto& c : agreeing) EXPECT_TRUE(c.accepted);
+  // Without confirmation the loop closer would add a closure to the filter itself: under a join
+  // check it leaves that to the check. Refused, the filter keeps its 50 m; agreeing, it goes in.
+  const auto [at_once_refused, refused_m] = closuresWithJoinCheck(60.0, true, 0);
+  for (const auto& c : at_once_refused) EXPECT_EQ(c.reason, slam::ClosureReason::Join);
+  EXPECT_NEAR(refused_m, 50.0, 1e-6);
+  const auto [at_once_agreeing, agreeing_m] = closuresWithJoinCheck(50.3, true, 0);
+  EXPECT_TRUE(std::all_of(at_once_agreeing.begin(), at_once_agreeing.end(), [](const slam::LoopClosureRecord& c) { return c.accepted; }));
+  EXPECT_NEAR(agreeing_m, 50.3, 0.05);
+}
+
 TEST(GlobalSlam, AHypothesisWithNoRoomToWaitForItsConfirmationIsOnRecordAsUnconfirmed) {
   // Five camera closures of keyframe 205, each within the gate, none confirming another (they
   // name one keyframe, and a confirmation comes from a later one): four may wait (4 x
@@ -289,15 +323,7 @@ TEST(GlobalSlam, AHypothesisWithNoRoomToWaitForItsConfirmationIsOnRecordAsUnconf
   r->options.loop_closure.confirm_window = 1;
   driveStraight(*r, Eigen::Vector3d(0.09, 0.09, 1e-6).asDiagonal());
   for (const double shift_m : {0.0, 1.0, -1.0, 2.0, -2.0}) {
-    slam::CameraMeasurement m;
-    m.mount = common::Pose2{0.0, 0.0, 0.0};
-    m.relative.valid = true;
-    m.relative.cov = Eigen::Vector2d(1e-4, 1e-4).asDiagonal();
-    m.relative.depth_per_baseline = 0.5;
-    m.metric.valid = true;
-    m.metric.pose = common::Pose2{50.0 + shift_m, 0.0, 0.0};
-    m.metric.cov = Eigen::Vector3d(1e-4, 1e-4, 1e-6).asDiagonal();
-    r->global->proposeImageClosure(155, 205, 1.0, m, std::chrono::steady_clock::now());
+    r->global->proposeImageClosure(155, 205, 1.0, test::cameraAhead(50.0 + shift_m), std::chrono::steady_clock::now());
   }
   r->global->finish();
   const std::vector<slam::LoopClosureRecord> closures = r->global->closures();

@@ -261,8 +261,9 @@ GlobalSlam::Admission GlobalSlam::admit(LoopClosureRecord r, size_t current, Mea
     reportClosure(r);
     return Admission::Rejected;
   }
-  if (window == 0) {  // tryClose already added it to the filter
-    map_.addEdge({r.from, current, r.measurement, r.information, true});
+  if (window == 0) {
+    if (!closerCommits()) return commit({&r});                            // gated, not yet added: the join check came first
+    map_.addEdge({r.from, current, r.measurement, r.information, true});  // tryClose added it to the filter
     reportClosure(r);
     return Admission::Accepted;
   }
@@ -293,6 +294,8 @@ GlobalSlam::Admission GlobalSlam::admit(LoopClosureRecord r, size_t current, Mea
   reportExpired(std::move(r));
   return Admission::Rejected;
 }
+
+bool GlobalSlam::closerCommits() const { return options_.loop_closure.confirm_window == 0 && !contradicts_join_; }
 
 GlobalSlam::Admission GlobalSlam::commit(std::initializer_list<LoopClosureRecord*> records) {
   bool accepted = false;
@@ -366,13 +369,12 @@ void GlobalSlam::searchLoops(size_t current, SteadyTime handed_over) {
   std::vector<size_t> keyframes;
   for (const Candidate& c : cands) keyframes.push_back(c.keyframe);
   for (auto* o : observers_) o->onCandidates({current, &keyframes});
-  const bool confirm = options_.loop_closure.confirm_window > 0;
   bool accepted = false;
   for (const Candidate& c : cands) {
     // 7-9. Alignment and gating (the update itself waits for a confirmation).
     ++stats_.closures_tried;
     const Detection* detection = c.detection ? &*c.detection : nullptr;
-    if (admit(closer_.tryClose(*map_.nodes(), map_, c.keyframe, current, !confirm, detection, recentClosure(current)), current) ==
+    if (admit(closer_.tryClose(*map_.nodes(), map_, c.keyframe, current, closerCommits(), detection, recentClosure(current)), current) ==
         Admission::Accepted) {
       accepted = true;
       break;  // one closure per keyframe; the next keyframe sees the corrected map
@@ -444,19 +446,18 @@ void GlobalSlam::proposeImageClosure(size_t earlier, size_t current, double scor
     // else the camera's own relative pose; then gating and confirmation by a second closure.
     common::Stopwatch sw;
     expirePending(current);
-    const bool confirm = options_.loop_closure.confirm_window > 0;
     const Detection detection{Proposer::Image, score};
     KeyframeNodes& f = *map_.nodes();
     LoopClosureRecord r;
     std::optional<CameraPairView> view;
     if (scans) {
-      r = closer_.tryClose(f, map_, earlier, current, !confirm, &detection, recentClosure(current));
+      r = closer_.tryClose(f, map_, earlier, current, closerCommits(), &detection, recentClosure(current));
       if (camera) view = CameraPairView{earlier, current, *camera};
     } else {
       CameraMeasurement m = *camera;
       if (m.metric.valid && !allowsFullCameraPose(earlier, current)) m.metric.valid = false;
       const esdf::RelativeFactor factor = cameraFactor(m, f.mean(earlier), f.mean(current));
-      r = closer_.tryCloseMeasured(f, map_, earlier, current, factor.z, factor.omega, !confirm, detection, &m);
+      r = closer_.tryCloseMeasured(f, map_, earlier, current, factor.z, factor.omega, closerCommits(), detection, &m);
     }
     ++stats_.closures_tried;
     const ClosureReason reason = r.reason;

@@ -65,7 +65,9 @@ void Pipeline::appendSession(const Pipeline& session, const SessionJoin& join) {
     const common::Pose2 claimed = common::compose(esdf::toPose(map_.nodes()->mean(r.from)), r.measurement);
     return !agreesWithJoin(join, r.to - n0, other.keyframes()[r.to - n0].pose, path_m, claimed);
   });
-  struct ClearedAtExit {  // also when a bad session throws below: the check refers to this call's locals
+  // Cleared when this call returns or throws (a bad session): it refers to this call's locals, and
+  // the closures it is for are all sought in the loop below.
+  struct ClearedAtExit {
     GlobalSlam& global;
     ~ClearedAtExit() { global.setJoinCheck({}); }
   } cleared{global_};
@@ -106,7 +108,6 @@ void Pipeline::appendSession(const Pipeline& session, const SessionJoin& join) {
     // Loop closures as a run finds them: against this map and the session's earlier keyframes.
     global_.closeLoops(n0 + k.index, now);
   }
-  global_.setJoinCheck({});  // the fixes are in
   map_.appendTrajectory(other, n0);
   session.reference_.forEach([&](const io::StampedPose& p) { reference_.push_back(p); });
 

@@ -118,6 +118,9 @@ class GlobalSlam {
   // confirm_window at most: beyond, unconfirmed at once).
   Admission admit(LoopClosureRecord r, size_t current, MeasuredBy measured = MeasuredBy::Scans,
                   const std::optional<CameraPairView>& view = std::nullopt);
+  // Whether the loop closer adds an accepted closure to the filter itself (no confirmation, and
+  // no join check that admit() must pass first), or leaves that to admit().
+  bool closerCommits() const;
   Admission commit(std::initializer_list<LoopClosureRecord*> records);
   // A closure the gate refused by less than two closures' quantile ([loop_closure] joint_gate):
   // in with an earlier such one that agrees and passes the joint gate, else waiting as pending.
