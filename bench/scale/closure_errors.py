@@ -5,6 +5,9 @@
 # minus true forward offset, in the earlier keyframe's frame: negative = the views put too close
 # together), the position error's median, 95th percentile and maximum, and how many are off by
 # more than 0.3 and 0.5 m (`urbanslam eval` counts a closure false beyond 0.5 m or 5 degrees).
+# Then what the innovation gate saw of them: the median Mahalanobis^2 of the closures within
+# 0.1 m along the track and of those 0.25 m or more off (the gate refuses above its threshold,
+# 11.34 at the default 0.99).
 #
 #   bench/scale/closure_errors.py RUN_DIR TRUTH_DIR
 #
@@ -32,8 +35,10 @@ def relative(a, b):
 closures = [r for r in csv.DictReader(open(f'{run}/loop_closures.csv')) if r['accepted'] == '1' and r['bearing_only'] == '0']
 print('%-9s %8s %14s %16s %9s %9s %9s %7s %7s' % ('views', 'closures', 'along_mean_m', 'along_median_m', 'median_m', 'p95_m',
                                                     'max_m', '>0.3_m', '>0.5_m'))
+innovation = {}
 for name, opposite in (('same', False), ('opposite', True)):
     along, error = [], []
+    innovation[name] = ([], [])
     for r in closures:
         if (abs(float(r['phi'])) > math.pi / 2) != opposite:
             continue
@@ -41,6 +46,10 @@ for name, opposite in (('same', False), ('opposite', True)):
         dx, dy = float(r['x']) - t[0], float(r['y']) - t[1]
         along.append(dx)
         error.append(math.hypot(dx, dy))
+        if abs(dx) < 0.1:
+            innovation[name][0].append(float(r['mahalanobis2']))
+        elif abs(dx) >= 0.25:
+            innovation[name][1].append(float(r['mahalanobis2']))
     if not error:
         print('%-9s %8d' % (name, 0))
         continue
@@ -48,3 +57,9 @@ for name, opposite in (('same', False), ('opposite', True)):
     print('%-9s %8d %+14.4f %+16.4f %9.4f %9.3f %9.3f %7d %7d' % (name, len(error), statistics.mean(along), statistics.median(along),
           statistics.median(error), error[int(0.95 * (len(error) - 1))], error[-1], sum(e > 0.3 for e in error),
           sum(e > 0.5 for e in error)))
+
+print()
+print('%-9s %21s %16s %22s %16s' % ('views', 'along<0.1m_closures', 'mahalanobis2_p50', 'along>=0.25m_closures', 'mahalanobis2_p50'))
+for name, (good, bad) in innovation.items():
+    median = lambda v: '%16.3f' % statistics.median(v) if v else '%16s' % '-'
+    print('%-9s %21d %s %22d %s' % (name, len(good), median(good), len(bad), median(bad)))
