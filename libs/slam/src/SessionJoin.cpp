@@ -20,6 +20,13 @@ constexpr double kDeg = M_PI / 180.0;
 
 double wrap(double a) { return std::atan2(std::sin(a), std::cos(a)); }
 
+// Two places of one session keyframe agree as two fixes must: within agree_m plus agree_per_m
+// times the session's path between the two (its drift there), and agree_deg.
+bool agree(const SessionJoinOptions& o, const common::Pose2& a, const common::Pose2& b, double path_between_m) {
+  return std::hypot(a.x - b.x, a.y - b.y) <= o.agree_m + o.agree_per_m * path_between_m &&
+         std::abs(wrap(a.phi - b.phi)) <= o.agree_deg * kDeg;
+}
+
 }  // namespace
 
 struct SessionJoiner::Search {
@@ -168,8 +175,7 @@ size_t SessionJoiner::check(const Map& session, SessionFix& f) {
       return;
     }
     const common::Pose2 landed = common::compose(m, a.transform);
-    const bool lands = r.reason == ClosureReason::None && std::hypot(landed.x - predicted.x, landed.y - predicted.y) <= tolerance &&
-                       std::abs(wrap(landed.phi - predicted.phi)) <= o.agree_deg * kDeg;
+    const bool lands = r.reason == ClosureReason::None && agree(o, landed, predicted, std::abs(path_[j] - s0));
     (lands ? f.confirmed : f.contradicted).push_back(j);
   };
   const size_t before = f.confirmed.size() + f.contradicted.size() + f.unaligned.size();
@@ -239,18 +245,15 @@ void SessionJoiner::decide(const Map& session) {
   SessionJoin& out = join_;
   // 2. Agreement: fix a's transform carries fix b's keyframe to where b was found. (The
   // session's poses as they are now: a growing session's may have moved since the fix.)
-  const auto agree = [&](const SessionFix& a, const SessionFix& b) {
-    const common::Pose2 predicted = common::compose(a.transform, kf[b.keyframe].pose);
-    const double drift = o.agree_per_m * std::abs(path_[a.keyframe] - path_[b.keyframe]);
-    return std::hypot(predicted.x - b.pose.x, predicted.y - b.pose.y) <= o.agree_m + drift &&
-           std::abs(wrap(predicted.phi - b.pose.phi)) <= o.agree_deg * kDeg;
+  const auto agreeing_fixes = [&](const SessionFix& a, const SessionFix& b) {
+    return agree(o, common::compose(a.transform, kf[b.keyframe].pose), b.pose, std::abs(path_[a.keyframe] - path_[b.keyframe]));
   };
   for (SessionFix& f : out.fixes) f.transform = common::compose(f.pose, common::inverse(kf[f.keyframe].pose));
   const size_t n = out.fixes.size();
   std::vector<std::vector<size_t>> agreeing(n);
   for (size_t i = 0; i < n; ++i)
     for (size_t j = 0; j < n; ++j)
-      if (i == j || agree(out.fixes[i], out.fixes[j])) agreeing[i].push_back(j);
+      if (i == j || agreeing_fixes(out.fixes[i], out.fixes[j])) agreeing[i].push_back(j);
   std::set<size_t> with_fix;
   for (const SessionFix& f : out.fixes) with_fix.insert(f.keyframe);
 
@@ -359,14 +362,9 @@ void SessionJoiner::decide(const Map& session) {
 
 bool agreesWithJoin(const SessionJoin& join, size_t keyframe, const common::Pose2& pose, const std::vector<double>& path_m,
                     const common::Pose2& claimed) {
-  const SessionJoinOptions& o = join.options;
-  const auto path = [&](size_t k) { return k < path_m.size() ? path_m[k] : 0.0; };
   return std::any_of(join.agreeing.begin(), join.agreeing.end(), [&](size_t i) {
     const SessionFix& f = join.fixes[i];
-    const common::Pose2 joined = common::compose(f.transform, pose);
-    return std::hypot(claimed.x - joined.x, claimed.y - joined.y) <=
-               o.agree_m + o.agree_per_m * std::abs(path(keyframe) - path(f.keyframe)) &&
-           std::abs(common::wrapToPi(claimed.phi - joined.phi)) <= o.agree_deg * kDeg;
+    return agree(join.options, claimed, common::compose(f.transform, pose), std::abs(path_m.at(keyframe) - path_m.at(f.keyframe)));
   });
 }
 

@@ -109,7 +109,7 @@ struct SessionJoin {
 // where one of the join's agreeing fixes puts it, as two fixes must agree: within agree_m plus
 // agree_per_m times the session's path between the keyframe and that fix (its drift), and
 // agree_deg (SessionJoinOptions). `pose`: the keyframe's pose in the session's frame; `path_m`:
-// the session's path length at each of its keyframes.
+// the session's path length at each of its keyframes (std::out_of_range for a keyframe beyond it).
 bool agreesWithJoin(const SessionJoin& join, size_t keyframe, const common::Pose2& pose, const std::vector<double>& path_m,
                     const common::Pose2& claimed);
 
