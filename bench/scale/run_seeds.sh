@@ -34,16 +34,19 @@ drive() {
   python3 bench/scale/closure_errors.py "$OUT/$name" "$OUT/$name-truth" > "$OUT/$name.closures.txt"
 }
 
-running=0
+# At most JOBS drives at once, each waited for by name: a drive that fails stops the table
+# with its seed named, whichever batch it was in.
+pids=() names=()
+finish() {
+  wait "${pids[0]}" || { echo "run_seeds.sh: the drive of seed ${names[0]} failed (its outputs in $OUT)" >&2; exit 2; }
+  pids=("${pids[@]:1}") names=("${names[@]:1}")
+}
 for s in "${SEEDS[@]}"; do
   drive "$s" &
-  running=$((running + 1))
-  if [ "$running" -ge "$JOBS" ]; then
-    wait -n
-    running=$((running - 1))
-  fi
+  pids+=($!) names+=("$s")
+  if [ "${#pids[@]}" -ge "$JOBS" ]; then finish; fi
 done
-wait
+while [ "${#pids[@]}" -gt 0 ]; do finish; done
 
 python3 - "$OUT" "${SEEDS[@]}" <<'PY'
 import json, os, statistics, sys
@@ -56,12 +59,12 @@ for s in seeds:
     r, e = json.load(open(name + ".json")), json.load(open(name + ".eval.json"))
     opp = next(l.split() for l in open(name + ".closures.txt") if l.startswith("opposite"))
     opp_n = int(opp[1])
-    along, over = (float(opp[3]), int(opp[8])) if opp_n else (float("nan"), 0)
+    along, over = ("%+.4f" % float(opp[3]), int(opp[8])) if opp_n else ("-", 0)
     rv = e["revisits_50m"]
     row = dict(ate=e["ate_rmse_m"], p95=e["map"]["p95_m"], loops=e["loops_accepted"], false=e["loops_false"],
                closed=rv["closed"], revisits=rv["revisits"], opp=opp_n, over=over, cpu=r["cpu_s"])
     rows.append(row)
-    print("%-6s %9d %7.4f %8.4f %7d %6d %8s %9d %+15.4f %9d %7.1f" % (s, r["keyframes"], row["ate"], row["p95"], row["loops"], row["false"],
+    print("%-6s %9d %7.4f %8.4f %7d %6d %8s %9d %15s %9d %7.1f" % (s, r["keyframes"], row["ate"], row["p95"], row["loops"], row["false"],
           "%d/%d" % (row["closed"], row["revisits"]), opp_n, along, over, row["cpu"]))
 med = lambda k: statistics.median(x[k] for x in rows)
 tot = lambda k: sum(x[k] for x in rows)
