@@ -13,6 +13,7 @@
 #include "urbanslam/alignment/HeadingCorrections.h"
 #include "urbanslam/alignment/LikelihoodGrid.h"
 #include "urbanslam/alignment/MotionPrior.h"
+#include "urbanslam/alignment/OdometryOutvotes.h"
 #include "urbanslam/alignment/PriorScanMatcher.h"
 #include "urbanslam/alignment/ScanModel.h"
 
@@ -299,6 +300,58 @@ TEST(PriorScanMatcher, ANarrowedHeadingWindowFindsTheSameMatchInsideItAndMissesB
   EXPECT_NEAR(far_full.pose.phi, far_truth.phi, 0.005);
   EXPECT_GT(std::abs(far_first.search_pose.phi - far_truth.phi), 0.05);
   EXPECT_GT(std::abs(far_first.search_pose.phi - odometry.phi), HeadingCorrections::kEdgeShare * far_first.search_half_angle_rad);
+}
+
+TEST(PriorScanMatcher, LeavingTheDirectionsReachOutSearchesTheOdometrysThreeSigmaOnly) {
+  // The same prior either way (the uniform share's density is that of the full window): a match
+  // inside the narrower window is the same match, for fewer nodes; a reversal beyond it is not found.
+  const Eigen::Matrix3d cov = Eigen::Vector3d(0.025 * 0.025, 0.025 * 0.025, 1e-4).asDiagonal();
+  PriorMatcherOptions o;
+  o.search_window_m = 0.3;
+  const MatchReference ref(scanPoints(test::roomWorld(), {0, 0, 0}), Eigen::Vector2d::Zero(), o);
+  PriorMatcherOptions narrow = o;
+  narrow.search_direction_reach = false;
+  const common::Pose2 odometry{0.5, 0.0, 0.0};
+  const PointSet near_scan = scanPoints(test::roomWorld(), {0.52, 0.03, 0.01}, 11);
+  const PriorMatchResult full = matchWithPrior(ref, near_scan, odometry, cov, o);
+  const PriorMatchResult first = matchWithPrior(ref, near_scan, odometry, cov, narrow);
+  ASSERT_TRUE(full.valid && first.valid);
+  EXPECT_EQ(first.pose.x, full.pose.x);
+  EXPECT_EQ(first.pose.y, full.pose.y);
+  EXPECT_EQ(first.pose.phi, full.pose.phi);
+  EXPECT_NEAR(full.search_half_width_m, 1.0, 1e-12);  // twice the travel
+  EXPECT_NEAR(first.search_half_width_m, 0.3, 1e-12);
+  EXPECT_FALSE(full.window_narrowed);
+  EXPECT_TRUE(first.window_narrowed);
+  EXPECT_LT(first.search_nodes, full.search_nodes);
+  const PointSet far_scan = scanPoints(test::roomWorld(), {-0.3, 0.0, 0.0}, 12);
+  EXPECT_NEAR(matchWithPrior(ref, far_scan, odometry, cov, o).pose.x, -0.3, 0.02);
+  EXPECT_GT(std::abs(matchWithPrior(ref, far_scan, odometry, cov, narrow).search_pose.x + 0.3), 0.5);
+}
+
+TEST(OdometryOutvotes, TrustedOnlyWhereMatchesRarelyOutvoteTheOdometry) {
+  OdometryOutvotes fresh;
+  EXPECT_FALSE(fresh.trusted());  // distrustful until matches have shown otherwise
+  OdometryOutvotes clean;
+  for (int k = 0; k < 80; ++k) clean.add(false);
+  EXPECT_FALSE(clean.trusted());  // 1 in 100 with the prior
+  clean.add(false);
+  EXPECT_TRUE(clean.trusted());
+  // One outvote in fifty (a robot that reverses now and then) is never trusted; one in a
+  // thousand is, and stays so after each outvote.
+  OdometryOutvotes often, rarely;
+  for (int k = 1; k <= 5000; ++k) {
+    often.add(k % 50 == 0);
+    rarely.add(k % 1000 == 0);
+    if (k > 500) {
+      EXPECT_FALSE(often.trusted()) << k;
+      EXPECT_TRUE(rarely.trusted()) << k;
+    }
+  }
+  EXPECT_NEAR(often.rate(), 0.02, 0.005);
+  OdometryOutvotes copy;
+  copy.restore(often.outvotes(), often.matches());
+  EXPECT_EQ(copy.rate(), often.rate());
 }
 
 TEST(HeadingCorrections, TheWindowIsFiveRmsOfTheCorrectionsInTheModelsSigmas) {

@@ -192,8 +192,8 @@ TEST(MapFile, MapWithAnImageDatabaseIsRefusedUnlessOnlyRead) {
 
 // A file of the format before separate maps (version 3, written by that version: the fuzzing
 // seed) is read as a map without any; written again, every section is as it was (the options
-// aside: they list the keys added since), local SLAM's but for its heading corrections (none
-// learnt: three zeros), the statistics but for their durations (histograms now, one per step
+// aside: they list the keys added since), local SLAM's but for its heading corrections and its
+// odometry outvotes (none learnt: five zeros), the statistics but for their durations (histograms now, one per step
 // read), and the empty separate-maps section follows.
 TEST(MapFile, AVersion3FileIsReadAsAMapWithoutSeparateMaps) {
   const std::string path = test::repoPath("fuzz/corpus/map_file/three-scans-24-beams.usmap");
@@ -276,11 +276,14 @@ TEST(MapFile, AVersion3FileIsReadAsAMapWithoutSeparateMaps) {
     local_old += local_v3.substr(copied);
   }
   const std::string& local_now = b.at("LOCL");
-  ASSERT_EQ(local_now.size(), local_old.size() + 24);
-  bool inserted = false;  // 24 zero bytes somewhere, the rest as it was
-  for (size_t i = 0; i + 24 <= local_now.size() && !inserted; ++i)
-    inserted = local_now.compare(i, 24, std::string(24, '\0')) == 0 && local_now.substr(0, i) + local_now.substr(i + 24) == local_old;
-  EXPECT_TRUE(inserted) << "section LOCL differs beyond the heading corrections and the sensor positions";
+  // The heading corrections (three f64) and the odometry outvotes (two f64) follow each other.
+  const size_t learnt = 24 + 16;
+  ASSERT_EQ(local_now.size(), local_old.size() + learnt);
+  bool inserted = false;  // that many zero bytes somewhere, the rest as it was
+  for (size_t i = 0; i + learnt <= local_now.size() && !inserted; ++i)
+    inserted =
+        local_now.compare(i, learnt, std::string(learnt, '\0')) == 0 && local_now.substr(0, i) + local_now.substr(i + learnt) == local_old;
+  EXPECT_TRUE(inserted) << "section LOCL differs beyond the heading corrections, the odometry outvotes and the sensor positions";
   ASSERT_TRUE(b.count("SEPM"));
   EXPECT_EQ(b.at("SEPM"), std::string(8, '\0'));  // a count of 0
   // The durations read into histograms: one per step, and they stay as they are once written so.

@@ -59,15 +59,19 @@ PriorMatchResult matchWithPrior(const MatchReference& reference, const PointSet&
   // it started, up to twice that from the odometry's pose (or as far as the caller knows it to be,
   // o.direction_reach_m).
   const double reach = o.direction_reach_m >= 0 ? o.direction_reach_m : 2 * std::hypot(prior_mean.x, prior_mean.y);
-  window.half_width_m = std::min(o.max_search_window_m, std::max({o.search_window_m, 3 * sxy, reach}));
+  const double full_half_width_m = std::min(o.max_search_window_m, std::max({o.search_window_m, 3 * sxy, reach}));
+  window.half_width_m =
+      o.search_direction_reach ? full_half_width_m : std::min(o.max_search_window_m, std::max(o.search_window_m, 3 * sxy));
   const auto half_angle_rad = [&](double scale) {
     return std::min(o.max_search_window_deg, std::max(o.search_window_deg, scale * 3 * sphi * 180 / M_PI)) * M_PI / 180;
   };
   const double full_half_angle_rad = half_angle_rad(1.0);
   window.half_angle_rad = half_angle_rad(std::min(1.0, o.heading_window_scale));
-  const double volume = 4 * window.half_width_m * window.half_width_m * 2 * full_half_angle_rad;
+  const double volume = 4 * full_half_width_m * full_half_width_m * 2 * full_half_angle_rad;
   const MotionPrior prior(prior_mean, prior_cov, o.odometry_outlier_probability, volume);
   out.search_half_angle_rad = window.half_angle_rad;
+  out.search_half_width_m = window.half_width_m;
+  out.window_narrowed = window.half_width_m < full_half_width_m || window.half_angle_rad < full_half_angle_rad;
   CorrelativeResult coarse = correlativeSearch(reference.grid(), thinned, prior, window);
   out.search_nodes = coarse.nodes;
   // Free space of both sides at a pose: points in view and seen through (reference points in the

@@ -7,6 +7,11 @@
 
 namespace urbanslam::slam {
 
+namespace {
+// A match within a trusted odometry's 3σ must explain this share of what matches usually do.
+constexpr double kTrustedMatchedShare = 0.9;
+}  // namespace
+
 alignment::PriorMatcherOptions priorMatcherOptions(const LocalOptions& o) {
   alignment::PriorMatcherOptions m;
   m.grid.resolution_m = o.resolution_m;
@@ -80,15 +85,36 @@ alignment::PriorMatchResult LocalSubmap::match(const io::LaserScan& scan, const 
   options.seen_through_rate_displaced = seen_through_displaced_.rate();
   options.direction_reach_m = direction_reach_m;
   const alignment::PointSet scan_points = points(scan);
-  // First within the heading corrections' own reach; the prior's full window when that match is
-  // in doubt (not when no search ran: too few points fail the same way in any window).
+  // The narrowest search the evidence does not doubt. Where the odometry has held to its Gaussian
+  // (OdometryOutvotes.h): within the heading corrections' reach and the prior's 3σ of
+  // translation. Otherwise the search over the
+  // heading corrections' reach and the translation that covers odometry wrong in direction
+  // (twice the travel: the window of a car at 10 m/s 4 m square). The prior's full window when a
+  // search's match is in doubt (not when no search ran: too few points fail the same way in any
+  // window): its best heading at the window's edge or the scan matched far less than usual
+  // (HeadingCorrections.h), or, with the direction's reach left out, its best translation at the
+  // window's edge, the odometry outvoted or the scan explained less than nine tenths of the usual
+  // share (what every match the full window moved beyond the narrower one showed on FR079 and
+  // Victoria Park).
+  const double usual = heading_corrections_.usualMatchedShare();
+  const bool trusted = outvotes_.trusted();
   options.heading_window_scale = heading_corrections_.windowScale();
+  options.search_direction_reach = !trusted;
   alignment::PriorMatchResult r = alignment::matchWithPrior(*ref, scan_points, prior, prior_cov, options);
-  if (options.heading_window_scale < 1 && r.search_nodes > 0 &&
-      heading_corrections_.doubts(r.valid, common::wrapToPi(r.search_pose.phi - prior.phi), r.search_half_angle_rad, r.matchedFraction())) {
+  const auto atEdge = [&] {
+    const double edge = alignment::HeadingCorrections::kEdgeShare * r.search_half_width_m;
+    return std::abs(r.search_pose.x - prior.x) > edge || std::abs(r.search_pose.y - prior.y) > edge;
+  };
+  const bool poor =
+      !options.search_direction_reach && (atEdge() || r.odometry_outvoted || r.matchedFraction() < kTrustedMatchedShare * usual);
+  if (r.window_narrowed && r.search_nodes > 0 &&
+      (poor || heading_corrections_.doubts(r.valid, common::wrapToPi(r.search_pose.phi - prior.phi), r.search_half_angle_rad,
+                                           r.matchedFraction()))) {
     options.heading_window_scale = 1;
+    options.search_direction_reach = true;
     r = alignment::matchWithPrior(*ref, scan_points, prior, prior_cov, options);
   }
+  if (r.valid) outvotes_.add(r.odometry_outvoted);
   if (r.valid && !r.odometry_outvoted) {
     heading_corrections_.add(common::wrapToPi(r.pose.phi - prior.phi), std::sqrt(prior_cov(2, 2)), r.matchedFraction());
     seen_through_.add(r.in_view, r.seen_through);

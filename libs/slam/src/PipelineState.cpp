@@ -493,9 +493,11 @@ void LocalSubmap::writeState(BinaryWriter& w) const {
   w.f64(heading_corrections_.sumSquares());
   w.f64(heading_corrections_.sumMatched());
   w.f64(heading_corrections_.matches());
+  w.f64(outvotes_.outvotes());
+  w.f64(outvotes_.matches());
 }
 
-void LocalSubmap::readState(BinaryReader& r, bool with_heading_corrections, bool with_origins) {
+void LocalSubmap::readState(BinaryReader& r, bool with_heading_corrections, bool with_origins, bool with_outvotes) {
   const size_t n = r.count(8);
   if (n > capacity_) r.fail("a local submap of " + std::to_string(n) + " keyframes where it holds " + std::to_string(capacity_));
   sets_.clear();
@@ -510,10 +512,15 @@ void LocalSubmap::readState(BinaryReader& r, bool with_heading_corrections, bool
   seen_through_.restore(seen, points);
   const double seen_d = r.f64(), points_d = r.f64();
   seen_through_displaced_.restore(seen_d, points_d);
+  outvotes_ = alignment::OdometryOutvotes{};
   if (!with_heading_corrections) return;  // an older map: the next matches learn them again
   const double sum_squares = r.f64(), sum_matched = r.f64(), matches = r.f64();
   if (!(sum_squares >= 0) || !(sum_matched >= 0) || !(matches >= 0)) r.fail("local SLAM's heading corrections");
   heading_corrections_.restore(sum_squares, sum_matched, matches);
+  if (!with_outvotes) return;  // an older map: the next matches learn it again
+  const double outvotes = r.f64(), outvote_matches = r.f64();
+  if (!(outvotes >= 0) || !(outvote_matches >= outvotes)) r.fail("local SLAM's odometry outvotes");
+  outvotes_.restore(outvotes, outvote_matches);
 }
 
 void LocalSlam::writeState(BinaryWriter& w) const {
@@ -528,9 +535,9 @@ void LocalSlam::writeState(BinaryWriter& w) const {
   w.f64(last_anchor_time_);
 }
 
-void LocalSlam::readState(BinaryReader& r, bool with_heading_corrections, bool with_origins) {
+void LocalSlam::readState(BinaryReader& r, bool with_heading_corrections, bool with_origins, bool with_outvotes) {
   motion_.readState(r);
-  submap_.readState(r, with_heading_corrections, with_origins);
+  submap_.readState(r, with_heading_corrections, with_origins, with_outvotes);
   have_scan_keyframe_ = r.boolean();
   local_poses_.resize(r.count(24));
   for (auto& p : local_poses_) p = readPose(r);
@@ -734,7 +741,7 @@ void Pipeline::readState(BinaryReader& r, std::uint32_t format_version, bool con
   }
   {
     BinaryReader s = r.section(kLocalTag);
-    local_.readState(s, format_version >= 5, format_version >= 13);
+    local_.readState(s, format_version >= 5, format_version >= 13, format_version >= 15);
     submap_corrections_.readState(s);
     s.expectEnd();
   }

@@ -49,8 +49,11 @@ class HeadingCorrections {
   bool doubts(bool valid, double search_offset_rad, double half_window_rad, double matched_fraction) const {
     if (!valid) return true;
     if (std::abs(search_offset_rad) > kEdgeShare * half_window_rad) return true;
-    return matches_ > 0 && matched_fraction < kMatchedShare * sum_matched_ / matches_;
+    return matches_ > 0 && matched_fraction < kMatchedShare * usualMatchedShare();
   }
+
+  // The mean share of the scan the matches matched (0 before any).
+  double usualMatchedShare() const { return matches_ > 0 ? sum_matched_ / matches_ : 0.0; }
 
   // What was learnt: for saving a run and taking it up again where it stopped.
   double sumSquares() const { return sum_squares_; }

@@ -61,6 +61,12 @@ struct PriorMatcherOptions {
   // driving forwards) can have put the vehicle: the window reaches at least this far. < 0: twice
   // the prior mean's distance from the reference's origin (the motion started there).
   double direction_reach_m = -1;
+  // false: the search leaves that reach out and covers search_window_m and the prior's 3σ only
+  // (a caller that searches again with it when the match is in doubt: odometry wrong in direction
+  // explains the scan poorly there, or puts the best pose at the window's edge). The uniform
+  // share's density stays that of the full window, so the prior, and a match inside the narrower
+  // window, are the same.
+  bool search_direction_reach = true;
   // The share of points in view that the other side saw through at the true pose, and at poses
   // displaced from it by displacement_m and displacement_deg (step 2'); 0: step 2' off.
   double seen_through_rate = 0.05;
@@ -96,6 +102,8 @@ struct PriorMatchResult {
   bool odometry_outvoted = false;                         // the result lies outside the odometry's Gaussian (after step 2')
   int iterations = 0, search_nodes = 0;
   double search_half_angle_rad = 0;  // the heading window searched (each side of the prior's mean)
+  double search_half_width_m = 0;    // ... and the translation window (each side, along x and y)
+  bool window_narrowed = false;      // the window searched is narrower than the prior's full one
   double time_ms = 0;
   double matchedFraction() const { return points > 0 ? static_cast<double>(matched) / points : 0.0; }
 };

@@ -68,7 +68,7 @@ class LocalSlam {
   // Motion, submap and keyframe decision state (PipelineState.cpp).
   void writeState(common::BinaryWriter& w) const;
   // with_heading_corrections: false for maps written before they were kept (LocalSubmap.h).
-  void readState(common::BinaryReader& r, bool with_heading_corrections = true, bool with_origins = true);
+  void readState(common::BinaryReader& r, bool with_heading_corrections = true, bool with_origins = true, bool with_outvotes = true);
 
  private:
   alignment::PriorMatchResult matchSubmap(const io::LaserScan& scan, const common::Pose2& z, const Eigen::Matrix3d& cov,

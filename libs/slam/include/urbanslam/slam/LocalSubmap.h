@@ -4,13 +4,15 @@
 // the one matcher that places a scan in it: the odometry prior and the scan evidence weighed
 // by their uncertainties (alignment/PriorScanMatcher.h). The prepared reference (kd-tree,
 // normals, likelihood grid) is kept until a keyframe is added or the submap's keyframes move
-// relative to each other (a closure), so the scans between two keyframes share it.
+// relative to each other (a closure), so the scans between two keyframes share it. A match
+// widens its search only when the narrower one's is in doubt (match(), LocalSubmap.cpp).
 #include <deque>
 #include <memory>
 #include <vector>
 
 #include "urbanslam/alignment/BeamFreeSpace.h"
 #include "urbanslam/alignment/HeadingCorrections.h"
+#include "urbanslam/alignment/OdometryOutvotes.h"
 #include "urbanslam/alignment/PointSet.h"
 #include "urbanslam/alignment/PriorScanMatcher.h"
 #include "urbanslam/alignment/ScanModel.h"
@@ -40,9 +42,9 @@ class LocalSubmap {
   // The keyframes' points, the count of keyframes added, the learnt seen-through rates and
   // heading corrections. The beams are rebuilt from the points and the prepared reference from
   // both at the next match, as a cache miss would (the same inputs give the same reference).
-  // with_heading_corrections: false for maps written before they were kept.
+  // with_heading_corrections, with_outvotes: false for maps written before they were kept.
   void writeState(common::BinaryWriter& w) const;
-  void readState(common::BinaryReader& r, bool with_heading_corrections = true, bool with_origins = true);
+  void readState(common::BinaryReader& r, bool with_heading_corrections = true, bool with_origins = true, bool with_outvotes = true);
 
  private:
   const alignment::MatchReference* reference(const std::vector<common::Pose2>& poses) const;
@@ -65,6 +67,8 @@ class LocalSubmap {
   mutable alignment::SeenThroughRate seen_through_{0.05}, seen_through_displaced_{0.3};
   // Learnt the same way: how much of the prior's heading window the search needs.
   mutable alignment::HeadingCorrections heading_corrections_;
+  // And how often the matches outvote the odometry: where rarely, its Gaussian bounds the first match.
+  mutable alignment::OdometryOutvotes outvotes_;
 };
 
 }  // namespace urbanslam::slam

@@ -20,7 +20,7 @@
 namespace urbanslam::slam {
 
 constexpr const char* kMapFileName = "map.usmap";
-constexpr std::uint32_t kMapFormatVersion = 14;
+constexpr std::uint32_t kMapFormatVersion = 15;
 // Version 3 files (no separate maps), 4 (no heading corrections of local SLAM), 5 (no record of
 // which camera closures measured bearing and heading only), 6 (no record of what confirmed a
 // closure), 7 (every step's duration instead of their histograms), 8 (no record of the

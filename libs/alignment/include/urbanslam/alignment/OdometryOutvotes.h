@@ -1,0 +1,41 @@
+#pragma once
+// How often a scan match outvotes the odometry (its pose lies outside the odometry's Gaussian,
+// PriorScanMatcher.h): on the raw benchmark logs from 1 in 500 matches (Intel) to 1 in 10
+// (FR079's reversals reported as driving forwards, Victoria Park's steering model), in the
+// simulated cities never. Where it stays rare the odometry can be trusted to its Gaussian: local
+// matching first searches the window the Gaussian spans, and the window that covers odometry
+// wrong in direction only when that match is in doubt (LocalSubmap.h). Learnt with a prior that starts distrustful and a memory, as
+// SeenThroughRate is, so that it follows the vehicle onto other ground.
+namespace urbanslam::alignment {
+
+class OdometryOutvotes {
+ public:
+  static constexpr double kTrustedRate = 0.01;   // trusted below one outvote in a hundred matches
+  static constexpr double kPriorOutvotes = 1;    // the prior: one outvote in ...
+  static constexpr double kPriorMatches = 20;    // ... twenty matches (trusted after some eighty clean ones)
+  static constexpr double kMemoryMatches = 500;  // older matches fade out
+
+  void add(bool outvoted) {
+    matches_ += 1;
+    outvotes_ += outvoted ? 1 : 0;
+    if (matches_ > kMemoryMatches) {
+      outvotes_ *= kMemoryMatches / matches_;
+      matches_ = kMemoryMatches;
+    }
+  }
+  double rate() const { return (outvotes_ + kPriorOutvotes) / (matches_ + kPriorMatches); }
+  bool trusted() const { return rate() < kTrustedRate; }
+
+  // What was learnt: for saving a run and taking it up again where it stopped.
+  double outvotes() const { return outvotes_; }
+  double matches() const { return matches_; }
+  void restore(double outvotes, double matches) {
+    outvotes_ = outvotes;
+    matches_ = matches;
+  }
+
+ private:
+  double outvotes_ = 0, matches_ = 0;
+};
+
+}  // namespace urbanslam::alignment
