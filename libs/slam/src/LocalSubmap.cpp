@@ -87,9 +87,9 @@ alignment::PriorMatchResult LocalSubmap::match(const io::LaserScan& scan, const 
   const alignment::PointSet scan_points = points(scan);
   // The narrowest search the evidence does not doubt. Where the odometry has held to its Gaussian
   // (OdometryOutvotes.h): within the heading corrections' reach and the prior's 3σ of
-  // translation. Otherwise the search over the
-  // heading corrections' reach and the translation that covers odometry wrong in direction
-  // (twice the travel: the window of a car at 10 m/s 4 m square). The prior's full window when a
+  // translation. Otherwise the search over the heading corrections' reach and the translation
+  // that covers odometry wrong in direction (twice the travel: the window of a car at 10 m/s 4 m
+  // square). The prior's full window when a
   // search's match is in doubt (not when no search ran: too few points fail the same way in any
   // window): its best heading at the window's edge or the scan matched far less than usual
   // (HeadingCorrections.h), or, with the direction's reach left out, its best translation at the

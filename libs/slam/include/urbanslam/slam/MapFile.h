@@ -26,7 +26,9 @@ constexpr std::uint32_t kMapFormatVersion = 15;
 // closure), 7 (every step's duration instead of their histograms), 8 (no record of the
 // filter's factors since its last factorisation), 9 (every keyframe a filter pose of its own),
 // 10 (a reduced pose graph that hung keyframes at their closures: refused when it has one) and
-// 11 (no record of which closures left the ambiguity restarts out) are read as well.
+// 11 (no record of which closures left the ambiguity restarts out), 12 (no sensor positions in
+// local SLAM's point sets), 13 (no loop-search cursor) and 14 (no odometry outvotes of local
+// SLAM) are read as well.
 constexpr std::uint32_t kOldestMapFormatVersion = 3;
 
 // The map of the pipeline's current state written to `out` from its start, streamed (the
