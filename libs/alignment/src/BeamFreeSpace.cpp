@@ -55,13 +55,6 @@ BeamFreeSpace::BeamFreeSpace(const PointSet& scan, double margin_m, double margi
   valid_ = true;
 }
 
-size_t BeamFreeSpace::binOf(double bearing_rad) const {
-  // atan2's range needs no reduction (std::remainder costs as much as the atan2 before it).
-  double from_zero = std::abs(bearing_rad) <= M_PI ? bearing_rad : std::remainder(bearing_rad, 2 * M_PI);
-  if (from_zero < 0) from_zero += 2 * M_PI;
-  return static_cast<size_t>(from_zero / bin_rad_) % free_m_.size();
-}
-
 int BeamFreeSpace::conflicts(const std::vector<Eigen::Vector2d>& points, const common::Pose2& scan_pose) const {
   std::vector<char> state(points.size(), kUnseen);
   classify(points, scan_pose, state);
@@ -80,9 +73,10 @@ void BeamFreeSpace::classify(const std::vector<Eigen::Vector2d>& points, const c
     const double r = q.norm();
     if (r > reach_m_ && state[i] >= kBehind) continue;
     const size_t b = binOf(fastAtan2(q.y(), q.x()));
-    const double f = std::min({free_m_[b], free_m_[(b + 1) % n], free_m_[(b + n - 1) % n]});
+    const double here = free_m_[b], next = free_m_[b + 1 == n ? 0 : b + 1], before = free_m_[b == 0 ? n - 1 : b - 1];
+    const double f = std::min({here, next, before});
     if (f <= 0) continue;
-    const double g = std::max({free_m_[b], free_m_[(b + 1) % n], free_m_[(b + n - 1) % n]});
+    const double g = std::max({here, next, before});
     const char s = r < f - margin_m_ - margin_fraction_ * f   ? kSeenThrough
                    : r > g + margin_m_ + margin_fraction_ * g ? kBehind
                                                               : kInView;

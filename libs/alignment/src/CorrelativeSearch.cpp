@@ -62,7 +62,7 @@ class Search {
     lo_y_ = -trimmed(w.trim_m[2]);
     hi_y_ = trimmed(w.trim_m[3]);
     const Eigen::Vector2d t(prior.mean().x, prior.mean().y);
-    const int64_t width = grid.levelWidth(0), pad = grid.pad();
+    const int64_t width = grid.levelWidth(0), stride = grid.levelStride(0), pad = grid.pad();
     // Every translation searched puts a point of cell c at c + (ox, oy), lo_ <= o <= hi_: inside
     // the base array for all of them, outside every level's array for all of them (before its
     // start, or past the top level's last block), or at the edge (checked per lookup). Outdoors
@@ -84,7 +84,7 @@ class Search {
           ++h.outside;
         } else if (x0 >= 0 && y0 >= 0 && x1 < width && y1 < grid.levelHeight(0)) {
           h.cells.push_back(c);
-          h.linear.push_back((c.y() + pad) * width + c.x() + pad);
+          h.linear.push_back((c.y() + pad) * stride + c.x() + pad);
         } else {
           h.edge.push_back(c);
         }
@@ -125,21 +125,22 @@ class Search {
     ++nodes_;
     const Heading& hd = headings_[static_cast<size_t>(a)];
     const float* values = grid_.levelData(level);
-    const int w = grid_.levelWidth(level), h = grid_.levelHeight(level), pad = grid_.pad();
+    const int w = grid_.levelWidth(level), h = grid_.levelHeight(level), stride = grid_.levelStride(level), pad = grid_.pad();
     const int shift = grid_.shiftOf(level);
     const float floor = grid_.floorValue();
     double sum = static_cast<double>(hd.outside) * floor;
     // The points inside at every translation: no per-point checks, and at full resolution one
     // addition per point.
     if (shift == 0) {
-      const float* base = values + static_cast<int64_t>(oy) * w + ox;
+      const float* base = values + static_cast<int64_t>(oy) * stride + ox;
       const int64_t* idx = hd.linear.data();
       sum += sum4(hd.linear.size(), [&](size_t k) { return base[idx[k]]; });
     } else {
       const Eigen::Vector2i* cells = hd.cells.data();
       sum += sum4(hd.cells.size(), [&](size_t k) {
         const Eigen::Vector2i& c = cells[k];
-        return values[static_cast<size_t>((c.y() + oy + pad) >> shift) * static_cast<size_t>(w) + static_cast<size_t>((c.x() + ox + pad) >> shift)];
+        return values[static_cast<size_t>((c.y() + oy + pad) >> shift) * static_cast<size_t>(stride) +
+                      static_cast<size_t>((c.x() + ox + pad) >> shift)];
       });
     }
     for (const auto& c : hd.edge) {
@@ -149,7 +150,7 @@ class Search {
         continue;
       }
       const int ia = i >> shift, ja = j >> shift;
-      sum += (ia >= w || ja >= h) ? floor : values[static_cast<size_t>(ja) * static_cast<size_t>(w) + static_cast<size_t>(ia)];
+      sum += (ia >= w || ja >= h) ? floor : values[static_cast<size_t>(ja) * static_cast<size_t>(stride) + static_cast<size_t>(ia)];
     }
     if (flat_prior_) return sum + flat_log_density_;
     const int last = std::min(hi_x_, ox + (1 << level) - 1), last_y = std::min(hi_y_, oy + (1 << level) - 1);

@@ -39,6 +39,10 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
   const int h = any ? static_cast<int>(std::ceil((hi.y() - lo.y()) / resolution_)) + 1 : 1;
   width_ = w + pad_;
   height_ = h + pad_;
+  // Rows stored in whole multiples of 64 cells: consecutive submaps' grids, a few cells apart in
+  // width, then lay their rows out alike, so the cells an earlier grid wrote are mostly the ones
+  // this grid writes again (reusedCells) rather than a skewed copy of them to be floored.
+  stride_ = (width_ + 63) / 64 * 64;
   const int r = static_cast<int>(std::ceil(reach / resolution_));
   const double inv2s2 = 1.0 / (2.0 * o.hit_sigma_m * o.hit_sigma_m);
   // The cell value as a function of the squared distance, tabulated (a stamp of (2r+1)² cells
@@ -48,6 +52,10 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
   std::vector<float> table(kTable + 1);
   for (int k = 0; k <= kTable; ++k)
     table[static_cast<size_t>(k)] = static_cast<float>(std::log(std::exp(-(max_d2 * k / kTable) * inv2s2) + o.miss_floor));
+  // A stamped cell lies within r + 1/2 cells of its point on either axis, short of the table's
+  // last entry: that entry is only ever read for a cell no stamp reached (an infinite squared
+  // distance), which holds the floor, so the pass below needs no test for it.
+  table[kTable] = floor_;
   const double to_index = kTable / max_d2;
   // A cell's value is the largest over the points of the table at their squared distance, and
   // the table falls with the distance: it is the table at the squared distance to the nearest
@@ -56,7 +64,7 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
   // minima are kept only over each row's span of stamped columns, grown as stamps reach past it:
   // a submap's grid spans every return within grid_radius_m, and filling and reading the whole
   // of it in doubles was most of the grid's cost in a city (an 80 m square of 5 cm cells).
-  const size_t cells = static_cast<size_t>(width_) * static_cast<size_t>(height_);
+  const size_t cells = static_cast<size_t>(stride_) * static_cast<size_t>(height_);
   const std::unique_ptr<double[]> nearest_d2(new double[cells]);  // valid within the spans only
   std::vector<int> span_lo(static_cast<size_t>(height_), 0), span_hi(static_cast<size_t>(height_), -1);
   constexpr double kNone = std::numeric_limits<double>::infinity();
@@ -76,7 +84,7 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
     for (int j = j0; j <= j1; ++j) {
       const double dy = (origin_.y() + resolution_ * (j + 0.5)) - sp.p.y(), dy2 = dy * dy;
       const size_t b = static_cast<size_t>(j + pad_);
-      double* row = nearest_d2.get() + b * static_cast<size_t>(width_);
+      double* row = nearest_d2.get() + b * static_cast<size_t>(stride_);
       int& lo = span_lo[b];
       int& hi = span_hi[b];
       if (lo > hi) {
@@ -89,25 +97,26 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
       for (int i = a0; i <= a1; ++i) row[i] = std::min(row[i], dx2[static_cast<size_t>(i - a0)] + dy2);
     }
   }
-  Cells base = flooredCells(cells, floor_);  // the spans written below, the floor elsewhere
+  Ranges stale;
+  Cells base = reusedCells(cells, floor_, &stale);  // the spans written below; the floor or `stale` elsewhere
   written_.emplace_back(static_cast<size_t>(height_));
   for (size_t b = 0; b < static_cast<size_t>(height_); ++b) {
-    float* out = base.data() + b * static_cast<size_t>(width_);
-    const double* row = nearest_d2.get() + b * static_cast<size_t>(width_);
+    float* out = base.data() + b * static_cast<size_t>(stride_);
+    const double* row = nearest_d2.get() + b * static_cast<size_t>(stride_);
     const int lo = span_lo[b], hi = span_hi[b];
     written_.back()[b] = {lo, hi};
-    for (int i = lo; i <= hi; ++i)
-      out[i] = row[i] == kNone ? floor_ : std::max(floor_, table[static_cast<size_t>(std::min<double>(kTable, row[i] * to_index + 0.5))]);
+    for (int i = lo; i <= hi; ++i) out[i] = std::max(floor_, table[static_cast<size_t>(std::min<double>(kTable, row[i] * to_index + 0.5))]);
   }
+  floorStale(base, stale, written_.back(), stride_, floor_);
   level_.push_back(std::move(base));
   // Level h from level h-1 by doubling: the block of 2^h starting at (i, j) is four blocks of
   // 2^(h-1) starting at (i, j), (i+s, j), (i, j+s), (i+s, j+s).
-  dims_.push_back({width_, height_});
+  dims_.push_back({width_, height_, stride_});
   // Levels 1 .. full_levels_ at full resolution: the exact largest value of the block of 2^h
   // cells starting at each cell (rows first, then columns, in loops the compiler vectorises;
   // a block reaching past the edge sees the floor there). Most of a search's blocks are scored
   // at these levels, where an exact bound prunes most.
-  const size_t w_ = static_cast<size_t>(width_), h_ = static_cast<size_t>(height_);
+  const size_t w_ = static_cast<size_t>(stride_), h_ = static_cast<size_t>(height_);
   // Both passes write into one array: the row pass reads the level below, the column pass runs
   // in place from the first row up (row b reads rows b and b + step, and row b + step is
   // overwritten only later), so a level costs one array of memory traffic, not two. Only the
@@ -116,7 +125,7 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
   for (int k = 1; k <= std::min(levels, full_levels_); ++k) {
     const int step = 1 << (k - 1);
     const Cells& prev = level_.back();
-    Cells next = flooredCells(cells, floor_);  // the spans written below, the floor elsewhere
+    Cells next = reusedCells(cells, floor_, &stale);  // the spans written below; the floor or `stale` elsewhere
     for (size_t b = 0; b < h_; ++b) {
       if (span_lo[b] > span_hi[b]) continue;
       const float* src = prev.data() + b * w_;
@@ -133,18 +142,28 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
       if (span_lo[c] > span_hi[c]) continue;
       float* dst = next.data() + b * w_;
       const float* r1 = next.data() + c * w_;
-      const int lo = span_lo[c], len = span_hi[c] - span_lo[c] + 1;
-      Cells1(dst + lo, len) = Cells1(dst + lo, len).max(ConstCells1(r1 + lo, len));
+      // Row b's cells outside its own span hold the floor in principle (stale values in fact,
+      // floored once the level is done): there the maximum is row c's value, copied.
+      const int lo = span_lo[c], hi = span_hi[c];
+      const int mlo = std::max(lo, span_lo[b]), mhi = std::min(hi, span_hi[b]);
+      if (mlo > mhi) {
+        std::copy(r1 + lo, r1 + hi + 1, dst + lo);
+      } else {
+        std::copy(r1 + lo, r1 + mlo, dst + lo);
+        Cells1(dst + mlo, mhi - mlo + 1) = Cells1(dst + mlo, mhi - mlo + 1).max(ConstCells1(r1 + mlo, mhi - mlo + 1));
+        std::copy(r1 + mhi + 1, r1 + hi + 1, dst + mhi + 1);
+      }
       if (span_lo[b] > span_hi[b]) {
         span_lo[b] = span_lo[c], span_hi[b] = span_hi[c];
       } else {
         span_lo[b] = std::min(span_lo[b], span_lo[c]), span_hi[b] = std::max(span_hi[b], span_hi[c]);
       }
     }
-    level_.push_back(std::move(next));
-    dims_.push_back({width_, height_});
     written_.emplace_back(static_cast<size_t>(height_));
     for (size_t b = 0; b < h_; ++b) written_.back()[b] = {span_lo[b], span_hi[b]};
+    floorStale(next, stale, written_.back(), stride_, floor_);
+    level_.push_back(std::move(next));
+    dims_.push_back({width_, height_, stride_});
   }
   // Higher levels at 1/2^h of the resolution (Olson's multi-resolution tables): block_max holds
   // the largest value of each aligned block of 2^h cells (from the four blocks of the level
@@ -155,24 +174,31 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
   // past the edge changes no maximum): read off it instead of another pass over the base.
   const int full = std::min(levels, full_levels_);
   Cells block_max;
-  int bw = width_, bh = height_;
+  int bw = width_, bh = height_, bs = stride_;  // the level below: width, height, row stride
   if (full > 0) {
     const int nw = (width_ + (1 << full) - 1) >> full, nh = (height_ + (1 << full) - 1) >> full;
     const Cells& lv = level_[static_cast<size_t>(full)];
     block_max.resize(static_cast<size_t>(nw) * static_cast<size_t>(nh));
-    for (int b = 0; b < nh; ++b)
-      for (int a = 0; a < nw; ++a)
-        block_max[static_cast<size_t>(b) * static_cast<size_t>(nw) + static_cast<size_t>(a)] =
-            lv[(static_cast<size_t>(b) << full) * w_ + (static_cast<size_t>(a) << full)];
+    fillFloor(block_max.data(), static_cast<long>(block_max.size()), floor_);
+    // Only the level's written spans hold more than the floor: reading every 2^k-th cell of
+    // the whole grid, a cache line each, was the hottest loop of the grid.
+    const RowSpans& spans = written_.back();
+    for (int b = 0; b < nh; ++b) {
+      const auto [lo, hi] = spans[static_cast<size_t>(b) << full];
+      float* out = block_max.data() + static_cast<size_t>(b) * static_cast<size_t>(nw);
+      const float* in = lv.data() + (static_cast<size_t>(b) << full) * w_;
+      for (int a = (lo + (1 << full) - 1) >> full; a <= hi >> full; ++a) out[a] = in[static_cast<size_t>(a) << full];
+    }
     bw = nw;
     bh = nh;
+    bs = nw;
   }
   const Cells* src = full > 0 ? &block_max : &level_.front();  // the block maxima of the level below
   for (int k = full + 1; k <= levels; ++k) {
     const int nw = (bw + 1) / 2, nh = (bh + 1) / 2;
     Cells next(static_cast<size_t>(nw) * static_cast<size_t>(nh));  // every cell written below
     const auto at = [&](int a, int b) {
-      return a < bw && b < bh ? (*src)[static_cast<size_t>(b) * static_cast<size_t>(bw) + static_cast<size_t>(a)] : floor_;
+      return a < bw && b < bh ? (*src)[static_cast<size_t>(b) * static_cast<size_t>(bs) + static_cast<size_t>(a)] : floor_;
     };
     for (int b = 0; b < nh; ++b)
       for (int a = 0; a < nw; ++a)
@@ -182,6 +208,7 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
     src = &block_max;
     bw = nw;
     bh = nh;
+    bs = nw;
     if (k <= full_levels_) continue;
     Cells dilated(block_max.size());  // every cell written below
     for (int b = 0; b < bh; ++b)
@@ -189,7 +216,7 @@ LikelihoodGrid::LikelihoodGrid(const PointSet& reference, const Eigen::Vector2d&
         dilated[static_cast<size_t>(b) * static_cast<size_t>(bw) + static_cast<size_t>(a)] =
             std::max(std::max(at(a, b), at(a + 1, b)), std::max(at(a, b + 1), at(a + 1, b + 1)));
     level_.push_back(std::move(dilated));
-    dims_.push_back({bw, bh});
+    dims_.push_back({bw, bh, bw});
   }
 }
 
@@ -197,7 +224,7 @@ struct LikelihoodGrid::Storage {
   struct Kept {
     Cells cells;
     float floor;
-    int width;
+    int stride;
     RowSpans written;
   };
   // One grid's levels: local SLAM's next grid takes those of the grid before the one in use.
@@ -216,7 +243,8 @@ struct LikelihoodGrid::Storage {
   }
 };
 
-LikelihoodGrid::Cells LikelihoodGrid::flooredCells(size_t cells, float floor) {
+LikelihoodGrid::Cells LikelihoodGrid::reusedCells(size_t cells, float floor, Ranges* stale) {
+  stale->clear();
   std::vector<Storage::Kept>& kept = Storage::ofThisThread().kept;
   size_t best = kept.size();  // the smallest kept storage large enough, of the same floor
   for (size_t k = 0; k < kept.size(); ++k)
@@ -235,18 +263,37 @@ LikelihoodGrid::Cells LikelihoodGrid::flooredCells(size_t cells, float floor) {
   kept.erase(kept.begin() + static_cast<long>(best));
   for (size_t b = 0; b < k.written.size(); ++b) {
     const auto [lo, hi] = k.written[b];
-    if (lo <= hi) fillFloor(k.cells.data() + b * static_cast<size_t>(k.width) + static_cast<size_t>(lo), hi - lo + 1, floor);
+    const size_t row = b * static_cast<size_t>(k.stride);
+    if (lo <= hi) stale->push_back({row + static_cast<size_t>(lo), row + static_cast<size_t>(hi) + 1});
   }
   return std::move(k.cells);
+}
+
+void LikelihoodGrid::floorStale(Cells& c, const Ranges& stale, const RowSpans& written, int stride, float floor) {
+  const size_t w = static_cast<size_t>(stride);
+  for (auto [s, e] : stale) {
+    // A stale range lies in one row of the earlier grid: one or two rows of this one, or past them.
+    while (s < e) {
+      const size_t b = s / w, row = b * w, end = std::min(e, row + w);
+      if (b < written.size() && written[b].first <= written[b].second) {
+        const size_t lo = row + static_cast<size_t>(written[b].first), hi = row + static_cast<size_t>(written[b].second) + 1;
+        if (s < lo) fillFloor(c.data() + s, static_cast<long>(std::min(end, lo) - s), floor);
+        if (end > hi) fillFloor(c.data() + std::max(s, hi), static_cast<long>(end - std::max(s, hi)), floor);
+      } else {
+        fillFloor(c.data() + s, static_cast<long>(end - s), floor);
+      }
+      s = end;
+    }
+  }
 }
 
 LikelihoodGrid::~LikelihoodGrid() {
   if (Storage::gone()) return;
   std::vector<Storage::Kept>& kept = Storage::ofThisThread().kept;
   // A full pool keeps what it holds (storage too small for a later grid is freed when that grid
-  // asks, flooredCells); this grid's levels are then freed.
+  // asks, reusedCells); this grid's levels are then freed.
   for (size_t k = 0; k < written_.size() && k < level_.size() && kept.size() < Storage::kMaxKept; ++k)
-    kept.push_back({std::move(level_[k]), floor_, width_, std::move(written_[k])});
+    kept.push_back({std::move(level_[k]), floor_, stride_, std::move(written_[k])});
 }
 
 }  // namespace urbanslam::alignment

@@ -3,6 +3,7 @@
 // range and bearing): the shortest return per bearing bin. Used to ask which points of another
 // scan or submap lie where this scan saw through (negative information, as FreeSpace.h gives it
 // for loop closures on whole scans).
+#include <cmath>
 #include <vector>
 
 #include <Eigen/Core>
@@ -28,7 +29,17 @@ class BeamFreeSpace {
   void classify(const std::vector<Eigen::Vector2d>& points, const common::Pose2& scan_pose, std::vector<char>& state) const;
 
  private:
-  size_t binOf(double bearing_rad) const;  // the bearing's bin, counted from 0 rad counter-clockwise
+  // The bearing's bin, counted from 0 rad counter-clockwise (here, to be inlined into classify's
+  // loop).
+  size_t binOf(double bearing_rad) const {
+    // atan2's range needs no reduction (std::remainder costs as much as the atan2 before it).
+    double from_zero = std::abs(bearing_rad) <= M_PI ? bearing_rad : std::remainder(bearing_rad, 2 * M_PI);
+    if (from_zero < 0) from_zero += 2 * M_PI;
+    // At most 2 pi over the bin width: at most the bin count, which is bin 0 again (a compare
+    // instead of an integer division, which was a tenth of classify's time).
+    const size_t b = static_cast<size_t>(from_zero / bin_rad_);
+    return b >= free_m_.size() ? b - free_m_.size() : b;
+  }
 
   bool valid_ = false;
   common::Pose2 sensor_;  // the sensor in the scan's frame (fitted from the points' own polar coordinates)

@@ -64,13 +64,15 @@ class LikelihoodGrid {
     if (i + pad_ < 0 || j + pad_ < 0) return floor_;
     const int a = (i + pad_) >> sh, b = (j + pad_) >> sh;
     if (a >= d.width || b >= d.height) return floor_;
-    return level_[static_cast<size_t>(level)][static_cast<size_t>(b) * static_cast<size_t>(d.width) + static_cast<size_t>(a)];
+    return level_[static_cast<size_t>(level)][static_cast<size_t>(b) * static_cast<size_t>(d.stride) + static_cast<size_t>(a)];
   }
-  // Raw access for tight loops: level h's values, row-major, levelWidth(h) x levelHeight(h);
-  // the cell (i, j) of value() at ((j + pad()) >> shiftOf(h)) * levelWidth(h) + ((i + pad()) >> shiftOf(h)).
+  // Raw access for tight loops: level h's values, row-major, levelWidth(h) x levelHeight(h) in
+  // rows of levelStride(h) >= levelWidth(h) cells (past the width: not part of the grid); the cell
+  // (i, j) of value() at ((j + pad()) >> shiftOf(h)) * levelStride(h) + ((i + pad()) >> shiftOf(h)).
   const float* levelData(int level) const { return level_[static_cast<size_t>(level)].data(); }
   int levelWidth(int level) const { return dims_[static_cast<size_t>(level)].width; }
   int levelHeight(int level) const { return dims_[static_cast<size_t>(level)].height; }
+  int levelStride(int level) const { return dims_[static_cast<size_t>(level)].stride; }
   int pad() const { return pad_; }
   // The log-likelihood of one point at p (level 0).
   float score(const Eigen::Vector2d& p) const {
@@ -84,9 +86,10 @@ class LikelihoodGrid {
   Eigen::Vector2d origin_;  // corner of cell (0, 0)
   int pad_ = 0;             // cells before cell 0 on each axis (blocks that start outside)
   int width_ = 0, height_ = 0;
+  int stride_ = 0;  // the full-resolution levels' row length in storage
   float floor_ = 0;
   struct Dims {
-    int width, height;
+    int width, height, stride;
   };
   std::vector<Dims> dims_;
   // Storage whose size constructor leaves the cells unset: every level is written in full by a
@@ -114,11 +117,16 @@ class LikelihoodGrid {
   // Local SLAM builds a grid of an 80 m square of 5 cm cells per keyframe, of which stamps
   // reach about a tenth: writing the floor into the rest of the base and full-resolution levels
   // was half of the grid's cost. Their storage is kept per thread when a grid is done, with the
-  // span of each row the grid wrote (rows are `width` cells); the next grid resets those spans
-  // to the floor and finds every other cell there already.
-  using RowSpans = std::vector<std::pair<int, int>>;  // per row: first and last cell written
+  // span of each row the grid wrote (rows are `stride` cells); the next grid finds the floor
+  // everywhere else, writes its own spans and then floors what is left of the earlier ones
+  // (consecutive submaps' spans mostly overlap: resetting them first wrote most cells twice).
+  using RowSpans = std::vector<std::pair<int, int>>;      // per row: first and last cell written
+  using Ranges = std::vector<std::pair<size_t, size_t>>;  // [begin, end) cell indices, ascending
   struct Storage;
-  static Cells flooredCells(size_t cells, float floor);
+  // At least `cells` cells, at the floor except within `stale` (another grid's values).
+  static Cells reusedCells(size_t cells, float floor, Ranges* stale);
+  // Floors the cells of `stale` outside the rows' spans this grid wrote.
+  static void floorStale(Cells& c, const Ranges& stale, const RowSpans& written, int stride, float floor);
   std::vector<RowSpans> written_;  // per full-resolution level (0 = base)
 };
 
