@@ -75,10 +75,6 @@ const char* confirmationName(Confirmation c) {
 
 namespace {
 
-// Earlier keyframes' references kept: a keyframe's candidates are the few nearest keyframes,
-// and the next keyframes' are mostly the same ones.
-constexpr size_t kKeptReferences = 32;
-
 MovingReturnsOptions movingReturnsOptions(const LoopClosureOptions& options) {
   MovingReturnsOptions o;
   o.neighbours = options.moving_returns_neighbours;
@@ -88,10 +84,7 @@ MovingReturnsOptions movingReturnsOptions(const LoopClosureOptions& options) {
 }  // namespace
 
 LoopCloser::LoopCloser(const LoopClosureOptions& options)
-    : options_(options),
-      chi2_2dof_(esdf::chi2Quantile(options.mahalanobis_probability, 2)),
-      moving_(movingReturnsOptions(options)),
-      earlier_references_(alignment::AlignerOptions{}.scan, alignment::AlignerOptions{}.in_vehicle_frame, kKeptReferences) {}
+    : options_(options), chi2_2dof_(esdf::chi2Quantile(options.mahalanobis_probability, 2)), moving_(movingReturnsOptions(options)) {}
 
 void LoopCloser::setScorer(CandidateScorer scorer) { scorer_ = std::move(scorer); }
 
@@ -260,8 +253,7 @@ LoopCloser::AlignedScans LoopCloser::alignScans(const io::LaserScan& earlier_sca
   // campus, Victoria Park or UAL; on ACES 9 closures replaced 7 (220 against 218, relation error
   // 0.0369 m against 0.0370); the cities ran 3-6 % faster (bench/scale/RESULTS.md).
   ao.crf.hypotheses_kept = 2;
-  // Built with the aligner's default scan model, as ao's.
-  std::shared_ptr<const alignment::IndexedReference> earlier = earlier_references_.get(earlier_scan);
+  alignment::PointSet earlier_set = alignment::pointSetFromScan(earlier_scan, ao.scan, ao.in_vehicle_frame);
   out.current = alignment::pointSetFromScan(current_scan, ao.scan, ao.in_vehicle_frame);
   // Two 180° scans that looked away from each other, or at places the other never saw, share no
   // points wherever the gate would put them: the check costs microseconds, a global alignment
@@ -269,7 +261,7 @@ LoopCloser::AlignedScans LoopCloser::alignScans(const io::LaserScan& earlier_sca
   if (admitted) {
     alignment::ViewOverlapOptions vo;
     vo.gate_m = ao.icp.gate_final_m;
-    const alignment::ViewSector sector = alignment::viewSector(earlier->points(), earlier_scan.sensor_pose);
+    const alignment::ViewSector sector = alignment::viewSector(earlier_set, earlier_scan.sensor_pose);
     if (!alignment::mayMatchShare(sector, out.current, *admitted, options_.min_matched_fraction, vo)) {
       r.measurement = guess;
       r.reason = ClosureReason::NoOverlap;
@@ -277,8 +269,8 @@ LoopCloser::AlignedScans LoopCloser::alignScans(const io::LaserScan& earlier_sca
     }
   }
   // The point sets, kd-tree and line normals built once for every alignment below (the
-  // ambiguity test restarts PL-ICP up to 16 times) and kept for the next attempts.
-  out.earlier = std::move(earlier);
+  // ambiguity test restarts PL-ICP up to 16 times).
+  out.earlier = std::make_unique<const alignment::IndexedReference>(std::move(earlier_set));
   // Below min_matched_fraction an alignment is refused: its ICP runs (from CRF-match's
   // hypotheses and the guess) that cannot reach it are given up early. The ambiguity test's
   // restarts are given up the same way below the count that would make them another minimum

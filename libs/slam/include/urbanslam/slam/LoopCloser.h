@@ -26,7 +26,6 @@
 #include "urbanslam/slam/MovingReturns.h"
 #include "urbanslam/slam/PipelineOptions.h"
 #include "urbanslam/slam/Proposer.h"
-#include "urbanslam/slam/ScanReferences.h"
 
 namespace urbanslam::alignment {
 class IndexedReference;
@@ -200,9 +199,6 @@ class LoopCloser {
   io::LaserScan current_scan_;  // the current keyframe's scan, its moving returns hidden (staticScan)
 
   MovingReturns moving_;  // the judges' free space, kept between attempts
-  // The earlier scans' references of the latest alignments (the aligner's default scan model,
-  // which every alignment here uses).
-  mutable ScanReferences earlier_references_;
   // Keyframe k's scan without the returns that moved (MovingReturns.h), judged by the keyframes
   // around it that the map holds, placed by the estimate (global SLAM seeks a keyframe's
   // closures once the ones after it are in: GlobalSlam::searchLag).
@@ -212,7 +208,7 @@ class LoopCloser {
   // tryClose runs only when the gate does not refuse the closure anyway).
   struct AlignedScans {
     alignment::AlignmentResult result;
-    std::shared_ptr<const alignment::IndexedReference> earlier;
+    std::unique_ptr<const alignment::IndexedReference> earlier;
     alignment::PointSet current;
     alignment::AlignerOptions options;
     double reach_m = 0;
