@@ -354,6 +354,22 @@ TEST(OdometryOutvotes, TrustedOnlyWhereMatchesRarelyOutvoteTheOdometry) {
   EXPECT_EQ(copy.rate(), often.rate());
 }
 
+// A match of the trusted odometry's window (0.4 m each way here; matches usually explain 80 %
+// of the scan) is doubted at the window's outer quarter on either axis, when it outvoted the
+// odometry, or below nine tenths of the usual share; otherwise it stands.
+TEST(OdometryOutvotes, ANarrowedMatchIsDoubtedAtTheWindowsEdgeOrWhenItExplainsLittle) {
+  const auto doubts = [](double dx, double dy, bool outvoted, double share) {
+    return OdometryOutvotes::doubtsNarrowMatch(dx, dy, 0.4, outvoted, share, 0.8);
+  };
+  EXPECT_FALSE(doubts(0.0, 0.0, false, 0.8));
+  EXPECT_FALSE(doubts(0.29, -0.29, false, 0.73));  // inside three quarters, 91 % of the usual
+  EXPECT_TRUE(doubts(0.31, 0.0, false, 0.8));
+  EXPECT_TRUE(doubts(0.0, -0.31, false, 0.8));
+  EXPECT_TRUE(doubts(0.0, 0.0, true, 0.8));
+  EXPECT_TRUE(doubts(0.0, 0.0, false, 0.71));                                         // 89 % of the usual
+  EXPECT_FALSE(OdometryOutvotes::doubtsNarrowMatch(0.0, 0.0, 0.4, false, 0.1, 0.0));  // nothing usual yet
+}
+
 TEST(HeadingCorrections, TheWindowIsFiveRmsOfTheCorrectionsInTheModelsSigmas) {
   std::mt19937 rng(5);
   HeadingCorrections h;

@@ -7,11 +7,6 @@
 
 namespace urbanslam::slam {
 
-namespace {
-// A match within a trusted odometry's 3σ must explain this share of what matches usually do.
-constexpr double kTrustedMatchedShare = 0.9;
-}  // namespace
-
 alignment::PriorMatcherOptions priorMatcherOptions(const LocalOptions& o) {
   alignment::PriorMatcherOptions m;
   m.grid.resolution_m = o.resolution_m;
@@ -89,24 +84,18 @@ alignment::PriorMatchResult LocalSubmap::match(const io::LaserScan& scan, const 
   // (OdometryOutvotes.h): within the heading corrections' reach and the prior's 3σ of
   // translation. Otherwise the search over the heading corrections' reach and the translation
   // that covers odometry wrong in direction (twice the travel: the window of a car at 10 m/s 4 m
-  // square). The prior's full window when a
-  // search's match is in doubt (not when no search ran: too few points fail the same way in any
-  // window): its best heading at the window's edge or the scan matched far less than usual
-  // (HeadingCorrections.h), or, with the direction's reach left out, its best translation at the
-  // window's edge, the odometry outvoted or the scan explained less than nine tenths of the usual
-  // share (what every match the full window moved beyond the narrower one showed on FR079 and
-  // Victoria Park).
+  // square). The prior's full window when a search's match is in doubt (not when no search ran:
+  // too few points fail the same way in any window): its heading (HeadingCorrections::doubts)
+  // or, with the direction's reach left out, its translation
+  // (OdometryOutvotes::doubtsNarrowMatch).
   const double usual = heading_corrections_.usualMatchedShare();
   const bool trusted = outvotes_.trusted();
   options.heading_window_scale = heading_corrections_.windowScale();
   options.search_direction_reach = !trusted;
   alignment::PriorMatchResult r = alignment::matchWithPrior(*ref, scan_points, prior, prior_cov, options);
-  const auto atEdge = [&] {
-    const double edge = alignment::HeadingCorrections::kEdgeShare * r.search_half_width_m;
-    return std::abs(r.search_pose.x - prior.x) > edge || std::abs(r.search_pose.y - prior.y) > edge;
-  };
-  const bool poor =
-      !options.search_direction_reach && (atEdge() || r.odometry_outvoted || r.matchedFraction() < kTrustedMatchedShare * usual);
+  const bool poor = !options.search_direction_reach &&
+                    alignment::OdometryOutvotes::doubtsNarrowMatch(r.search_pose.x - prior.x, r.search_pose.y - prior.y,
+                                                                   r.search_half_width_m, r.odometry_outvoted, r.matchedFraction(), usual);
   if (r.window_narrowed && r.search_nodes > 0 &&
       (poor || heading_corrections_.doubts(r.valid, common::wrapToPi(r.search_pose.phi - prior.phi), r.search_half_angle_rad,
                                            r.matchedFraction()))) {
