@@ -23,14 +23,19 @@ io::LaserScan roomScan(const common::Pose2& pose, unsigned seed) {
   return at::simulateScan(at::roomWorld(), pose, spec);
 }
 
-TEST(LocalSubmap, AHeadingErrorBeyondTheLearntWindowIsStillFound) {
+// A submap of one keyframe of the room at the origin, and the odometry model's covariance: 2.5 cm,
+// and a heading sigma of 0.1 rad (17° of window each side).
+class LocalSubmapInARoom : public ::testing::Test {
+ protected:
+  LocalSubmapInARoom() { submap.addKeyframe(roomScan({0, 0, 0}, 1)); }
   const slam::LocalOptions o;  // a 5° window at least
-  slam::LocalSubmap submap(o);
-  submap.addKeyframe(roomScan({0, 0, 0}, 1));
+  slam::LocalSubmap submap{o};
   const std::vector<common::Pose2> poses{common::Pose2{}};
-  // The model's heading sigma is 0.1 rad (17° of window each side); this odometry errs by a
-  // few milliradians.
   const Eigen::Matrix3d cov = Eigen::Vector3d(0.025 * 0.025, 0.025 * 0.025, 0.01).asDiagonal();
+};
+
+TEST_F(LocalSubmapInARoom, AHeadingErrorBeyondTheLearntWindowIsStillFound) {
+  // This odometry errs in heading by a few milliradians.
   std::mt19937 rng(3);
   std::normal_distribution<double> heading_error(0, 0.005);
   alignment::PriorMatchResult last;
@@ -53,12 +58,7 @@ TEST(LocalSubmap, AHeadingErrorBeyondTheLearntWindowIsStillFound) {
   EXPECT_NEAR(r.search_half_angle_rad, 3 * 0.1, 1e-12);  // the full window found it
 }
 
-TEST(LocalSubmap, TrustedOdometryNarrowsTheSearchAndAReversalIsStillFound) {
-  const slam::LocalOptions o;
-  slam::LocalSubmap submap(o);
-  submap.addKeyframe(roomScan({0, 0, 0}, 1));
-  const std::vector<common::Pose2> poses{common::Pose2{}};
-  const Eigen::Matrix3d cov = Eigen::Vector3d(0.025 * 0.025, 0.025 * 0.025, 0.01).asDiagonal();
+TEST_F(LocalSubmapInARoom, TrustedOdometryNarrowsTheSearchAndAReversalIsStillFound) {
   std::mt19937 rng(4);
   std::normal_distribution<double> error(0, 0.01);
   const common::Pose2 truth{0.3, 0.05, 0.02};

@@ -193,8 +193,8 @@ TEST(MapFile, MapWithAnImageDatabaseIsRefusedUnlessOnlyRead) {
 // A file of the format before separate maps (version 3, written by that version: the fuzzing
 // seed) is read as a map without any; written again, every section is as it was (the options
 // aside: they list the keys added since), local SLAM's but for its heading corrections and its
-// odometry outvotes (none learnt: five zeros), the statistics but for their durations (histograms now, one per step
-// read), and the empty separate-maps section follows.
+// odometry outvotes (none learnt: five zeros), the statistics but for their durations
+// (histograms now, one per step read), and the empty separate-maps section follows.
 TEST(MapFile, AVersion3FileIsReadAsAMapWithoutSeparateMaps) {
   const std::string path = test::repoPath("fuzz/corpus/map_file/three-scans-24-beams.usmap");
   const std::string old = readBytes(path);

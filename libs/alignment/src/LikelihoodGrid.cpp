@@ -272,7 +272,9 @@ LikelihoodGrid::Cells LikelihoodGrid::reusedCells(size_t cells, float floor, Ran
 void LikelihoodGrid::floorStale(Cells& c, const Ranges& stale, const RowSpans& written, int stride, float floor) {
   const size_t w = static_cast<size_t>(stride);
   for (auto [s, e] : stale) {
-    // A stale range lies in one row of the earlier grid: one or two rows of this one, or past them.
+    // A stale range is one row of the earlier grid, whose rows may be longer or shorter than
+    // this grid's: cut it at this grid's rows (or past its last), each part floored outside that
+    // row's span.
     while (s < e) {
       const size_t b = s / w, row = b * w, end = std::min(e, row + w);
       if (b < written.size() && written[b].first <= written[b].second) {
