@@ -1,6 +1,7 @@
-// Global SLAM's candidate schedule far from the map, through GlobalSlam itself: the pose-gated
-// candidates are searched at every far_every_n_keyframes-th keyframe only, except while a closure
-// hypothesis waits for its confirmation, which only the next keyframes' searches can bring.
+// Global SLAM's candidate schedule, through GlobalSlam itself: far from the map the pose-gated
+// candidates are searched at every far_every_n_keyframes-th keyframe only, along a revisit at every
+// revisit_every_n_keyframes-th, except while a closure hypothesis waits for its confirmation,
+// which only the next keyframes' searches can bring.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -41,9 +42,12 @@ struct Run {
 
 // Keyframes 0-199 one metre apart along x, each odometry link 0.5 m uncertain; keyframe 200 back
 // at x = 100 (5 m uncertain relative to keyframe 100: far from the map) and on from there.
-// `late_range_m`: the range of the scans from keyframe 200 on (the earlier ones see 10 m).
-std::unique_ptr<Run> drive(double late_range_m) {
+// `late_range_m`: the range of the scans from keyframe 200 on (the earlier ones see 10 m);
+// `last`: the last keyframe; [loop_closure] revisit_every_n_keyframes and max_candidates.
+std::unique_ptr<Run> drive(double late_range_m, size_t last = 203, int revisit_every_n = 1, int max_candidates = 3) {
   auto r = std::make_unique<Run>();
+  r->options.loop_closure.revisit_every_n_keyframes = revisit_every_n;
+  r->options.loop_closure.max_candidates = max_candidates;
   r->options.loop_closure.detector = slam::LoopClosureOptions::Detector::None;
   r->options.loop_closure.appearance_min_sigma_m = 3;
   r->options.loop_closure.far_every_n_keyframes = 4;
@@ -56,7 +60,7 @@ std::unique_ptr<Run> drive(double late_range_m) {
   r->global = std::make_unique<slam::GlobalSlam>(r->options, r->map, r->stats, r->observers);
   slam::KeyframeConstraint c;
   c.cov = Eigen::Vector3d(0.25, 0.25, 1e-6).asDiagonal();
-  for (size_t k = 0; k <= 203; ++k) {
+  for (size_t k = 0; k <= last; ++k) {
     c.z = {k == 200 ? -99.0 : 1.0, 0, 0};  // from x = 199 back to 100, then on along x
     const float range = static_cast<float>(k < 200 ? 10.0 : late_range_m);
     r->global->addKeyframe({k, static_cast<double>(k), {}, true, false, {}}, io::CompactScan(test::constantScan(k, range, 80)), c);
@@ -95,6 +99,32 @@ TEST(GlobalSlam, AClosureAwaitingConfirmationMakesTheNextKeyframesSearchFarFromT
   EXPECT_FALSE(none.at(200).empty());
   for (size_t k : {201, 202, 203}) EXPECT_TRUE(!none.count(k) || none.at(k).empty()) << k;
   EXPECT_EQ(other->stats.closures_accepted, 0u);
+}
+
+// Along a revisit the search waits for the n-th keyframe after the newest closure: a closure
+// waits for its confirmation at the next keyframe, the two go in, and the next two keyframes
+// (with n = 3) are not searched. Every keyframe of the revisit searches with n = 1, and with
+// n = 3 while a hypothesis waits (three candidates a search: two are left waiting).
+TEST(GlobalSlam, AlongARevisitTheSearchWaitsForTheNthKeyframeAfterTheNewestClosure) {
+  const auto every = drive(10.0, 209, 1, 1);
+  const auto strided = drive(10.0, 209, 3, 1);
+  const auto waiting = drive(10.0, 209, 3, 3);
+  const auto searched_from_200 = [](const ::Run& r) {
+    std::vector<size_t> out;
+    for (const auto& [k, candidates] : r.log.by_keyframe)
+      if (k >= 200) out.push_back(k);
+    return out;
+  };
+  const std::vector<size_t> searched = searched_from_200(*strided);
+  EXPECT_EQ(searched, (std::vector<size_t>{200, 201, 204, 205, 208, 209}));
+  EXPECT_EQ(searched_from_200(*every), (std::vector<size_t>{200, 201, 202, 203, 204, 205, 206, 207, 208, 209}));
+  EXPECT_EQ(searched_from_200(*waiting), searched_from_200(*every));
+  // Each search of the revisit closes the loop (a closure and its confirmation).
+  std::vector<size_t> closed;
+  for (const slam::LoopClosureRecord& c : strided->global->closures())
+    if (c.accepted) closed.push_back(c.to);
+  EXPECT_EQ(closed, searched);
+  EXPECT_EQ(every->stats.closures_accepted, 10u);
 }
 
 // A camera closure's full pose goes in only where the estimate knows the pair within

@@ -354,8 +354,17 @@ void GlobalSlam::closePendingLoops(SteadyTime handed_over) {
 }
 
 void GlobalSlam::searchLoopsEvery(size_t current, SteadyTime handed_over) {
-  if (map_.filter() && options_.loop_closure.enabled && current % static_cast<size_t>(options_.loop_closure.every_n_keyframes) == 0)
-    searchLoops(current, handed_over);
+  const LoopClosureOptions& o = options_.loop_closure;
+  if (!map_.filter() || !o.enabled || current % static_cast<size_t>(o.every_n_keyframes) != 0) return;
+  if (alongRevisit(current)) return;
+  searchLoops(current, handed_over);
+}
+
+bool GlobalSlam::alongRevisit(size_t current) const {
+  // The newest closure is at most n-1 keyframes back: the next is at the n-th (a hypothesis that
+  // waits for its confirmation is searched at every keyframe, or it expires).
+  const size_t n = static_cast<size_t>(options_.loop_closure.revisit_every_n_keyframes);
+  return last_accepted_ && last_accepted_->to < current && current - last_accepted_->to < n && !confirming();
 }
 
 void GlobalSlam::searchLoops(size_t current, SteadyTime handed_over) {

@@ -98,6 +98,9 @@ void declareOptions(common::OptionsSchema& s, PipelineOptions& o) {
         "a laser short of the full circle: a candidate heading the other way is replaced by the keyframe of its visit nearest to this "
         "far ahead of the current pose, where the two views meet (0: off)");
   s.add("every_n_keyframes", o.loop_closure.every_n_keyframes, 1, 1000, "keyframes", "search at every n-th keyframe");
+  s.add("revisit_every_n_keyframes", o.loop_closure.revisit_every_n_keyframes, 1, 1000, "keyframes",
+        "along a revisit (a closure accepted at one of the last n-1 keyframes, none awaiting confirmation) search at every n-th keyframe "
+        "only: consecutive closures measure the same walls");
   s.add("far_every_n_keyframes", o.loop_closure.far_every_n_keyframes, 1, 1000, "keyframes",
         "beyond appearance_min_sigma_m, the keyframes nearest the estimate are candidates at every n-th keyframe only (as likely wrong at "
         "the next keyframe; detections are searched at every one)");

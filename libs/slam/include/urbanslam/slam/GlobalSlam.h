@@ -151,8 +151,9 @@ class GlobalSlam {
   void closureAdded(size_t current, SteadyTime handed_over);
   bool missesAddedClosure() const;
   // Candidates, alignment, gating and confirmation for keyframe `current` (every
-  // [loop_closure] every_n_keyframes).
+  // [loop_closure] every_n_keyframes; along a revisit every revisit_every_n_keyframes).
   void searchLoopsEvery(size_t current, SteadyTime handed_over);
+  bool alongRevisit(size_t current) const;
   void searchLoops(size_t current, SteadyTime handed_over);
   // The newest filter poses recovered ([estimator] recent_window), the newest keyframes' poses
   // pulled.

@@ -93,6 +93,10 @@ struct LoopClosureOptions {
   // visit nearest to this far ahead of the current pose (0: off).
   double opposite_view_offset_m = 20.0;
   int every_n_keyframes = 1;  // search at every n-th keyframe
+  // Along a revisit (a closure accepted at one of the last n-1 keyframes, none waiting for its
+  // confirmation) the search waits for the n-th keyframe: consecutive keyframes' closures measure
+  // the same walls from half a metre further on, and the filter counts each as independent.
+  int revisit_every_n_keyframes = 3;
   // Where the pose relative to the nearest keyframe is uncertain beyond appearance_min_sigma_m,
   // the keyframes nearest the estimate are searched at every n-th keyframe only (detections still
   // at every one): from one keyframe to the next they are the same guesses about as wrong.
