@@ -163,3 +163,175 @@ TEST(PathSubmaps, AFarClosureIsMeasuredByTheSubmaps) {
   EXPECT_NEAR(submaps.free_space_conflict, conflict(c.measurement), 1e-12);
   EXPECT_GT(conflict(common::compose(common::Pose2{12, 0, 0}, c.measurement)), 2 * o.max_free_space_conflict);
 }
+
+namespace {
+
+// A street whose design repeats every 48 m: four buildings of 12 m, each with its recessed door
+// at another place, then the four again; facades 8 m either side of the centre line.
+World streetOfPeriod48() {
+  World w;
+  const double doors[] = {1.0, 6.5, 3.0, 8.5};
+  for (int b = -20; b < 20; ++b) {
+    const double x = 12.0 * b, door = doors[((b % 4) + 4) % 4];
+    w.push_back({{x, 8}, {x + door, 8}});
+    w.push_back({{x + door, 8}, {x + door, 9.5}});
+    w.push_back({{x + door, 9.5}, {x + door + 2, 9.5}});
+    w.push_back({{x + door + 2, 9.5}, {x + door + 2, 8}});
+    w.push_back({{x + door + 2, 8}, {x + 12, 8}});
+    w.push_back({{x, -8}, {x + 12 - door - 2, -8}});
+    w.push_back({{x + 12 - door - 2, -8}, {x + 12 - door - 2, -9.5}});
+    w.push_back({{x + 12 - door - 2, -9.5}, {x + 12 - door, -9.5}});
+    w.push_back({{x + 12 - door, -9.5}, {x + 12 - door, -8}});
+    w.push_back({{x + 12 - door, -8}, {x + 12, -8}});
+  }
+  return w;
+}
+
+// Two visits east along y = -3, each from x = -120 to 120 a metre a keyframe (keyframes 0..240,
+// then 241..481), the map's poses the truth.
+std::unique_ptr<slam::Map> twoVisitsEast(const World& w) {
+  auto map = std::make_unique<slam::Map>(nullptr, 2.0);
+  alignment::test::ScanSpec spec;
+  spec.max_range_m = 50;
+  size_t index = 0;
+  for (int visit = 0; visit < 2; ++visit)
+    for (int s = 0; s <= 240; ++s) {
+      const common::Pose2 pose{-120.0 + s, -3, 0};
+      spec.seed = static_cast<unsigned>(index + 1);
+      map->addKeyframe({index, static_cast<double>(index), pose, true, false, {}},
+                       io::CompactScan(alignment::test::simulateScan(w, pose, spec)));
+      ++index;
+    }
+  return map;
+}
+
+}  // namespace
+
+// A closure one period (48 m) off along a street that repeats beyond the submaps' 60 m: the two
+// submaps align at it as well as at the truth. Only an earlier submap that reaches as far as the
+// gate admits holds the stretch the restarts shift the current submap to, where it matches as
+// well: the closure is ambiguous, the true one as much as its alias; within a reach short of the
+// period, neither is.
+TEST(PathSubmaps, AStreetThatRepeatsBeyondTheSubmapsIsAmbiguousWithinTheGatesReach) {
+  const auto map = twoVisitsEast(streetOfPeriod48());
+  constexpr size_t kCurrent = 241 + 120;  // x = 0 on the second visit
+  // The true closure (the first visit's keyframe at x = 0) and its alias (the one at x = -48,
+  // measured at the same place): each aligns where it started, and is ambiguous within a reach
+  // of 60 m, not within 20 m.
+  for (const size_t earlier : {size_t{120}, size_t{72}}) {
+    const common::Pose2 z{};
+    const slam::SubmapCheck wide = slam::alignPathSubmaps(*map, earlier, kCurrent, z, 60, {});
+    ASSERT_TRUE(wide.aligned);
+    EXPECT_LT(std::hypot(wide.measurement.x, wide.measurement.y), 0.1) << earlier;
+    EXPECT_TRUE(wide.ambiguous) << earlier;
+    EXPECT_FALSE(slam::alignPathSubmaps(*map, earlier, kCurrent, z, 20, {}).ambiguous) << earlier;
+  }
+}
+
+namespace {
+
+// A street of 6 m buildings whose facades stand back by their own setback (0 to 2.4 m behind 8 m
+// from the centre line, by the building's number and `design` (1 or 2), the buildings of design 2
+// 3 m further back), a tree before each on either side; the buildings from x = -6 to 18 are of
+// design 1 in every street.
+World streetOfSetbacks(int design) {
+  World w;
+  double north_before = 8, south_before = -8;
+  for (int b = -30; b < 30; ++b) {
+    const double x = 6.0 * b;
+    const int d = (b >= -1 && b < 3) ? 1 : design;
+    const auto setback = [&](unsigned side) {
+      unsigned h = static_cast<unsigned>(b + 100) * 2654435761u ^ static_cast<unsigned>(d) * 40503u ^ side * 97u;
+      h ^= h >> 13;
+      h *= 0x5bd1e995u;
+      h ^= h >> 15;
+      return 3.0 * (d - 1) + 0.6 * static_cast<double>(h % 5u);
+    };
+    const double north = 8 + setback(0), south = -8 - setback(1);
+    alignment::test::addPolygon(w, x + 1 + setback(2), 6.5, 0.4, 8);  // a tree a building, where its design puts it
+    alignment::test::addPolygon(w, x + 1 + setback(3), -6.5, 0.4, 8);
+    w.push_back({{x, north_before}, {x, north}});
+    w.push_back({{x, north}, {x + 6, north}});
+    w.push_back({{x, south_before}, {x, south}});
+    w.push_back({{x, south}, {x + 6, south}});
+    north_before = north;
+    south_before = south;
+  }
+  return w;
+}
+
+// The first visit east along the centre line from x = first_from_x to 120 in `first`, a
+// keyframe a metre, the second from x = -120 to 120 in `second` (keyframes 0..240, then
+// 241..481, with the default start), a 180° laser of 16 m range.
+std::unique_ptr<slam::Map> visitsOf(const World& first, const World& second, int first_from_x = -120) {
+  auto map = std::make_unique<slam::Map>(nullptr, 2.0);
+  alignment::test::ScanSpec spec;
+  spec.max_range_m = 16;
+  size_t index = 0;
+  for (const World* w : {&first, &second})
+    for (int x = w == &first ? first_from_x : -120; x <= 120; ++x) {
+      const common::Pose2 pose{static_cast<double>(x), 0, 0};
+      spec.seed = static_cast<unsigned>(index + 1);
+      map->addKeyframe({index, static_cast<double>(index), pose, true, false, {}},
+                       io::CompactScan(alignment::test::simulateScan(*w, pose, spec)));
+      ++index;
+    }
+  return map;
+}
+
+}  // namespace
+
+// Two streets alike from x = -6 to 18 and nowhere else: scans at x = 0 (looking east) see the
+// same, and the submaps of 60 m of path around them (the closure putting both at one place)
+// share under a quarter of the current one's points. Two visits of one street agree there.
+TEST(PathSubmaps, NeighbourhoodsOfTwoPlacesThatLookAlikeOnlyThereDisagree) {
+  slam::PathSubmapOptions o;
+  o.path_m = 60;
+  const common::Pose2 z{};
+  const auto same = visitsOf(streetOfSetbacks(1), streetOfSetbacks(1));
+  const slam::SubmapCheck agree = slam::alignPathSubmaps(*same, 120, 361, z, 3, o);
+  EXPECT_TRUE(agree.aligned);
+  EXPECT_FALSE(agree.disagree);
+  const auto other = visitsOf(streetOfSetbacks(1), streetOfSetbacks(2));
+  const slam::SubmapCheck differ = slam::alignPathSubmaps(*other, 120, 361, z, 3, o);
+  EXPECT_FALSE(differ.aligned);
+  EXPECT_TRUE(differ.disagree);
+}
+
+// The earlier visit starts at the closure's place: the current submap's 60 m of path before it
+// lie where that visit saw nothing (its laser looked ahead), and its points there are not
+// counted: the two submaps agree. Counting every point, they would disagree.
+TEST(PathSubmaps, WhereTheEarlierVisitSawNothingThereIsNothingToDisagreeWith) {
+  const auto map = visitsOf(streetOfSetbacks(1), streetOfSetbacks(1), 0);  // keyframes 0..120, then 121..361
+  constexpr size_t kStart = 0, kCurrent = 121 + 120;                       // x = 0 on both visits
+  slam::PathSubmapOptions o;
+  o.path_m = 60;
+  EXPECT_FALSE(slam::alignPathSubmaps(*map, kStart, kCurrent, common::Pose2{}, 3, o).disagree);
+  o.near_m = 1e3;
+  EXPECT_TRUE(slam::alignPathSubmaps(*map, kStart, kCurrent, common::Pose2{}, 3, o).disagree);
+}
+
+// Through the loop closer: a closure far from what the filter knows (the two visits joined by a
+// link known to 5 m) between the two streets, whose scans agree, is refused by the submaps; the
+// same closure between two visits of one street is not.
+TEST(PathSubmaps, AFarClosureBetweenPlacesWhoseNeighbourhoodsDisagreeIsRefused) {
+  const auto reason = [](const slam::Map& map) {
+    const auto& kf = map.keyframes();
+    esdf::Esdf filter;
+    filter.initialise(esdf::toVec(kf[0].pose), esdf::Mat3::Identity() * 1e-9);
+    const esdf::Mat3 tight = esdf::Vec3(1e-4, 1e-4, 1e-6).asDiagonal(), loose = esdf::Vec3(25, 25, 1e-4).asDiagonal();
+    for (size_t j = 1; j < kf.size(); ++j) {
+      common::Pose2 z = common::between(kf[j - 1].pose, kf[j].pose);
+      if (j == 241) z.x += 1;  // the link between the visits: the second visit's x = 0 put 1 m east of the first's
+      filter.augmentRelative(static_cast<int>(j - 1), esdf::toVec(z), (j == 241 ? loose : tight).inverse());
+    }
+    filter.recover();
+    slam::LoopClosureOptions o;
+    o.submap_check_path_m = 60;
+    const slam::LoopClosureRecord r = slam::LoopCloser(o).tryClose(filter, map, 120, 361, false);
+    EXPECT_GT(r.prior_sigma_m, o.appearance_min_sigma_m);
+    return r.reason;
+  };
+  EXPECT_EQ(reason(*visitsOf(streetOfSetbacks(1), streetOfSetbacks(2))), slam::ClosureReason::Submaps);
+  EXPECT_EQ(reason(*visitsOf(streetOfSetbacks(1), streetOfSetbacks(1))), slam::ClosureReason::None);
+}

@@ -390,7 +390,7 @@ LoopClosureRecord LoopCloser::tryClose(KeyframeNodes& filter, const Map& map, si
   if (options_.submap_check_path_m > 0 && (r.prior_sigma_m > options_.appearance_min_sigma_m || headingOtherWay(map, xi, xk, current))) {
     PathSubmapOptions po;
     po.path_m = options_.submap_check_path_m;
-    submaps.emplace(map, earlier, current, a.transform, po);
+    submaps.emplace(map, earlier, current, a.transform, 3 * r.prior_sigma_m, po);
     if (submaps->aligned()) {
       // The submaps' measurement replaces the scans' only where the two scans agree on free space
       // there too: along a street of one repeated design (window bays metres apart) the submaps
@@ -401,6 +401,14 @@ LoopClosureRecord LoopCloser::tryClose(KeyframeNodes& filter, const Map& map, si
         r.measurement = submaps->measurement();
         r.free_space_conflict = conflict;
       }
+    }
+    // Far from the map, neighbourhoods that do not overlap where the closure puts them are two
+    // places whose single scans look alike (a stretch of street like one 50 m along it, beyond
+    // what the ambiguity restarts reach). Two narrow views heading opposite ways may see little
+    // of each other's street: theirs are left to the other tests.
+    if (r.prior_sigma_m > options_.appearance_min_sigma_m && submaps->disagree()) {
+      r.reason = ClosureReason::Submaps;
+      return r;
     }
   }
   const esdf::Mat3 cov = options_.covariance_scale * a.cov;
@@ -428,7 +436,7 @@ LoopClosureRecord LoopCloser::tryClose(KeyframeNodes& filter, const Map& map, si
     r.reason = ClosureReason::Ambiguous;
     return r;
   }
-  if (submaps && submaps->ambiguous(3 * r.prior_sigma_m)) {
+  if (submaps && submaps->ambiguous()) {
     r.reason = ClosureReason::Submaps;
     return r;
   }

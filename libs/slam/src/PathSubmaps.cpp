@@ -1,5 +1,6 @@
 #include "urbanslam/slam/PathSubmaps.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "urbanslam/alignment/Aligner.h"
@@ -41,27 +42,39 @@ alignment::PointSet pathSubmap(const Map& map, size_t center, size_t first, size
   return out;
 }
 
-PathSubmapAlignment::PathSubmapAlignment(const Map& map, size_t earlier, size_t current, const common::Pose2& z,
+PathSubmapAlignment::PathSubmapAlignment(const Map& map, size_t earlier, size_t current, const common::Pose2& z, double reach_m,
                                          const PathSubmapOptions& options)
-    : options_(options) {
+    : options_(options), reach_m_(reach_m) {
   if (earlier >= current || current >= map.size()) return;
   // Each visit on its own side of the halfway keyframe: a short loop's two neighbourhoods must
   // not share keyframes (they would align as the trajectory says, not as the closure does).
   const size_t half = earlier + (current - earlier) / 2;
-  before_ = std::make_unique<const alignment::IndexedReference>(pathSubmap(map, earlier, 0, half, options));
+  PathSubmapOptions wide = options;
+  wide.path_m += std::max(0.0, reach_m);
+  before_ = std::make_unique<const alignment::IndexedReference>(pathSubmap(map, earlier, 0, half, wide));
   now_ = pathSubmap(map, current, half + 1, current, options);
   alignment::AlignerOptions ao;
   ao.method = alignment::Method::PlIcp;
   result_ = alignment::alignPointSets(*before_, now_, z, ao);
+  if (result_.converged || now_.empty() || before_->points().empty()) return;
+  // The share is of the current submap's points within near_m of the earlier submap's where the
+  // alignment left them: where the earlier visit saw nothing (the current visit came from a street
+  // it never drove, or the earlier one is the drive's start) there is nothing to disagree with.
+  size_t near = 0;
+  int index = 0;
+  double d2 = 0;
+  for (const auto& q : alignment::transformed(now_, result_.transform))
+    if (before_->index().nearestWithin(q.p, options_.near_m * options_.near_m, &index, &d2)) ++near;
+  disagree_ = static_cast<double>(result_.matches) < ao.icp.min_overlap * static_cast<double>(near);
 }
 
-bool PathSubmapAlignment::ambiguous(double reach_m) const {
+bool PathSubmapAlignment::ambiguous() const {
   if (!aligned()) return false;
   alignment::AlignerOptions ao;
   ao.method = alignment::Method::PlIcp;
   alignment::ShiftedRestarts restarts;
   restarts.first_shift_m = options_.min_shift_m;
-  restarts.last_shift_m = reach_m;
+  restarts.last_shift_m = reach_m_;
   restarts.same_minimum_m = 0.5 * options_.min_shift_m;
   restarts.min_match_ratio = 1.0 - options_.ambiguity_loss;
   return alignment::findsOtherMinimum(*before_, now_, result_, ao, restarts);
@@ -69,11 +82,12 @@ bool PathSubmapAlignment::ambiguous(double reach_m) const {
 
 SubmapCheck alignPathSubmaps(const Map& map, size_t earlier, size_t current, const common::Pose2& z, double reach_m,
                              const PathSubmapOptions& options) {
-  const PathSubmapAlignment p(map, earlier, current, z, options);
+  const PathSubmapAlignment p(map, earlier, current, z, reach_m, options);
   SubmapCheck out;
   out.aligned = p.aligned();
   out.measurement = p.measurement();
-  out.ambiguous = p.ambiguous(reach_m);
+  out.ambiguous = p.ambiguous();
+  out.disagree = p.disagree();
   return out;
 }
 

@@ -48,7 +48,7 @@ enum class ClosureReason {
   NoFilter,             // an image proposal in dead reckoning
   LoopClosureDisabled,  // an image proposal with [loop_closure] enabled = false
   NoOverlap,            // nowhere the gate admits could the scans share min_matched_fraction (not aligned)
-  Submaps,              // the two visits' path submaps have another alignment nearly as good (a repeated street)
+  Submaps,              // the visits' path submaps align nearly as well elsewhere, or (far) do not align where it puts them
   SceneDepth,           // camera alone: at the estimated distance the shared scene would lie beyond max_scene_depth_m
   Join,                 // a merged session's keyframe put where none of its join's fixes puts it, before they tie it
 };

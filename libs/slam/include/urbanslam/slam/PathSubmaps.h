@@ -26,6 +26,7 @@ struct PathSubmapOptions {
   double voxel_m = 0.3;    // one point per cell of this size
   double min_shift_m = 6;  // the restarts' first shift (the single-scan ambiguity test covers the shorter ones)
   double ambiguity_loss = 0.05;
+  double near_m = 5.0;  // disagreement: of the current submap's points this near the earlier submap's
 };
 
 // The scans of keyframes [first, last] within path_m of path of `center` (one every spacing_m),
@@ -38,6 +39,9 @@ struct SubmapCheck {
   // Another alignment, min_shift_m or more away, matches nearly as many points (at least
   // 1 - ambiguity_loss of them): a street of one repeated design, as far as the submaps reach.
   bool ambiguous = false;
+  // Aligned from the closure, the two submaps share under the aligner's minimum overlap of the
+  // current one's points that lie near the earlier one's: the neighbourhoods are different places.
+  bool disagree = false;
 };
 
 // The two visits' submaps (the current one's path up to `current`, the earlier one's around
@@ -45,16 +49,27 @@ struct SubmapCheck {
 // the closure's measurement z (pose of current in earlier's frame). They are kept for the
 // ambiguity test, the costly part, which a caller runs only when nothing else refuses the
 // closure: restarts from that alignment shifted along x and y by min_shift_m, twice and four
-// times that, ... as far as reach_m (what the innovation gate could admit).
+// times that, ... as far as reach_m (what the innovation gate could admit). The earlier visit's
+// submap reaches reach_m further along its path each way than path_m: the current submap shifted
+// anywhere within reach then still lies on the earlier visit's scans (a stretch of street that
+// looks like the one reach_m away is told from it only where the earlier submap holds both).
 class PathSubmapAlignment {
  public:
-  PathSubmapAlignment(const Map& map, size_t earlier, size_t current, const common::Pose2& z, const PathSubmapOptions& options);
+  PathSubmapAlignment(const Map& map, size_t earlier, size_t current, const common::Pose2& z, double reach_m,
+                      const PathSubmapOptions& options);
   bool aligned() const { return result_.converged; }
   const common::Pose2& measurement() const { return result_.transform; }
-  bool ambiguous(double reach_m) const;
+  bool ambiguous() const;
+  // The alignment failed, matching within its final gate under the aligner's minimum overlap
+  // (IcpOptions::min_overlap) of the current submap's points within near_m of the earlier
+  // submap's: the scans of the two neighbourhoods contradict a closure that the single scans
+  // supported.
+  bool disagree() const { return disagree_; }
 
  private:
   PathSubmapOptions options_;
+  double reach_m_ = 0;
+  bool disagree_ = false;
   std::unique_ptr<const alignment::IndexedReference> before_;
   alignment::PointSet now_;
   alignment::AlignmentResult result_;
