@@ -49,27 +49,32 @@ PathSubmapAlignment::PathSubmapAlignment(const Map& map, size_t earlier, size_t 
   // Each visit on its own side of the halfway keyframe: a short loop's two neighbourhoods must
   // not share keyframes (they would align as the trajectory says, not as the closure does).
   const size_t half = earlier + (current - earlier) / 2;
-  PathSubmapOptions wide = options;
-  wide.path_m += std::max(0.0, reach_m);
-  before_ = std::make_unique<const alignment::IndexedReference>(pathSubmap(map, earlier, 0, half, wide));
   now_ = pathSubmap(map, current, half + 1, current, options);
   alignment::AlignerOptions ao;
   ao.method = alignment::Method::PlIcp;
-  result_ = alignment::alignPointSets(*before_, now_, z, ao);
-  if (result_.converged || now_.empty() || before_->points().empty()) return;
+  const alignment::IndexedReference before(pathSubmap(map, earlier, 0, half, options));
+  result_ = alignment::alignPointSets(before, now_, z, ao);
+  // The tests see further: the earlier submap reaching reach_m further each way. (Its alignment
+  // is not the measurement: along a street seen from its two ends, the longer submap let one
+  // slide 1.4 m.)
+  PathSubmapOptions wide = options;
+  wide.path_m += std::max(0.0, reach_m);
+  wide_ = std::make_unique<const alignment::IndexedReference>(pathSubmap(map, earlier, 0, half, wide));
+  wide_result_ = alignment::alignPointSets(*wide_, now_, z, ao);
+  if (wide_result_.converged || now_.empty() || wide_->points().empty()) return;
   // The share is of the current submap's points within near_m of the earlier submap's where the
   // alignment left them: where the earlier visit saw nothing (the current visit came from a street
   // it never drove, or the earlier one is the drive's start) there is nothing to disagree with.
   size_t near = 0;
   int index = 0;
   double d2 = 0;
-  for (const auto& q : alignment::transformed(now_, result_.transform))
-    if (before_->index().nearestWithin(q.p, options_.near_m * options_.near_m, &index, &d2)) ++near;
-  disagree_ = static_cast<double>(result_.matches) < ao.icp.min_overlap * static_cast<double>(near);
+  for (const auto& q : alignment::transformed(now_, wide_result_.transform))
+    if (wide_->index().nearestWithin(q.p, options_.near_m * options_.near_m, &index, &d2)) ++near;
+  disagree_ = static_cast<double>(wide_result_.matches) < ao.icp.min_overlap * static_cast<double>(near);
 }
 
 bool PathSubmapAlignment::ambiguous() const {
-  if (!aligned()) return false;
+  if (!aligned() || !wide_result_.converged) return false;
   alignment::AlignerOptions ao;
   ao.method = alignment::Method::PlIcp;
   alignment::ShiftedRestarts restarts;
@@ -77,7 +82,7 @@ bool PathSubmapAlignment::ambiguous() const {
   restarts.last_shift_m = reach_m_;
   restarts.same_minimum_m = 0.5 * options_.min_shift_m;
   restarts.min_match_ratio = 1.0 - options_.ambiguity_loss;
-  return alignment::findsOtherMinimum(*before_, now_, result_, ao, restarts);
+  return alignment::findsOtherMinimum(*wide_, now_, wide_result_, ao, restarts);
 }
 
 SubmapCheck alignPathSubmaps(const Map& map, size_t earlier, size_t current, const common::Pose2& z, double reach_m,

@@ -49,10 +49,11 @@ struct SubmapCheck {
 // the closure's measurement z (pose of current in earlier's frame). They are kept for the
 // ambiguity test, the costly part, which a caller runs only when nothing else refuses the
 // closure: restarts from that alignment shifted along x and y by min_shift_m, twice and four
-// times that, ... as far as reach_m (what the innovation gate could admit). The earlier visit's
-// submap reaches reach_m further along its path each way than path_m: the current submap shifted
-// anywhere within reach then still lies on the earlier visit's scans (a stretch of street that
-// looks like the one reach_m away is told from it only where the earlier submap holds both).
+// times that, ... as far as reach_m (what the innovation gate could admit). For the restarts and
+// the disagreement the earlier visit's submap reaches reach_m further along its path each way
+// than path_m: the current submap shifted anywhere within reach then still lies on the earlier
+// visit's scans (a stretch of street that looks like the one reach_m away is told from it only
+// where the earlier submap holds both). The measurement is the alignment onto the path_m one.
 class PathSubmapAlignment {
  public:
   PathSubmapAlignment(const Map& map, size_t earlier, size_t current, const common::Pose2& z, double reach_m,
@@ -70,9 +71,10 @@ class PathSubmapAlignment {
   PathSubmapOptions options_;
   double reach_m_ = 0;
   bool disagree_ = false;
-  std::unique_ptr<const alignment::IndexedReference> before_;
   alignment::PointSet now_;
-  alignment::AlignmentResult result_;
+  alignment::AlignmentResult result_;                        // onto the earlier submap of path_m: the measurement
+  std::unique_ptr<const alignment::IndexedReference> wide_;  // the earlier submap of path_m + reach_m
+  alignment::AlignmentResult wide_result_;                   // onto it: the restarts' start, the disagreement
 };
 
 // Both steps at once.
