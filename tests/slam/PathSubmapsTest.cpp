@@ -2,6 +2,7 @@
 
 #include <Eigen/LU>
 #include <cmath>
+#include <vector>
 
 #include "../alignment/SyntheticScan.h"
 #include "urbanslam/alignment/FreeSpace.h"
@@ -43,24 +44,43 @@ World street(bool cross_street) {
   return w;
 }
 
-// The earlier visit drives east along y = -3 (keyframes 0..120 at x = -60..60), the current one
-// west along y = +3 (keyframes 121..241 at x = 60..-60): opposite lanes, each scan a front 180°
-// laser, the map's poses the truth.
-std::unique_ptr<slam::Map> twoVisits(const World& w) {
+// A visit: the world its scans see and its keyframes' poses.
+struct Visit {
+  const World* world;
+  std::vector<common::Pose2> poses;
+};
+
+// Poses a metre apart along y = `y` from x = from_x to to_x, heading that way.
+std::vector<common::Pose2> along(double y, int from_x, int to_x) {
+  std::vector<common::Pose2> out;
+  const int step = from_x <= to_x ? 1 : -1;
+  for (int x = from_x;; x += step) {
+    out.push_back({static_cast<double>(x), y, step > 0 ? 0.0 : M_PI});
+    if (x == to_x) break;
+  }
+  return out;
+}
+
+// The visits' keyframes in turn, numbered from 0, each scan a front 180° laser of range_m in its
+// visit's world, the map's poses the truth.
+std::unique_ptr<slam::Map> mapOf(const std::vector<Visit>& visits, double range_m) {
   auto map = std::make_unique<slam::Map>(nullptr, 2.0);
   alignment::test::ScanSpec spec;
-  spec.max_range_m = 50;
+  spec.max_range_m = range_m;
   size_t index = 0;
-  for (int visit = 0; visit < 2; ++visit)
-    for (int s = 0; s <= 120; ++s) {
-      const common::Pose2 pose = visit == 0 ? common::Pose2{-60.0 + s, -3, 0} : common::Pose2{60.0 - s, 3, M_PI};
+  for (const Visit& v : visits)
+    for (const common::Pose2& pose : v.poses) {
       spec.seed = static_cast<unsigned>(index + 1);
       map->addKeyframe({index, static_cast<double>(index), pose, true, false, {}},
-                       io::CompactScan(alignment::test::simulateScan(w, pose, spec)));
+                       io::CompactScan(alignment::test::simulateScan(*v.world, pose, spec)));
       ++index;
     }
   return map;
 }
+
+// The earlier visit drives east along y = -3 (keyframes 0..120 at x = -60..60), the current one
+// west along y = +3 (keyframes 121..241 at x = 60..-60): opposite lanes, a 50 m laser.
+std::unique_ptr<slam::Map> twoVisits(const World& w) { return mapOf({{&w, along(-3, -60, 60)}, {&w, along(3, 60, -60)}}, 50); }
 
 constexpr size_t kEarlier = 60;        // x = 0 on the earlier visit
 constexpr size_t kCurrent = 121 + 48;  // x = 12 on the current one
@@ -187,23 +207,9 @@ World streetOfPeriod48() {
   return w;
 }
 
-// Two visits east along y = -3, each from x = -120 to 120 a metre a keyframe (keyframes 0..240,
-// then 241..481), the map's poses the truth.
-std::unique_ptr<slam::Map> twoVisitsEast(const World& w) {
-  auto map = std::make_unique<slam::Map>(nullptr, 2.0);
-  alignment::test::ScanSpec spec;
-  spec.max_range_m = 50;
-  size_t index = 0;
-  for (int visit = 0; visit < 2; ++visit)
-    for (int s = 0; s <= 240; ++s) {
-      const common::Pose2 pose{-120.0 + s, -3, 0};
-      spec.seed = static_cast<unsigned>(index + 1);
-      map->addKeyframe({index, static_cast<double>(index), pose, true, false, {}},
-                       io::CompactScan(alignment::test::simulateScan(w, pose, spec)));
-      ++index;
-    }
-  return map;
-}
+// Two visits east along y = -3, each from x = -120 to 120 (keyframes 0..240, then 241..481), a
+// 50 m laser.
+std::unique_ptr<slam::Map> twoVisitsEast(const World& w) { return mapOf({{&w, along(-3, -120, 120)}, {&w, along(-3, -120, 120)}}, 50); }
 
 }  // namespace
 
@@ -260,23 +266,11 @@ World streetOfSetbacks(int design) {
   return w;
 }
 
-// The first visit east along the centre line from x = first_from_x to 120 in `first`, a
-// keyframe a metre, the second from x = -120 to 120 in `second` (keyframes 0..240, then
-// 241..481, with the default start), a 180° laser of 16 m range.
+// The first visit east along the centre line from x = first_from_x to 120 in `first`, the
+// second from x = -120 to 120 in `second` (keyframes 0..240, then 241..481, with the default
+// start), a 16 m laser.
 std::unique_ptr<slam::Map> visitsOf(const World& first, const World& second, int first_from_x = -120) {
-  auto map = std::make_unique<slam::Map>(nullptr, 2.0);
-  alignment::test::ScanSpec spec;
-  spec.max_range_m = 16;
-  size_t index = 0;
-  for (const World* w : {&first, &second})
-    for (int x = w == &first ? first_from_x : -120; x <= 120; ++x) {
-      const common::Pose2 pose{static_cast<double>(x), 0, 0};
-      spec.seed = static_cast<unsigned>(index + 1);
-      map->addKeyframe({index, static_cast<double>(index), pose, true, false, {}},
-                       io::CompactScan(alignment::test::simulateScan(*w, pose, spec)));
-      ++index;
-    }
-  return map;
+  return mapOf({{&first, along(0, first_from_x, 120)}, {&second, along(0, -120, 120)}}, 16);
 }
 
 }  // namespace

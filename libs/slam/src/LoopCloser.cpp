@@ -387,7 +387,8 @@ LoopClosureRecord LoopCloser::tryClose(KeyframeNodes& filter, const Map& map, si
   // Two narrow views heading opposite ways meet only ahead of both (oppositeViewPartner), on a
   // stretch of street that slides along itself as easily as a far closure's: the same check.
   std::optional<PathSubmapAlignment> submaps;
-  if (options_.submap_check_path_m > 0 && (r.prior_sigma_m > options_.appearance_min_sigma_m || headingOtherWay(map, xi, xk, current))) {
+  const bool far = r.prior_sigma_m > options_.appearance_min_sigma_m;
+  if (options_.submap_check_path_m > 0 && (far || headingOtherWay(map, xi, xk, current))) {
     PathSubmapOptions po;
     po.path_m = options_.submap_check_path_m;
     submaps.emplace(map, earlier, current, a.transform, 3 * r.prior_sigma_m, po);
@@ -406,7 +407,7 @@ LoopClosureRecord LoopCloser::tryClose(KeyframeNodes& filter, const Map& map, si
     // places whose single scans look alike (a stretch of street like one 50 m along it, beyond
     // what the ambiguity restarts reach). Two narrow views heading opposite ways may see little
     // of each other's street: theirs are left to the other tests.
-    if (r.prior_sigma_m > options_.appearance_min_sigma_m && submaps->disagree()) {
+    if (far && submaps->disagree()) {
       r.reason = ClosureReason::Submaps;
       return r;
     }

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <vector>
 
 #include "urbanslam/alignment/Aligner.h"
 #include "urbanslam/alignment/IndexedReference.h"
@@ -12,10 +14,12 @@
 
 namespace urbanslam::slam {
 
-alignment::PointSet pathSubmap(const Map& map, size_t center, size_t first, size_t last, const PathSubmapOptions& options) {
+namespace {
+
+// The keyframes of pathSubmap: along the path each way from the centre, one every spacing_m.
+std::vector<size_t> pathKeyframes(const Map& map, size_t center, size_t first, size_t last, const PathSubmapOptions& options) {
   const auto& kf = map.keyframes();
   std::vector<size_t> chosen;
-  // Along the path each way from the centre, a keyframe every spacing_m.
   for (const int step : {-1, 1}) {
     double path = 0, last_taken = -options.spacing_m;
     for (size_t j = center;;) {
@@ -30,16 +34,28 @@ alignment::PointSet pathSubmap(const Map& map, size_t center, size_t first, size
       j = next;
     }
   }
+  return chosen;
+}
+
+// The scans of `keyframes` in center's vehicle frame, thinned to a point per voxel.
+alignment::PointSet submapOf(const Map& map, size_t center, const std::vector<size_t>& keyframes, double voxel_m) {
+  const auto& kf = map.keyframes();
   alignment::PointSet all;
   const common::Pose2& origin = kf[center].pose;
-  for (const size_t j : chosen) {
+  for (const size_t j : keyframes) {
     const alignment::PointSet points = alignment::transformed(alignment::pointSetFromScan(map.scan(j), alignment::ScanModelOptions{}, true),
                                                               common::between(origin, kf[j].pose));
     all.insert(all.end(), points.begin(), points.end());
   }
   alignment::PointSet out;
-  for (const size_t i : alignment::firstPerVoxel(all, options.voxel_m)) out.push_back(all[i]);
+  for (const size_t i : alignment::firstPerVoxel(all, voxel_m)) out.push_back(all[i]);
   return out;
+}
+
+}  // namespace
+
+alignment::PointSet pathSubmap(const Map& map, size_t center, size_t first, size_t last, const PathSubmapOptions& options) {
+  return submapOf(map, center, pathKeyframes(map, center, first, last, options), options.voxel_m);
 }
 
 PathSubmapAlignment::PathSubmapAlignment(const Map& map, size_t earlier, size_t current, const common::Pose2& z, double reach_m,
@@ -52,15 +68,23 @@ PathSubmapAlignment::PathSubmapAlignment(const Map& map, size_t earlier, size_t 
   now_ = pathSubmap(map, current, half + 1, current, options);
   alignment::AlignerOptions ao;
   ao.method = alignment::Method::PlIcp;
-  const alignment::IndexedReference before(pathSubmap(map, earlier, 0, half, options));
-  result_ = alignment::alignPointSets(before, now_, z, ao);
+  const std::vector<size_t> keyframes = pathKeyframes(map, earlier, 0, half, options);
+  before_ = std::make_shared<const alignment::IndexedReference>(submapOf(map, earlier, keyframes, options.voxel_m));
+  result_ = alignment::alignPointSets(*before_, now_, z, ao);
   // The tests see further: the earlier submap reaching reach_m further each way. (Its alignment
   // is not the measurement: along a street seen from its two ends, the longer submap let one
-  // slide 1.4 m.)
+  // slide 1.4 m.) Where that reaches no further keyframe (a reach under spacing_m, the path's
+  // end), it is the same submap and alignment.
   PathSubmapOptions wide = options;
   wide.path_m += std::max(0.0, reach_m);
-  wide_ = std::make_unique<const alignment::IndexedReference>(pathSubmap(map, earlier, 0, half, wide));
-  wide_result_ = alignment::alignPointSets(*wide_, now_, z, ao);
+  const std::vector<size_t> wide_keyframes = pathKeyframes(map, earlier, 0, half, wide);
+  if (wide_keyframes == keyframes) {
+    wide_ = before_;
+    wide_result_ = result_;
+  } else {
+    wide_ = std::make_shared<const alignment::IndexedReference>(submapOf(map, earlier, wide_keyframes, options.voxel_m));
+    wide_result_ = alignment::alignPointSets(*wide_, now_, z, ao);
+  }
   if (wide_result_.converged || now_.empty() || wide_->points().empty()) return;
   // The share is of the current submap's points within near_m of the earlier submap's where the
   // alignment left them: where the earlier visit saw nothing (the current visit came from a street

@@ -72,9 +72,10 @@ class PathSubmapAlignment {
   double reach_m_ = 0;
   bool disagree_ = false;
   alignment::PointSet now_;
-  alignment::AlignmentResult result_;                        // onto the earlier submap of path_m: the measurement
-  std::unique_ptr<const alignment::IndexedReference> wide_;  // the earlier submap of path_m + reach_m
-  alignment::AlignmentResult wide_result_;                   // onto it: the restarts' start, the disagreement
+  std::shared_ptr<const alignment::IndexedReference> before_;  // the earlier submap of path_m
+  alignment::AlignmentResult result_;                          // onto it: the measurement
+  std::shared_ptr<const alignment::IndexedReference> wide_;    // of path_m + reach_m (before_ when the same keyframes)
+  alignment::AlignmentResult wide_result_;                     // onto it: the restarts' start, the disagreement
 };
 
 // Both steps at once.
