@@ -9,12 +9,14 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <random>
 #include <utility>
 #include <vector>
 
 #include <Eigen/Dense>
 
 #include "CameraAhead.h"
+#include "CastScan.h"
 #include "ConstantScan.h"
 #include "urbanslam/esdf/Esdf.h"
 #include "urbanslam/slam/GlobalSlam.h"
@@ -552,4 +554,41 @@ TEST(GlobalSlam, AFullRecoveryWaitsUntilTheKeyframesSinceThePreviousHavePaidForI
     EXPECT_LT(since * budget, paid[i - 1].second + 10 * budget)
         << "recovery " << i << " came later than the next closure after it was paid";
   }
+}
+
+// A place search recognises a place to within its grid's reach: in a corridor it can settle a
+// metre along it. The two keyframes' scans, aligned from the fix, measure the closure: a fix
+// 0.8 m off along the room's length and held to 2 cm goes in where the scans put the keyframe.
+TEST(GlobalSlam, APlaceFixIsMeasuredByItsKeyframesScansAlignedFromIt) {
+  // A room 12 m x 6 m with two pillars, seen from its middle; keyframe 1 comes back near
+  // keyframe 0 after a loose odometry link (1 m uncertain), as a merged session's keyframe does.
+  std::vector<test::Segment> world;
+  test::addBox(world, 0, 0, 12, 6, false);
+  test::addBox(world, 3, 1, 3.6, 1.6, false);
+  test::addBox(world, 8, 4, 8.8, 4.5, false);
+  const common::Pose2 first{2, 3, 0.1}, second{2.4, 2.8, -0.15};
+  std::mt19937 rng(7);
+  auto r = std::make_unique<::Run>();
+  r->options.loop_closure.moving_returns_neighbours = 0;
+  r->global = std::make_unique<slam::GlobalSlam>(r->options, r->map, r->stats, r->observers);
+  slam::KeyframeConstraint c;
+  r->global->addKeyframe({0, 0.0, {}, true, false, {}}, io::CompactScan(test::castScan(first, world, 0.0, 30, rng)), c);
+  c.z = common::Pose2{0, 0, 0};
+  c.cov = Eigen::Vector3d(1.0, 1.0, 0.1).asDiagonal();
+  r->global->addKeyframe({1, 1.0, {}, true, false, {}}, io::CompactScan(test::castScan(second, world, 0.0, 30, rng)), c);
+
+  const common::Pose2 truth = common::between(first, second);
+  const common::Pose2 off = common::compose(truth, common::Pose2{0.8, 0, 0});
+  const Eigen::Matrix3d tight = Eigen::Vector3d(1 / 4e-4, 1 / 4e-4, 1 / 3e-6).asDiagonal();
+  r->global->addPlaceFix(0, 1, off, tight, 1.0, slam::Proposer::Place);
+  const std::vector<slam::LoopClosureRecord> closures = r->global->closures();
+  ASSERT_EQ(closures.size(), 1u);
+  ASSERT_TRUE(closures[0].accepted) << slam::reasonName(closures[0].reason);
+  EXPECT_NEAR(closures[0].measurement.x, truth.x, 0.05);
+  EXPECT_NEAR(closures[0].measurement.y, truth.y, 0.05);
+  EXPECT_NEAR(closures[0].measurement.phi, truth.phi, 0.01);
+  r->global->finish();
+  const common::Pose2 placed = common::between(r->map.keyframes()[0].pose, r->map.keyframes()[1].pose);
+  EXPECT_NEAR(placed.x, truth.x, 0.05);
+  EXPECT_NEAR(placed.y, truth.y, 0.05);
 }

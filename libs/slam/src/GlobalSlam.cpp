@@ -400,7 +400,22 @@ void GlobalSlam::addPlaceFix(size_t earlier, size_t current, const common::Pose2
   if (!map_.filter()) return;
   ++stats_.closures_tried;
   const Detection detection{detector, score};
-  LoopClosureRecord r = closer_.tryCloseMeasured(*map_.nodes(), map_, earlier, current, esdf::toVec(z), information, true, detection);
+  // The place search matched the scan against a whole area's grid: it recognised the place. The
+  // two keyframes' scans, aligned from there, measure it as a loop closure does (in a corridor a
+  // search can settle a metre along it, and the closures that follow would be gated out).
+  common::Pose2 measured = z;
+  Eigen::Matrix3d measured_information = information;
+  if (detector == Proposer::Place) {
+    LoopClosureRecord check;
+    const alignment::AlignmentResult a =
+        closer_.verifyAlignment(map_.scan(earlier), map_.scan(current), z, alignment::Method::CrfIcp, 0.0, check);
+    if (check.reason == ClosureReason::None) {
+      measured = a.transform;
+      measured_information = (options_.loop_closure.covariance_scale * a.cov).inverse();
+    }
+  }
+  LoopClosureRecord r =
+      closer_.tryCloseMeasured(*map_.nodes(), map_, earlier, current, esdf::toVec(measured), measured_information, true, detection);
   if (r.accepted) map_.addEdge({earlier, current, r.measurement, r.information, true});
   reportClosure(r);
   if (r.accepted) closureAdded(current, std::chrono::steady_clock::now());

@@ -88,7 +88,9 @@ class GlobalSlam {
   // A place that a session join recognised: keyframe `current` (the session's) found at `z` from
   // the map's keyframe `earlier`. Gated and, when it passes, a closure (`detector`: Place for
   // the place search, Laser for the classifier's detection aligned); the fixes that agree with
-  // it are its confirmation.
+  // it are its confirmation. A place search's fix is measured by the two keyframes' scans aligned
+  // from it where they align (CRF-match and ICP, weighed as a loop closure weighs an alignment),
+  // as it is given where they do not.
   void addPlaceFix(size_t earlier, size_t current, const common::Pose2& z, const Eigen::Matrix3d& information, double score,
                    Proposer detector);
   // How closures the scans measured are confirmed by the camera ([loop_closure]
