@@ -401,8 +401,10 @@ void GlobalSlam::addPlaceFix(size_t earlier, size_t current, const common::Pose2
   ++stats_.closures_tried;
   const Detection detection{detector, score};
   // The place search matched the scan against a whole area's grid: it recognised the place. The
-  // two keyframes' scans, aligned from there, measure it as a loop closure does (in a corridor a
-  // search can settle a metre along it, and the closures that follow would be gated out).
+  // two keyframes' scans, aligned from there, measure it as a loop closure does (in an ACES
+  // corridor a search settled 1.2 m along it, held to 2 cm, and the closures that followed were
+  // gated out). CRF-match first: PL-ICP from a fix a metre off stops in a wrong minimum. No
+  // ambiguity restarts: the join's agreeing fixes have told the place already.
   common::Pose2 measured = z;
   Eigen::Matrix3d measured_information = information;
   if (detector == Proposer::Place) {
