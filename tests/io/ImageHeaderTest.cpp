@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <system_error>
 #include <opencv2/imgcodecs.hpp>
 
 #include "urbanslam/common/Error.h"
@@ -13,10 +14,18 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// This process's scratch folder, removed when the process ends (each test runs in its own).
+struct ScratchFolder {
+  const fs::path path = fs::temp_directory_path() / ("urbanslam-image-header-" + std::to_string(::getpid()));
+  ~ScratchFolder() {
+    std::error_code ignored;
+    fs::remove_all(path, ignored);
+  }
+} scratch_folder;
+
 fs::path scratch(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("urbanslam-image-header-" + std::to_string(::getpid()));
-  fs::create_directories(d);
-  return d / name;
+  fs::create_directories(scratch_folder.path);
+  return scratch_folder.path / name;
 }
 
 std::string readAll(const fs::path& p) {

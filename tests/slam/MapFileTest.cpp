@@ -2,6 +2,7 @@
 // of this version is refused with one error naming it.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <fstream>
 #include <iterator>
 #include <memory>
@@ -301,4 +302,5 @@ TEST(MapFile, AVersion3FileIsReadAsAMapWithoutSeparateMaps) {
   EXPECT_EQ(again->stats().step_ms.count(), st.step_ms.count());
   EXPECT_EQ(again->stats().step_ms.max(), st.step_ms.max());
   EXPECT_TRUE(test::mapFileSections(slam::encodeMap(*again)).at("STAT") == b.at("STAT"));
+  std::remove(again_path.c_str());
 }
