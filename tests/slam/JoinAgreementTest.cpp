@@ -36,3 +36,23 @@ TEST(JoinAgreement, AClosureMustPutTheKeyframeWhereAFixOfTheJoinDoesWithinTheDri
   join.agreeing = {0};  // only the first fix
   EXPECT_FALSE(slam::agreesWithJoin(join, 1, pose, path_m, {10.0, 10.0 + 2.5, M_PI / 2}));
 }
+
+TEST(JoinAgreement, APlaceSearchsFixEntersTheMapNoTighterThanTheJoinsAgreement) {
+  // The join checked a place search's fix to agree_m (1 m) and agree_deg (5°), whatever the
+  // search's posterior says (2 cm here; 3 m along x for one in a corridor). A classifier's
+  // detection was aligned: its covariance is the alignment's.
+  const slam::SessionJoinOptions options;
+  slam::SessionFix place;
+  place.detector = slam::Proposer::Place;
+  place.cov = Eigen::Vector3d(4e-4, 4e-4, 1e-6).asDiagonal();
+  const Eigen::Matrix3d c = slam::fixCovariance(place, options);
+  EXPECT_DOUBLE_EQ(c(0, 0), 1.0);
+  EXPECT_DOUBLE_EQ(c(1, 1), 1.0);
+  EXPECT_NEAR(std::sqrt(c(2, 2)) * 180 / M_PI, 5.0, 1e-12);
+  place.cov(0, 0) = 9.0;
+  EXPECT_DOUBLE_EQ(slam::fixCovariance(place, options)(0, 0), 9.0);
+  slam::SessionFix laser = place;
+  laser.detector = slam::Proposer::Laser;
+  laser.cov = Eigen::Vector3d(4e-4, 4e-4, 1e-6).asDiagonal();
+  EXPECT_TRUE(slam::fixCovariance(laser, options).isApprox(laser.cov));
+}

@@ -102,8 +102,8 @@ void Pipeline::appendSession(const Pipeline& session, const SessionJoin& join) {
       if (f.keyframe != k.index) continue;
       const size_t earlier = nearestOwn(f.pose, 10.0, true);
       if (earlier < n0)
-        global_.addPlaceFix(earlier, n0 + k.index, common::between(map_.keyframes()[earlier].pose, f.pose), f.cov.inverse(),
-                            f.margin_per_point, f.detector);
+        global_.addPlaceFix(earlier, n0 + k.index, common::between(map_.keyframes()[earlier].pose, f.pose),
+                            fixCovariance(f, join.options).inverse(), f.margin_per_point, f.detector);
     }
     // Loop closures as a run finds them: against this map and the session's earlier keyframes.
     global_.closeLoops(n0 + k.index, now);

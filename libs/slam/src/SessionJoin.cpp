@@ -360,6 +360,16 @@ void SessionJoiner::decide(const Map& session) {
   out.transform_cov = Eigen::Vector3d(sxy * sxy, sxy * sxy, sphi * sphi).asDiagonal();
 }
 
+Eigen::Matrix3d fixCovariance(const SessionFix& fix, const SessionJoinOptions& options) {
+  Eigen::Matrix3d cov = fix.cov;
+  if (fix.detector != Proposer::Place) return cov;
+  const double sxy = options.agree_m, sphi = options.agree_deg * kDeg;
+  cov(0, 0) = std::max(cov(0, 0), sxy * sxy);
+  cov(1, 1) = std::max(cov(1, 1), sxy * sxy);
+  cov(2, 2) = std::max(cov(2, 2), sphi * sphi);
+  return cov;
+}
+
 bool agreesWithJoin(const SessionJoin& join, size_t keyframe, const common::Pose2& pose, const std::vector<double>& path_m,
                     const common::Pose2& claimed) {
   return std::any_of(join.agreeing.begin(), join.agreeing.end(), [&](size_t i) {

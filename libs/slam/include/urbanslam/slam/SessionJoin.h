@@ -113,6 +113,13 @@ struct SessionJoin {
 bool agreesWithJoin(const SessionJoin& join, size_t keyframe, const common::Pose2& pose, const std::vector<double>& path_m,
                     const common::Pose2& claimed);
 
+// The covariance a join's fix enters the map with where its two keyframes' scans cannot measure
+// it (GlobalSlam::addPlaceFix): a place search's no tighter than the join's agreement (agree_m,
+// agree_deg), which is all the join checked of it; a search settles to its grid's reach, and
+// on ACES one settled 1.2 m along a corridor with a posterior of 2 cm. A classifier's detection
+// is an alignment already: its covariance as it is.
+Eigen::Matrix3d fixCovariance(const SessionFix& fix, const SessionJoinOptions& options);
+
 // The search kept up to date while the session grows (a run that joins a map as it goes):
 // update() probes the keyframes added since the last call.
 class SessionJoiner {
