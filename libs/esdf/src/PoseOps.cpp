@@ -60,6 +60,14 @@ Mat3 betweenCovariance(const Vec3& a, const Vec3& b, const Eigen::Matrix<double,
   return j * joint * j.transpose();
 }
 
+Mat3 withDiagonalFloors(const Mat3& cov, double sigma_xy_m, double sigma_phi_rad) {
+  Mat3 out = cov;
+  out(0, 0) = std::max(out(0, 0), sigma_xy_m * sigma_xy_m);
+  out(1, 1) = std::max(out(1, 1), sigma_xy_m * sigma_xy_m);
+  out(2, 2) = std::max(out(2, 2), sigma_phi_rad * sigma_phi_rad);
+  return out;
+}
+
 double largestPositionSigma(const Mat3& cov) { return std::sqrt(std::max(0.0, cov.topLeftCorner<2, 2>().eigenvalues().real().maxCoeff())); }
 
 Vec3 relativePoseError(const Vec3& a, const Vec3& b, const Vec3& z) { return relativePoseError(a, b, z, nullptr, nullptr); }

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "urbanslam/esdf/PoseOps.h"
+
 namespace urbanslam::slam {
 
 namespace {
@@ -50,11 +52,7 @@ KeyframeConstraint LocalSlam::keyframeConstraint(const io::LaserScan& scan) cons
   c.match = KeyframeConstraint::Match::Used;
   // The posterior of the increment given the motion and the scan replaces the motion's.
   c.z = r.pose;
-  c.cov = options_.covariance_scale * r.cov;
-  const double sxy = options_.min_sigma_xy_m, sphi = options_.min_sigma_phi_deg * kDeg;
-  c.cov(0, 0) = std::max(c.cov(0, 0), sxy * sxy);
-  c.cov(1, 1) = std::max(c.cov(1, 1), sxy * sxy);
-  c.cov(2, 2) = std::max(c.cov(2, 2), sphi * sphi);
+  c.cov = esdf::withDiagonalFloors(options_.covariance_scale * r.cov, options_.min_sigma_xy_m, options_.min_sigma_phi_deg * kDeg);
   // The search and the refinement disagreeing is doubt of another kind: added after the floors
   // (which bound the Hessian's optimism along every axis; added before them, a rank-one spread
   // would lift the diagonal past them and leave the other directions as tight as the Hessian),

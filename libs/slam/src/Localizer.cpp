@@ -7,6 +7,7 @@
 #include "urbanslam/alignment/ScanModel.h"
 #include "urbanslam/common/Timing.h"
 #include "urbanslam/esdf/Gating.h"
+#include "urbanslam/esdf/PoseOps.h"
 #include "urbanslam/slam/LocalSubmap.h"
 
 namespace urbanslam::slam {
@@ -65,12 +66,7 @@ void Localizer::setInitialPose(const common::Pose2& pose) {
 }
 
 Eigen::Matrix3d withFloors(const Eigen::Matrix3d& cov, const LocalizerOptions& options) {
-  Eigen::Matrix3d out = 0.5 * (cov + cov.transpose());
-  const double sxy = options.min_sigma_xy_m, sphi = options.min_sigma_deg * kDeg;
-  out(0, 0) = std::max(out(0, 0), sxy * sxy);
-  out(1, 1) = std::max(out(1, 1), sxy * sxy);
-  out(2, 2) = std::max(out(2, 2), sphi * sphi);
-  return out;
+  return esdf::withDiagonalFloors(0.5 * (cov + cov.transpose()), options.min_sigma_xy_m, options.min_sigma_deg * kDeg);
 }
 
 void Localizer::setPose(const common::Pose2& pose, const Eigen::Matrix3d& cov) {
@@ -352,12 +348,7 @@ LocalizedScan Localizer::onScan(io::LaserScan scan) {
     }
     if (monitor_.lost() || initial_contradicted) {
       initial_pose_ = false;
-      const double sxy = options_.lost_sigma_xy_m, sphi = options_.lost_sigma_deg * kDeg;
-      Eigen::Matrix3d widened = cov_;
-      widened(0, 0) = std::max(widened(0, 0), sxy * sxy);
-      widened(1, 1) = std::max(widened(1, 1), sxy * sxy);
-      widened(2, 2) = std::max(widened(2, 2), sphi * sphi);
-      setPose(pose_, widened);
+      setPose(pose_, esdf::withDiagonalFloors(cov_, options_.lost_sigma_xy_m, options_.lost_sigma_deg * kDeg));
       state_ = LocalizationState::Lost;
       ++stats_.lost_events;
       searched_ = false;  // a place search right away

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "urbanslam/alignment/PointSet.h"
+#include "urbanslam/esdf/PoseOps.h"
 #include "urbanslam/laser_loop/LoopDetector.h"
 #include "urbanslam/slam/Localizer.h"
 #include "urbanslam/slam/LoopCloser.h"
@@ -361,13 +362,8 @@ void SessionJoiner::decide(const Map& session) {
 }
 
 Eigen::Matrix3d fixCovariance(const SessionFix& fix, const SessionJoinOptions& options) {
-  Eigen::Matrix3d cov = fix.cov;
-  if (fix.detector != Proposer::Place) return cov;
-  const double sxy = options.agree_m, sphi = options.agree_deg * kDeg;
-  cov(0, 0) = std::max(cov(0, 0), sxy * sxy);
-  cov(1, 1) = std::max(cov(1, 1), sxy * sxy);
-  cov(2, 2) = std::max(cov(2, 2), sphi * sphi);
-  return cov;
+  if (fix.detector != Proposer::Place) return fix.cov;
+  return esdf::withDiagonalFloors(fix.cov, options.agree_m, options.agree_deg * kDeg);
 }
 
 bool agreesWithJoin(const SessionJoin& join, size_t keyframe, const common::Pose2& pose, const std::vector<double>& path_m,

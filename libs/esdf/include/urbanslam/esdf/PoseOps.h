@@ -34,6 +34,9 @@ void betweenJacobians(const Vec3& a, const Vec3& b, Mat3* ja, Mat3* jb);
 Mat3 betweenCovariance(const Vec3& a, const Vec3& b, const Eigen::Matrix<double, 6, 6>& joint);
 // Standard deviation of a pose covariance's position part along its worst direction.
 double largestPositionSigma(const Mat3& cov);
+// `cov` with its diagonal raised to at least sigma_xy_m² (x, y) and sigma_phi_rad² (heading): a
+// pose's uncertainty no smaller than what the estimate that produced it can be trusted to.
+Mat3 withDiagonalFloors(const Mat3& cov, double sigma_xy_m, double sigma_phi_rad);
 
 // Difference of two poses in the state chart: a - b with the heading difference wrapped.
 inline Vec3 poseDifference(const Vec3& a, const Vec3& b) { return {a.x() - b.x(), a.y() - b.y(), common::wrapToPi(a.z() - b.z())}; }
