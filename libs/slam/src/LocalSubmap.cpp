@@ -47,10 +47,12 @@ const alignment::MatchReference* LocalSubmap::reference(const std::vector<common
       std::equal(offsets.begin(), offsets.end(), cache_.offsets.begin(), same))
     return cache_.reference.get();
   alignment::PointSet points;
+  size_t total = 0;
+  for (const auto& set : sets_) total += set.size();
+  points.reserve(total);
   std::vector<alignment::ReferenceView> views;
   for (size_t i = 0; i < sets_.size(); ++i) {
-    const auto t = alignment::transformed(sets_[i], offsets[i]);
-    points.insert(points.end(), t.begin(), t.end());
+    alignment::appendTransformed(sets_[i], offsets[i], &points);
     views.push_back({beams_[i], offsets[i]});
   }
   cache_.generation = generation_;

@@ -63,9 +63,14 @@ std::vector<size_t> MapAreas::tileKeyframes(int64_t key) const {
   return out;
 }
 
-alignment::PointSet MapAreas::keyframePoints(size_t k) const {
-  const Keyframe& kf = map_.keyframes()[k];
-  return alignment::transformed(alignment::pointSetFromScan(map_.scan(k), options_.scan_model, true), kf.pose);
+std::vector<alignment::PointSet> MapAreas::ownPoints(const std::vector<size_t>& keyframes, size_t* total) const {
+  std::vector<alignment::PointSet> own;
+  *total = 0;
+  for (size_t k : keyframes) {
+    own.push_back(alignment::pointSetFromScan(map_.scan(k), options_.scan_model, true));
+    *total += own.back().size();
+  }
+  return own;
 }
 
 MapAreas::Tile* MapAreas::find(std::list<Tile>& cache, int64_t key) {
@@ -80,15 +85,17 @@ MapAreas::Tile* MapAreas::find(std::list<Tile>& cache, int64_t key) {
 const alignment::MatchReference* MapAreas::reference(double x, double y) {
   const int64_t key = tileKey(x, y);
   if (Tile* t = find(fine_, key)) return t->reference.get();
+  const std::vector<size_t> keyframes = tileKeyframes(key);
+  size_t total = 0;
+  const std::vector<alignment::PointSet> own = ownPoints(keyframes, &total);
   alignment::PointSet points;
+  points.reserve(total);
   std::vector<alignment::ReferenceView> views;
-  for (size_t k : tileKeyframes(key)) {
+  for (size_t i = 0; i < keyframes.size(); ++i) {
+    const common::Pose2& pose = map_.keyframes()[keyframes[i]].pose;
     // Each keyframe's free space in its own frame, placed by its pose (the matcher's step 2').
-    const alignment::PointSet own = alignment::pointSetFromScan(map_.scan(k), options_.scan_model, true);
-    views.push_back({alignment::BeamFreeSpace(own, options_.matcher.free_margin_m, options_.matcher.free_margin_fraction),
-                     map_.keyframes()[k].pose});
-    const alignment::PointSet placed = alignment::transformed(own, map_.keyframes()[k].pose);
-    points.insert(points.end(), placed.begin(), placed.end());
+    views.push_back({alignment::BeamFreeSpace(own[i], options_.matcher.free_margin_m, options_.matcher.free_margin_fraction), pose});
+    alignment::appendTransformed(own[i], pose, &points);
   }
   Tile tile{key, nullptr, nullptr};
   if (!points.empty())
@@ -102,11 +109,12 @@ const alignment::MatchReference* MapAreas::reference(double x, double y) {
 const alignment::LikelihoodGrid* MapAreas::coarseGrid(double x, double y) {
   const int64_t key = tileKey(x, y);
   if (Tile* t = find(coarse_, key)) return t->grid.get();
+  const std::vector<size_t> keyframes = tileKeyframes(key);
+  size_t total = 0;
+  const std::vector<alignment::PointSet> own = ownPoints(keyframes, &total);
   alignment::PointSet points;
-  for (size_t k : tileKeyframes(key)) {
-    const alignment::PointSet placed = keyframePoints(k);
-    points.insert(points.end(), placed.begin(), placed.end());
-  }
+  points.reserve(total);
+  for (size_t i = 0; i < keyframes.size(); ++i) alignment::appendTransformed(own[i], map_.keyframes()[keyframes[i]].pose, &points);
   Tile tile{key, nullptr, nullptr};
   if (!points.empty()) tile.grid = std::make_unique<const alignment::LikelihoodGrid>(points, tileCentre(key), options_.coarse);
   ++built_coarse_;

@@ -42,11 +42,9 @@ alignment::PointSet submapOf(const Map& map, size_t center, const std::vector<si
   const auto& kf = map.keyframes();
   alignment::PointSet all;
   const common::Pose2& origin = kf[center].pose;
-  for (const size_t j : keyframes) {
-    const alignment::PointSet points = alignment::transformed(alignment::pointSetFromScan(map.scan(j), alignment::ScanModelOptions{}, true),
-                                                              common::between(origin, kf[j].pose));
-    all.insert(all.end(), points.begin(), points.end());
-  }
+  for (const size_t j : keyframes)
+    alignment::appendTransformed(alignment::pointSetFromScan(map.scan(j), alignment::ScanModelOptions{}, true),
+                                 common::between(origin, kf[j].pose), &all);
   alignment::PointSet out;
   for (const size_t i : alignment::firstPerVoxel(all, voxel_m)) out.push_back(all[i]);
   return out;

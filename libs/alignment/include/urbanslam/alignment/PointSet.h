@@ -38,5 +38,8 @@ struct Rigid2 {
 // them) expressed in the frame in which `pose` is the
 // frame of the set: p' = R(phi) p + t.
 PointSet transformed(const PointSet& points, const common::Pose2& pose);
+// The same appended to `out`, with no copy in between (a submap or a map tile concatenates the
+// scans of many keyframes; callers reserve the whole first).
+void appendTransformed(const PointSet& points, const common::Pose2& pose, PointSet* out);
 
 }  // namespace urbanslam::alignment

@@ -56,7 +56,8 @@ class MapAreas {
   // The keyframes (with scans) whose references make up the tile, thinned.
   std::vector<size_t> tileKeyframes(int64_t key) const;
   Eigen::Vector2d tileCentre(int64_t key) const;
-  alignment::PointSet keyframePoints(size_t k) const;
+  // Their points in their own frames, as local SLAM made them, and how many in all.
+  std::vector<alignment::PointSet> ownPoints(const std::vector<size_t>& keyframes, size_t* total) const;
   Tile* find(std::list<Tile>& cache, int64_t key);
 
   const Map& map_;
