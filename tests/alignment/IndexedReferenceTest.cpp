@@ -84,6 +84,82 @@ TEST(NearestNeighbours, BoundedSearchAgreesWithBruteForce) {
   EXPECT_FALSE(index.nearestWithin(q, std::nextafter(best, 0.0), &j, &d2));
 }
 
+// A refinement's queries: each scan point asked again at every iteration, a little (sometimes a
+// lot) from where it was last asked, with the bound changing. The memo's answers are the brute
+// force's (found, squared distance) and the plain search's (the index: of two points at the same
+// distance the grid answers the lower, the kd-tree the one its order finds), whether or not a
+// search ran.
+TEST(NearestNeighbours, MemoGivesTheSearchsAnswerAsTheQueryWanders) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-5, 5), unit(-1, 1);
+  std::vector<Eigen::Vector2d> pts;
+  // Walls sampled every centimetre or two (a refinement's usual reference), scattered points,
+  // and a duplicate (a tie at every query).
+  for (int i = 0; i < 400; ++i) pts.push_back({-3.0 + 0.015 * i, 2.0 + 0.002 * unit(rng)});
+  for (int i = 0; i < 300; ++i) pts.push_back({1.5 + 0.002 * unit(rng), -3.0 + 0.02 * i});
+  for (int i = 0; i < 300; ++i) pts.push_back({u(rng), u(rng)});
+  pts.push_back(pts[250]);
+  const ua::NearestNeighbours index(pts);
+  const auto truth = [&](const Eigen::Vector2d& q, double bound, double* d2) {
+    *d2 = bruteForceNearest(pts, q);
+    return *d2 <= bound;
+  };
+  size_t searched_less = 0;
+  for (int walk = 0; walk < 300; ++walk) {
+    ua::NearestNeighbours::Memo memo;
+    Eigen::Vector2d q = walk % 3 == 0 ? pts[static_cast<size_t>(walk) % pts.size()] : Eigen::Vector2d(u(rng), u(rng));
+    for (int step = 0; step < 30; ++step) {
+      const double scale = step % 10 == 9 ? 0.5 : (step % 2 == 0 ? 1e-4 : 3e-3);  // sub-millimetre, millimetres, a jump
+      q += scale * Eigen::Vector2d(unit(rng), unit(rng));
+      if (walk % 3 == 0 && step == 15) q = pts[250];  // exactly on the duplicated point
+      // Bounds the cell grid answers, and ones beyond its reach (the kd-tree's: ICP's first gates).
+      const double bounds[] = {0.09, 0.01, 0.0001, 0.16, 0.25, 4.0};
+      const double bound = bounds[(walk + step / 5) % 6];
+      int j = -1;
+      double dt = 0, d2 = -1;
+      const Eigen::Vector2d before = memo.query;
+      const bool expected = truth(q, bound, &dt);
+      int jp = -1;
+      double dp = -1;
+      ASSERT_EQ(index.nearestWithin(q, bound, &jp, &dp), expected) << walk << " " << step;
+      ASSERT_EQ(index.nearestWithin(q, bound, &memo, &j, &d2), expected) << walk << " " << step;
+      if (expected) {
+        EXPECT_EQ(j, jp) << walk << " " << step;
+        EXPECT_EQ((pts[static_cast<size_t>(j)] - q).squaredNorm(), dt) << walk << " " << step;
+        EXPECT_EQ(d2, dt) << walk << " " << step;
+      }
+      if (memo.query == before && step > 0) ++searched_less;
+    }
+  }
+  // Most small steps keep their answer without a search: the memo is what makes it cheaper.
+  EXPECT_GT(searched_less, 300u * 30u / 3);
+  // A tie the kd-tree answers: the plain search's choice of the two.
+  ua::NearestNeighbours::Memo memo;
+  int j = -1, jp = -1;
+  double d2 = -1, dp = -1;
+  const Eigen::Vector2d q = pts[250] + Eigen::Vector2d(0.3, 0.4);
+  ASSERT_TRUE(index.nearestWithin(q, 4.0, &j, &d2));
+  ASSERT_TRUE(index.nearestWithin(q, 4.0, &memo, &jp, &dp));
+  EXPECT_EQ(jp, j);
+  EXPECT_EQ(dp, d2);
+}
+
+// The next nearest point can lie in the next cell of the search's grid while the nearest is so
+// close that the plain search never looks there: the memo's search must, or a query that then
+// crosses into that cell keeps a stale answer. Cells are 0.1 m from the lowest point.
+TEST(NearestNeighbours, MemoSeesTheNextNearestAcrossACellEdge) {
+  const std::vector<Eigen::Vector2d> pts = {{0, 0}, {0.099, 0.05}, {0.101, 0.05}, {0.5, 0.5}};
+  const ua::NearestNeighbours index(pts);
+  ua::NearestNeighbours::Memo memo;
+  int j = -1;
+  double d2 = -1;
+  ASSERT_TRUE(index.nearestWithin({0.0985, 0.05}, 0.09, &memo, &j, &d2));
+  EXPECT_EQ(j, 1);
+  ASSERT_TRUE(index.nearestWithin({0.1005, 0.05}, 0.09, &memo, &j, &d2));
+  EXPECT_EQ(j, 2);
+  EXPECT_EQ(d2, (pts[2] - Eigen::Vector2d(0.1005, 0.05)).squaredNorm());
+}
+
 TEST(IndexedReference, SameResultAsAligningThePointSets) {
   const auto world = ua::test::roomWorld();
   ua::test::ScanSpec spec;

@@ -60,6 +60,9 @@ RegistrationResult icpWithIndex(const PointSet& reference, const NearestNeighbou
   std::vector<Eigen::Vector2d> src, dst;
   std::vector<double> w;
   std::vector<int> ref_index, mov_index;
+  // Each point's last association: near convergence the pose moves by little and most points
+  // keep their nearest reference point (NearestNeighbours::Memo).
+  std::vector<NearestNeighbours::Memo> memos(moving.size());
   src.reserve(moving.size());
   dst.reserve(moving.size());
   w.reserve(moving.size());
@@ -83,7 +86,7 @@ RegistrationResult icpWithIndex(const PointSet& reference, const NearestNeighbou
       const Eigen::Vector2d m = T * q.p;
       int j = 0;
       double d2 = 0;
-      if (!index.nearestWithin(m, g * g, &j, &d2)) continue;
+      if (!index.nearestWithin(m, g * g, &memos[i], &j, &d2)) continue;
       if (point_to_line && !seenFromSameSide(normals[j], reference[j], T * q.origin, seen_side_tolerance)) continue;
       double e = std::sqrt(d2);
       if (point_to_line && normals[j].valid) e = std::abs(normals[j].n.dot(m - reference[j].p));

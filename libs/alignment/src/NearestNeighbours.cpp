@@ -95,22 +95,26 @@ struct CellGrid {
                                    q.y() <= y0 + kCellM * ny - kMarginM));
   }
 
-  // The nearest point within max_d2 (inclusive); ties to the lower index. False: none.
-  bool nearestWithin(const Eigen::Vector2d& q, double max_d2, int* index, double* distance_sq) const {
+  // The nearest point within max_d2 (inclusive); ties to the lower index. False: none. With
+  // `second_d2`, also the squared distance of the next nearest point within max_d2 (max_d2 when
+  // there is none): the search then prunes by that one instead of the nearest.
+  bool nearestWithin(const Eigen::Vector2d& q, double max_d2, int* index, double* distance_sq, double* second_d2 = nullptr) const {
     // A query farther than the bound from the grid's rectangle has nothing within it.
     const double ox = std::max(0.0, std::max(x0 - q.x(), q.x() - (x0 + kCellM * nx)));
     const double oy = std::max(0.0, std::max(y0 - q.y(), q.y() - (y0 + kCellM * ny)));
+    if (second_d2) *second_d2 = max_d2;
     if (ox * ox + oy * oy > max_d2) return false;
     const double fx = (q.x() - x0) / kCellM, fy = (q.y() - y0) / kCellM;
     const double cxf = std::floor(fx), cyf = std::floor(fy);
     // Beyond ring k every point is farther than k cells plus q's distance to its own cell's edge.
     const double edge = kCellM * std::min(std::min(fx - cxf, 1.0 - (fx - cxf)), std::min(fy - cyf, 1.0 - (fy - cyf)));
     const long cx = static_cast<long>(cxf), cy = static_cast<long>(cyf);
-    double best = max_d2;
+    double best = max_d2, second = max_d2;
     long best_i = -1;
+    double& prune = second_d2 ? second : best;  // nothing farther than this can change the answer
     for (int ring = 0; ring <= kMaxRings; ++ring) {
       const double reach = kCellM * (ring - 1) + edge;  // the nearest any point of this ring can be
-      if (ring > 0 && reach > 0 && reach * reach > best) break;
+      if (ring > 0 && reach > 0 && reach * reach > prune) break;
       for (long y = cy - ring; y <= cy + ring; ++y) {
         if (y < 0 || y >= ny) continue;
         const bool edge_row = y == cy - ring || y == cy + ring;
@@ -119,15 +123,21 @@ struct CellGrid {
           // The cell's nearest corner or side: farther than the best so far, nothing in it wins.
           const double gx = std::max(0.0, std::max(static_cast<double>(x) - fx, fx - static_cast<double>(x + 1)));
           const double gy = std::max(0.0, std::max(static_cast<double>(y) - fy, fy - static_cast<double>(y + 1)));
-          if (kCellM * kCellM * (gx * gx + gy * gy) > best) continue;
+          if (kCellM * kCellM * (gx * gx + gy * gy) > prune) continue;
           const size_t c = static_cast<size_t>(y * nx + x);
           for (uint32_t k = start[c]; k < start[c + 1]; ++k) {
             const double d2 = (sorted[k] - q).squaredNorm();
-            if (d2 < best || (d2 == best && (best_i < 0 || order[k] < best_i))) best = d2, best_i = order[k];
+            if (d2 < best || (d2 == best && (best_i < 0 || order[k] < best_i))) {
+              if (best_i >= 0) second = std::min(second, best);
+              best = d2, best_i = order[k];
+            } else if (d2 < second) {
+              second = d2;
+            }
           }
         }
       }
     }
+    if (second_d2) *second_d2 = second;
     if (best_i < 0) return false;
     *index = static_cast<int>(best_i);
     *distance_sq = best;
@@ -188,6 +198,59 @@ bool NearestNeighbours::nearestWithin(const Eigen::Vector2d& query, double max_d
   *index = static_cast<int>(idx);
   *distance_sq = d2;
   return true;
+}
+
+bool NearestNeighbours::nearestWithin(const Eigen::Vector2d& query, double max_distance_sq, Memo* memo, int* index,
+                                      double* distance_sq) const {
+  if (impl_->cloud.pts.empty()) return false;
+  // Rounding in the distances below is far under this; a query this close to a tie searches.
+  constexpr double kSlackM = 1e-9;
+  const double moved = (query - memo->query).norm();  // NaN for a fresh memo: every test below fails
+  if (memo->index >= 0) {
+    const Eigen::Vector2d& p = impl_->cloud.pts[static_cast<size_t>(memo->index)];
+    // As both searches compute it (the kd-tree's metric sums the same two squares).
+    const double d2 = (p - query).squaredNorm();
+    // Every other point lay at least `others` from the last query, so at least others - moved
+    // from this one: farther than the memo's point, which stays the strict nearest (the answer
+    // of either search, ties aside).
+    if (memo->others - moved > std::sqrt(d2) + kSlackM) {
+      if (d2 > max_distance_sq) return false;  // and every other point is farther still
+      *index = memo->index;
+      *distance_sq = d2;
+      return true;
+    }
+  } else if (memo->others - moved > std::sqrt(max_distance_sq) + kSlackM) {
+    return false;  // nothing lay within `others` of the last query
+  }
+  // The search, as nearestWithin's, also finding the next nearest.
+  bool found = false;
+  double second_d2 = max_distance_sq;
+  if (max_distance_sq <= CellGrid::kMarginM * CellGrid::kMarginM && impl_->grid.covers(query)) {
+    found = impl_->grid.nearestWithin(query, max_distance_sq, index, distance_sq, &second_d2);
+  } else {
+    uint32_t idx[2] = {0, 0};
+    double d2[2] = {0, 0};
+    nanoflann::KNNResultSet<double, uint32_t> result(2);
+    result.init(idx, d2);
+    d2[1] = std::nextafter(max_distance_sq, std::numeric_limits<double>::infinity());  // the bound, inclusive
+    const double q[2] = {query.x(), query.y()};
+    impl_->tree().findNeighbors(result, q, nanoflann::SearchParams());
+    if (result.size() == 2 && d2[0] == d2[1]) {
+      // A tie: the answer is the plain search's, whichever of the two its order finds first; the
+      // memo then holds no margin.
+      found = nearestWithin(query, max_distance_sq, index, distance_sq);
+      second_d2 = d2[0];
+    } else if (result.size() > 0) {
+      found = true;
+      *index = static_cast<int>(idx[0]);
+      *distance_sq = d2[0];
+      if (result.size() == 2) second_d2 = d2[1];
+    }
+  }
+  memo->query = query;
+  memo->index = found ? *index : -1;
+  memo->others = std::sqrt(second_d2);
+  return found;
 }
 
 size_t NearestNeighbours::knn(const Eigen::Vector2d& query, size_t k, std::vector<int>* indices, std::vector<double>* distances_sq) const {

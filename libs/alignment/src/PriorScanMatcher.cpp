@@ -148,6 +148,9 @@ PriorMatchResult matchWithPrior(const MatchReference& reference, const PointSet&
   common::Pose2 x = coarse.pose;
   Eigen::Matrix3d H;
   double sum_d2 = 0;
+  // Each point's last association: the iterations move the pose by less and less, and most
+  // points keep their nearest reference point (NearestNeighbours::Memo).
+  std::vector<NearestNeighbours::Memo> memos(scan.size());
   const auto linearise = [&](const common::Pose2& at, Eigen::Vector3d& g, int& matched) {
     H.setZero();
     g.setZero();
@@ -159,7 +162,7 @@ PriorMatchResult matchWithPrior(const MatchReference& reference, const PointSet&
       const Eigen::Vector2d rp = R * scan[i].p, q = rp + t;
       int j = -1;
       double d2 = 0;
-      if (!reference.indexed().index().nearestWithin(q, gate2, &j, &d2)) continue;
+      if (!reference.indexed().index().nearestWithin(q, gate2, &memos[i], &j, &d2)) continue;
       ++matched;
       sum_d2 += d2;
       const Eigen::Vector2d dq(-rp.y(), rp.x());  // d q / d phi
