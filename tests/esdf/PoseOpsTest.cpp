@@ -135,15 +135,12 @@ TEST(PoseOps, RelativePoseErrorClosedFormEqualsTheCompositeChain) {
   }
 }
 
-}  // namespace
-}  // namespace urbanslam::esdf
-
 TEST(PoseOps, DiagonalFloorsRaiseOnlyTheDiagonalEntriesBelowThem) {
-  urbanslam::esdf::Mat3 cov;
+  Mat3 cov;
   cov << 4e-4, 1e-4, 2e-5,  //
       1e-4, 9.0, 3e-5,      //
       2e-5, 3e-5, 1e-6;
-  const urbanslam::esdf::Mat3 f = urbanslam::esdf::withDiagonalFloors(cov, 0.1, 0.01);
+  const Mat3 f = withDiagonalFloors(cov, 0.1, 0.01);
   EXPECT_DOUBLE_EQ(f(0, 0), 0.01);  // 2 cm raised to 10 cm
   EXPECT_DOUBLE_EQ(f(1, 1), 9.0);   // 3 m left as it is
   EXPECT_DOUBLE_EQ(f(2, 2), 1e-4);  // 1 mrad raised to 10 mrad
@@ -155,3 +152,6 @@ TEST(PoseOps, DiagonalFloorsRaiseOnlyTheDiagonalEntriesBelowThem) {
     }
   }
 }
+
+}  // namespace
+}  // namespace urbanslam::esdf

@@ -155,6 +155,21 @@ struct NearestNeighbours::Impl {
     std::call_once(tree_built, [this] { tree_ = std::make_unique<Tree>(2, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(8)); });
     return *tree_;
   }
+  // Whether the grid answers a bounded query (else the kd-tree does): both give the same point.
+  bool gridAnswers(const Eigen::Vector2d& q, double max_d2) const {
+    return max_d2 <= CellGrid::kMarginM * CellGrid::kMarginM && grid.covers(q);
+  }
+  // The kd-tree's `n` (1 or 2) nearest within max_d2 (inclusive), nearest first: how many.
+  size_t treeNearestWithin(const Eigen::Vector2d& query, double max_d2, size_t n, uint32_t* idx, double* d2) const {
+    nanoflann::KNNResultSet<double, uint32_t> result(n);
+    result.init(idx, d2);
+    // The result set's worst distance is the search bound; the leaf test is strict, so the bound
+    // is the next double above the limit to keep a point exactly at it.
+    d2[n - 1] = std::nextafter(max_d2, std::numeric_limits<double>::infinity());
+    const double q[2] = {query.x(), query.y()};
+    tree().findNeighbors(result, q, nanoflann::SearchParams());
+    return result.size();
+  }
 
  private:
   mutable std::once_flag tree_built;
@@ -183,18 +198,10 @@ bool NearestNeighbours::nearest(const Eigen::Vector2d& query, int* index, double
 
 bool NearestNeighbours::nearestWithin(const Eigen::Vector2d& query, double max_distance_sq, int* index, double* distance_sq) const {
   if (impl_->cloud.pts.empty()) return false;
-  if (max_distance_sq <= CellGrid::kMarginM * CellGrid::kMarginM && impl_->grid.covers(query))
-    return impl_->grid.nearestWithin(query, max_distance_sq, index, distance_sq);
+  if (impl_->gridAnswers(query, max_distance_sq)) return impl_->grid.nearestWithin(query, max_distance_sq, index, distance_sq);
   uint32_t idx = 0;
   double d2 = 0;
-  nanoflann::KNNResultSet<double, uint32_t> result(1);
-  result.init(&idx, &d2);
-  // The result set's worst distance is the search bound; the leaf test is strict, so the bound
-  // is the next double above the limit to keep a point exactly at it.
-  d2 = std::nextafter(max_distance_sq, std::numeric_limits<double>::infinity());
-  const double q[2] = {query.x(), query.y()};
-  impl_->tree().findNeighbors(result, q, nanoflann::SearchParams());
-  if (result.size() == 0) return false;
+  if (impl_->treeNearestWithin(query, max_distance_sq, 1, &idx, &d2) == 0) return false;
   *index = static_cast<int>(idx);
   *distance_sq = d2;
   return true;
@@ -225,26 +232,22 @@ bool NearestNeighbours::nearestWithin(const Eigen::Vector2d& query, double max_d
   // The search, as nearestWithin's, also finding the next nearest.
   bool found = false;
   double second_d2 = max_distance_sq;
-  if (max_distance_sq <= CellGrid::kMarginM * CellGrid::kMarginM && impl_->grid.covers(query)) {
+  if (impl_->gridAnswers(query, max_distance_sq)) {
     found = impl_->grid.nearestWithin(query, max_distance_sq, index, distance_sq, &second_d2);
   } else {
     uint32_t idx[2] = {0, 0};
     double d2[2] = {0, 0};
-    nanoflann::KNNResultSet<double, uint32_t> result(2);
-    result.init(idx, d2);
-    d2[1] = std::nextafter(max_distance_sq, std::numeric_limits<double>::infinity());  // the bound, inclusive
-    const double q[2] = {query.x(), query.y()};
-    impl_->tree().findNeighbors(result, q, nanoflann::SearchParams());
-    if (result.size() == 2 && d2[0] == d2[1]) {
+    const size_t n = impl_->treeNearestWithin(query, max_distance_sq, 2, idx, d2);
+    if (n == 2 && d2[0] == d2[1]) {
       // A tie: the answer is the plain search's, whichever of the two its order finds first; the
       // memo then holds no margin.
       found = nearestWithin(query, max_distance_sq, index, distance_sq);
       second_d2 = d2[0];
-    } else if (result.size() > 0) {
+    } else if (n > 0) {
       found = true;
       *index = static_cast<int>(idx[0]);
       *distance_sq = d2[0];
-      if (result.size() == 2) second_d2 = d2[1];
+      if (n == 2) second_d2 = d2[1];
     }
   }
   memo->query = query;

@@ -404,8 +404,9 @@ void GlobalSlam::addPlaceFix(size_t earlier, size_t current, const common::Pose2
   // two keyframes' scans, aligned from there, measure it as a loop closure does (in an ACES
   // corridor a search settled 1.2 m along it, held to 2 cm, and the closures that followed were
   // gated out). CRF-match first, ICP then from its hypotheses and the fix: PL-ICP from a fix a
-  // metre off stops in a wrong minimum. No ambiguity restarts: the join's agreeing fixes have
-  // told the place already; the innovation gate below judges the measurement as any closure's.
+  // metre off stops in a wrong minimum. No ambiguity restarts (a reach of 0 leaves them none):
+  // the join's agreeing fixes have told the place already; the innovation gate below judges the
+  // measurement as any closure's.
   common::Pose2 measured = z;
   Eigen::Matrix3d measured_information = information;
   if (detector == Proposer::Place) {
